@@ -1,0 +1,43 @@
+"""Log-spaced bins with an underflow and an overflow bin.
+
+A ``LogBins(lo, hi, per_decade)`` has the finite edges e_0 = lo < ... < e_n = hi
+and n + 2 bins: index 0 holds everything below lo (including 0 and negative
+values), index j + 1 holds [e_j, e_{j+1}), and index n + 1 holds [hi, inf).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class LogBins:
+    lo: float
+    hi: float
+    per_decade: int
+
+    def __post_init__(self):
+        if not (0.0 < self.lo < self.hi):
+            raise ValueError(f"bins need 0 < lo < hi, got lo={self.lo}, hi={self.hi}")
+        if self.per_decade < 1:
+            raise ValueError(f"bins need per_decade >= 1, got {self.per_decade}")
+
+    @property
+    def n(self) -> int:
+        """Number of finite bins (hi is rounded up to a whole bin)."""
+        return int(np.ceil(np.log10(self.hi / self.lo) * self.per_decade - 1e-9))
+
+    @property
+    def edges(self) -> np.ndarray:
+        """The n + 1 finite edges."""
+        return self.lo * 10.0 ** (np.arange(self.n + 1) / self.per_decade)
+
+    @property
+    def lower(self) -> np.ndarray:
+        """Lower edge of each of the n + 2 bins (0 for the underflow bin)."""
+        return np.concatenate([[0.0], self.edges])
+
+    @property
+    def upper(self) -> np.ndarray:
+        """Upper edge of each of the n + 2 bins (inf for the overflow bin)."""
+        return np.concatenate([self.edges, [np.inf]])

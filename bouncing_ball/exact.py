@@ -1,0 +1,118 @@
+"""The paper's exact solutions at r = 1/2 and r = 1/3.
+
+eq. (P(0,v)) with the constants of eq. (constants), and P(x) of eq. (P(x)2).
+The time averages <x>, Delta x and the collision rate I of eq. (xandDeltax)
+are computed here from these distributions (not copied from the paper), so
+that a test can compare them with the paper's closed forms.
+"""
+
+from fractions import Fraction
+
+import numpy as np
+from scipy import integrate, special
+
+EXACT_RESTITUTIONS = (Fraction(1, 2), Fraction(1, 3))
+
+
+def _which(restitution) -> Fraction:
+    value = Fraction(restitution).limit_denominator(1000)
+    if value not in EXACT_RESTITUTIONS or abs(float(value) - float(restitution)) > 1e-12:
+        raise ValueError(f"exact solutions exist only for r = 1/2 and 1/3, not r = {restitution}")
+    return value
+
+
+def normalization_constant(restitution) -> float:
+    """A_{1/2} = 1/3 and A_{1/3} = (27 / (32 pi))^(1/2), eq. (constants)."""
+    if _which(restitution) == Fraction(1, 2):
+        return 1.0 / 3.0
+    return np.sqrt(27.0 / (32.0 * np.pi))
+
+
+def outgoing_speed_density(v, restitution):
+    """P(0, v) for v > 0 (outgoing side), eq. (P(0,v))."""
+    v = np.asarray(v, dtype=float)
+    a = normalization_constant(restitution)
+    if _which(restitution) == Fraction(1, 2):
+        return a * np.exp(-v) / v
+    return a * v**-1.5 * np.exp(-1.5 * v)
+
+
+def outgoing_speed_bin_average(lo, hi, restitution):
+    """int_lo^hi v P(0,v) dv / int_lo^hi v dv, the quantity a simulation bin measures."""
+    lo = np.asarray(lo, dtype=float)
+    hi = np.asarray(hi, dtype=float)
+    a = normalization_constant(restitution)
+    if _which(restitution) == Fraction(1, 2):
+        rate = a * (np.exp(-lo) - np.exp(-hi))  # int v^0 e^{-v}
+    else:
+        # int v^{-1/2} e^{-3v/2} dv = Gamma(1/2) (3/2)^{-1/2} [P(1/2, 3v/2)]
+        scale = special.gamma(0.5) / np.sqrt(1.5)
+        rate = a * scale * (special.gammainc(0.5, 1.5 * hi) - special.gammainc(0.5, 1.5 * lo))
+    return rate / (0.5 * (hi**2 - lo**2))
+
+
+def position_density(x, restitution):
+    """P(x), eq. (P(x)2)."""
+    x = np.asarray(x, dtype=float)
+    if _which(restitution) == Fraction(1, 2):
+        return special.k0(np.sqrt(2.0 * x / 3.0)) / 3.0
+    return np.vectorize(_position_density_third)(x)
+
+
+def _position_density_third(x):
+    # (1/4 pi) int dF F^-1 K_{1/6}(z) e^{-z - F x}, z = 1/(12 F); in ln F
+    def integrand(log_f):
+        f = np.exp(log_f)
+        z = 1.0 / (12.0 * f)
+        return special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z - f * x)
+
+    # e^{-2z} cuts off small F; e^{-F x} (or, at x = 0, nothing) large F
+    upper = np.log(60.0 / x) if x > 0.0 else np.inf
+    value, _ = integrate.quad(
+        integrand, -8.0, max(upper, 8.0), limit=400, epsabs=0.0, epsrel=1e-11
+    )
+    return value / (4.0 * np.pi)
+
+
+def position_bin_average(lo, hi, restitution):
+    """int_lo^hi P(x) dx / (hi - lo)."""
+    lo = np.asarray(lo, dtype=float)
+    hi = np.asarray(hi, dtype=float)
+    if _which(restitution) == Fraction(1, 2):
+        # int (1/3) K0(sqrt(2x/3)) dx = -u K1(u), u = sqrt(2x/3)
+        def primitive(x):
+            u = np.sqrt(2.0 * x / 3.0)
+            return np.where(u > 0, -u * special.k1(np.where(u > 0, u, 1.0)), -1.0)
+
+        return (primitive(hi) - primitive(lo)) / (hi - lo)
+    averages = [
+        integrate.quad(lambda x: _position_density_third(x), a, b, epsrel=1e-10)[0] / (b - a)
+        for a, b in zip(np.atleast_1d(lo), np.atleast_1d(hi))
+    ]
+    return np.asarray(averages).reshape(np.shape(lo))
+
+
+def position_moments(restitution) -> dict:
+    """<x>, Delta x (eq. (xandDeltax)) from P(x), and I from eq. (collrate)."""
+    moments = []
+    for k in (0, 1, 2):
+        # x = 3 u^2 / 2 makes the decay exp(-u) for both r
+        def integrand(u, k=k):
+            x = 1.5 * u * u
+            return x**k * float(position_density(x, restitution)) * 3.0 * u
+
+        value, _ = integrate.quad(integrand, 0.0, np.inf, limit=400, epsrel=1e-12)
+        moments.append(value)
+    norm, first, second = moments
+    mean_x = first / norm
+    a = normalization_constant(restitution)
+    if _which(restitution) == Fraction(1, 2):
+        rate = a  # int_0^inf v * v^-1 e^-v dv
+    else:
+        rate = a * special.gamma(0.5) / np.sqrt(1.5)
+    return {
+        "normalization": norm,
+        "mean_x": mean_x,
+        "delta_x": np.sqrt(second / norm - mean_x**2),
+        "collision_rate": rate,
+    }

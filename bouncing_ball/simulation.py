@@ -1,0 +1,262 @@
+"""Monte Carlo simulation of the inelastically bouncing ball (the paper's Sec. IV).
+
+The particle moves by the exact free-flight update, eqs. (xstep), (vstep),
+with step Delta = D(x, v) + delta: D is the largest step allowed by
+eq. (criterion) and delta a minimum step, reset after every collision so
+that sqrt(2 delta) = v_out / min_step_divisor (the paper uses 500).
+
+Where a collision happens.  When a step ends below x = 0, the collision is
+placed where the bridge mean path (the cubic Hermite interpolant of the two
+ends of the step, see ``free_flight``) first reaches x = 0, and the impact
+speed is that path's slope there.  The rest of the step is discarded, the
+particle restarts from x = 0 with v_out = r v_in, eq. (restitution), and
+the clock advances only to the collision.  Taking the end-of-step velocity
+instead adds the whole step's noise sqrt(2 Delta) >= sqrt(2 delta) to the
+impact speed, which biases P(0, v) upward at speeds comparable to it; the
+interpolated crossing does not.
+
+What a shard records after its equilibration time (all exact in expectation
+given the ends of each step, not left-point sums, because Delta depends on
+the state):
+  * outgoing speeds at collisions, on log bins;
+  * the time, collisions and steps;
+  * int x dt and int x^2 dt (mean path plus bridge variance);
+  * the time spent in each log bin of x along the mean path, and
+    int v^2 dt in each bin (slope squared plus bridge variance of v), which
+    give P(x) and <v^2>_x of eq. (moment2).
+
+A shard's work is bounded: it stops after ``max_steps`` steps even if the
+simulated time has not been reached, and says so.
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .bins import LogBins
+from .free_flight import (
+    cubic_level_time,
+    cubic_slope,
+    cubic_value,
+    first_crossing_time,
+    free_flight_step,
+    hermite_cubic,
+    largest_safe_step,
+    mean_path_integrals,
+    slope_zeros,
+    speed_squared_antiderivative,
+)
+from .tallies import ShardTallies
+
+# indices into the scalar tally array of the compiled loop
+_TIME, _COLLISIONS, _STEPS, _INT_X, _INT_X2, _EXHAUSTED = range(6)
+
+
+def shard_seed_sequence(seed: int, label: str, shard: int) -> np.random.SeedSequence:
+    """The random stream of one (r, shard): independent of job order and cores.
+
+    The r label (see ``restitution.label``) enters the spawn key as the integer
+    spelled by its ASCII bytes, so different r never share a stream.
+    """
+    r_key = int.from_bytes(label.encode("ascii"), "big")
+    return np.random.SeedSequence(entropy=seed, spawn_key=(r_key, shard))
+
+
+@njit(cache=True)
+def _bin_index(value, log_lo, per_ln, n, edges):
+    """Index of ``value`` in LogBins (0 underflow, n + 1 overflow)."""
+    if value < edges[0]:
+        return 0
+    if value >= edges[n]:
+        return n + 1
+    k = int((math.log(value) - log_lo) * per_ln)
+    if k < 0:
+        k = 0
+    if k > n - 1:
+        k = n - 1
+    # correct a last-digit disagreement between log and the stored edges
+    while k > 0 and value < edges[k]:
+        k -= 1
+    while k < n - 1 and value >= edges[k + 1]:
+        k += 1
+    return k + 1
+
+
+@njit(cache=True)
+def _tally_position(a0, a1, a2, a3, dt, t_a, t_b, k, edges, time_in, v2_in):
+    """Add the time and int v^2 dt of the monotone piece [t_a, t_b] to x bins.
+
+    ``k`` is the bin of m(t_a); the walk crosses one bin edge at a time (no
+    logarithms) and returns the bin of m(t_b).
+    """
+    n = edges.shape[0] - 1
+    x_b = cubic_value(a0, a1, a2, a3, t_b)
+    t_prev = t_a
+    s_prev = speed_squared_antiderivative(a1, a2, a3, dt, t_a)
+    while True:
+        if k <= n and x_b >= edges[k]:  # leaves bin k through its upper edge
+            level = edges[k]
+            k_next = k + 1
+        elif k >= 1 and x_b < edges[k - 1]:  # through its lower edge
+            level = edges[k - 1]
+            k_next = k - 1
+        else:
+            break
+        t_e = cubic_level_time(a0, a1, a2, a3, level, t_prev, t_b)
+        s_e = speed_squared_antiderivative(a1, a2, a3, dt, t_e)
+        time_in[k] += t_e - t_prev
+        v2_in[k] += s_e - s_prev
+        t_prev, s_prev = t_e, s_e
+        k = k_next
+    s_b = speed_squared_antiderivative(a1, a2, a3, dt, t_b)
+    time_in[k] += t_b - t_prev
+    v2_in[k] += s_b - s_prev
+    return k
+
+
+@njit(cache=True)
+def _run(
+    rng,
+    restitution,
+    c,
+    min_step_divisor,
+    equilibration_time,
+    recorded_time,
+    max_steps,
+    v_edges,
+    x_edges,
+    speed_counts,
+    position_time,
+    position_v2_time,
+    scalars,
+):
+    nv = v_edges.shape[0] - 1
+    v_log_lo = math.log(v_edges[0])
+    v_per_ln = nv / (math.log(v_edges[nv]) - v_log_lo)
+    nx = x_edges.shape[0] - 1
+    x_log_lo = math.log(x_edges[0])
+    x_per_ln = nx / (math.log(x_edges[nx]) - x_log_lo)
+
+    # start at rest one unit above the floor; equilibration forgets this
+    x = 1.0
+    v = 0.0
+    x_bin = _bin_index(x, x_log_lo, x_per_ln, nx, x_edges)  # kept while recording
+    delta = 0.5 * (1.0 / min_step_divisor) ** 2
+    recording = equilibration_time <= 0.0
+    t = 0.0
+    t_stop = recorded_time if recording else equilibration_time
+    steps = 0
+    collisions = 0
+    int_x = 0.0
+    int_x2 = 0.0
+    exhausted = 0
+
+    while True:
+        if t >= t_stop:
+            if recording:
+                break
+            recording = True
+            x_bin = _bin_index(x, x_log_lo, x_per_ln, nx, x_edges)
+            t = 0.0
+            t_stop = recorded_time
+            continue
+        if steps >= max_steps:
+            exhausted = 1
+            break
+        dt = largest_safe_step(x, v, c) + delta  # eq. (criterion) plus delta
+        if t + dt > t_stop:
+            dt = t_stop - t
+        normal_r = rng.standard_normal()
+        normal_s = rng.standard_normal()
+        x1, v1 = free_flight_step(x, v, dt, normal_r, normal_s)
+        a0, a1, a2, a3 = hermite_cubic(x, v, x1, v1, dt)
+        collided = x1 < 0.0
+        tau = first_crossing_time(a0, a1, a2, a3, dt) if collided else dt
+        steps += 1
+        if recording:
+            ix, ix2 = mean_path_integrals(a0, a1, a2, a3, dt, tau)
+            int_x += ix
+            int_x2 += ix2
+            n_zero, t1, t2 = slope_zeros(a1, a2, a3, tau)
+            t_a = 0.0
+            for piece in range(n_zero + 1):
+                t_b = tau
+                if piece == 0 and n_zero >= 1:
+                    t_b = t1
+                elif piece == 1 and n_zero == 2:
+                    t_b = t2
+                x_bin = _tally_position(
+                    a0, a1, a2, a3, dt, t_a, t_b, x_bin,
+                    x_edges, position_time, position_v2_time,
+                )
+                t_a = t_b
+        t += tau
+        if collided:
+            v_out = restitution * abs(cubic_slope(a1, a2, a3, tau))  # eq. (restitution)
+            if recording:
+                collisions += 1
+                speed_counts[_bin_index(v_out, v_log_lo, v_per_ln, nv, v_edges)] += 1
+            x = 0.0
+            x_bin = 0
+            v = v_out
+            delta = 0.5 * (v_out / min_step_divisor) ** 2
+        else:
+            x = x1
+            v = v1
+
+    scalars[_TIME] = t if recording else 0.0
+    scalars[_COLLISIONS] = collisions
+    scalars[_STEPS] = steps
+    scalars[_INT_X] = int_x
+    scalars[_INT_X2] = int_x2
+    scalars[_EXHAUSTED] = exhausted
+
+
+def simulate_shard(
+    restitution: float,
+    seed_sequence: np.random.SeedSequence,
+    recorded_time: float,
+    equilibration_time: float,
+    criterion_c: float,
+    min_step_divisor: float,
+    max_steps: int,
+    speed_bins: LogBins,
+    position_bins: LogBins,
+) -> ShardTallies:
+    """Run one shard and return its tallies (pure: no I/O)."""
+    if not 0.0 < restitution < 1.0:
+        raise ValueError(f"restitution must lie in (0, 1), got {restitution}")
+    rng = np.random.Generator(np.random.PCG64(seed_sequence))
+    speed_counts = np.zeros(speed_bins.n + 2, dtype=np.int64)
+    position_time = np.zeros(position_bins.n + 2)
+    position_v2_time = np.zeros(position_bins.n + 2)
+    scalars = np.zeros(6)
+    _run(
+        rng,
+        float(restitution),
+        float(criterion_c),
+        float(min_step_divisor),
+        float(equilibration_time),
+        float(recorded_time),
+        int(max_steps),
+        speed_bins.edges,
+        position_bins.edges,
+        speed_counts,
+        position_time,
+        position_v2_time,
+        scalars,
+    )
+    return ShardTallies(
+        speed_bins=speed_bins,
+        position_bins=position_bins,
+        speed_counts=speed_counts,
+        position_time=position_time,
+        position_v2_time=position_v2_time,
+        time=scalars[_TIME],
+        collisions=int(scalars[_COLLISIONS]),
+        steps=int(scalars[_STEPS]),
+        int_x=scalars[_INT_X],
+        int_x2=scalars[_INT_X2],
+        budget_exhausted=int(scalars[_EXHAUSTED]),
+    )
