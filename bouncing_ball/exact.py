@@ -92,6 +92,32 @@ def position_bin_average(lo, hi, restitution):
     return np.asarray(averages).reshape(np.shape(lo))
 
 
+def speed_squared_given_position_bin_average(lo, hi, restitution):
+    """<v^2>_x of eq. (moment2) averaged over [lo, hi) with weight P(x).
+
+    That is int_bin dx int_x^inf P(x') dx' / int_bin P(x) dx, the quantity a
+    simulation bin measures.  For r = 1/2, int_x^inf P = u K1(u) with
+    u = sqrt(2x/3), and int u K1(u) dx = -3 u^2 K2(u).
+    """
+    lo = np.asarray(lo, dtype=float)
+    hi = np.asarray(hi, dtype=float)
+    if _which(restitution) == Fraction(1, 2):
+        def primitive(x):
+            u = np.sqrt(2.0 * x / 3.0)
+            safe = np.where(u > 0, u, 1.0)
+            return np.where(u > 0, -3.0 * safe**2 * special.kn(2, safe), -6.0)
+
+        numerator = primitive(hi) - primitive(lo)
+    else:
+        def tail(x):
+            return integrate.quad(_position_density_third, x, np.inf, epsrel=1e-10, limit=200)[0]
+
+        numerator = np.asarray(
+            [integrate.quad(tail, a, b, epsrel=1e-9)[0] for a, b in zip(np.atleast_1d(lo), np.atleast_1d(hi))]
+        ).reshape(np.shape(lo))
+    return numerator / (position_bin_average(lo, hi, restitution) * (hi - lo))
+
+
 def position_moments(restitution) -> dict:
     """<x>, Delta x (eq. (xandDeltax)) from P(x), and I from eq. (collrate)."""
     moments = []

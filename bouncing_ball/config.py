@@ -1,0 +1,49 @@
+"""Checks of the workflow config that a JSON schema cannot express.
+
+The schema (workflow/schemas/config.schema.yaml) fixes keys, types and
+simple ranges; here: r values parsed exactly and unique, bin ranges
+ordered, and the keys of the per-r overrides valid r values.  An override
+may name an r that is not in ``restitution``: it then applies when that r
+is asked for as a target.
+"""
+
+from fractions import Fraction
+
+from .bins import LogBins
+from .restitution import parse_restitution, restitution_grid, restitution_label
+
+OVERRIDABLE = ("shards", "shard_time")
+
+
+def check_config(config: dict) -> dict[str, Fraction]:
+    """Raise ValueError naming the key if the config is inconsistent; return the r grid."""
+    grid = restitution_grid(config["restitution"])
+    simulation = config["simulation"]
+    for name in ("speed_bins", "position_bins"):
+        bins = simulation[name]
+        if not bins["lo"] < bins["hi"]:
+            raise ValueError(
+                f"simulation.{name}: lo = {bins['lo']} must be smaller than hi = {bins['hi']}"
+            )
+    seen = {}
+    for key in simulation.get("per_restitution", {}):
+        where = f"simulation.per_restitution.{key}"
+        label = restitution_label(parse_restitution(key, where))
+        if label in seen:
+            raise ValueError(f"{where}: the same r as simulation.per_restitution.{seen[label]}")
+        seen[label] = key
+    return grid
+
+
+def simulation_settings(config: dict, label: str) -> dict:
+    """The simulation parameters of one r: the defaults with its overrides applied."""
+    simulation = config["simulation"]
+    settings = {k: v for k, v in simulation.items() if k != "per_restitution"}
+    for key, override in simulation.get("per_restitution", {}).items():
+        if restitution_label(parse_restitution(key)) == label:
+            settings.update(override)
+    return settings
+
+
+def log_bins(spec: dict) -> LogBins:
+    return LogBins(float(spec["lo"]), float(spec["hi"]), int(spec["per_decade"]))

@@ -1,0 +1,60 @@
+"""Parquet tables with provenance, written atomically, read with clear errors.
+
+Provenance (r, the rule's parameters, seed, package version) is stored as
+JSON under the key ``bouncing_ball`` of the Parquet key-value metadata.
+"""
+
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from . import __version__
+
+METADATA_KEY = b"bouncing_ball"
+
+
+class UnreadableFileError(RuntimeError):
+    """An input file is missing, truncated or not what it should be."""
+
+
+def write_table(frame: pd.DataFrame, path, provenance: dict) -> None:
+    """Write ``frame`` to ``path`` with ``provenance``; atomic (temp file, then rename)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    table = pa.Table.from_pandas(frame, preserve_index=False)
+    metadata = dict(table.schema.metadata or {})
+    metadata[METADATA_KEY] = json.dumps(
+        {"package_version": __version__, **provenance}, sort_keys=True, default=str
+    ).encode()
+    table = table.replace_schema_metadata(metadata)
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(handle)
+    try:
+        pq.write_table(table, temporary)
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+def read_table(path) -> tuple[pd.DataFrame, dict]:
+    """The frame and provenance of a table written by ``write_table``."""
+    path = Path(path)
+    try:
+        table = pq.read_table(path)
+    except FileNotFoundError:
+        raise UnreadableFileError(f"{path}: file not found") from None
+    except (pa.ArrowException, OSError) as error:
+        raise UnreadableFileError(
+            f"{path}: not a readable Parquet file ({error}). It is probably truncated or "
+            "corrupt: delete it, or rerun the rule that makes it (snakemake --forcerun RULE)."
+        ) from None
+    raw = (table.schema.metadata or {}).get(METADATA_KEY)
+    if raw is None:
+        raise UnreadableFileError(f"{path}: no '{METADATA_KEY.decode()}' provenance metadata")
+    return table.to_pandas(), json.loads(raw)

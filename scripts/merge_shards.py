@@ -1,0 +1,109 @@
+"""Merge the shards of one r into P(0,v), P(x) and the summary.
+
+Writes results/simulation/r{r}/{p0v,position,summary}.parquet.  Run by
+Snakemake (rule merge_shards), or by hand:
+    python scripts/merge_shards.py --restitution 1/3 --p0v p0v.parquet \
+        --position position.parquet --summary summary.parquet shard*.parquet
+"""
+
+import argparse
+import logging
+
+from bouncing_ball.config import log_bins
+from bouncing_ball.histograms import (
+    outgoing_speed_histogram,
+    position_histogram,
+    position_moments_summary,
+)
+from bouncing_ball.io import UnreadableFileError, read_table, write_table
+from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
+from bouncing_ball.tallies import tallies_from_frame
+
+
+def read_shards(paths, label):
+    """The tallies of every shard, checked to belong to r = ``label`` and to share bins."""
+    shards, provenances = [], []
+    for path in paths:
+        frame, provenance = read_table(path)
+        if provenance.get("r_label") != label:
+            raise UnreadableFileError(
+                f"{path}: simulated for r = {provenance.get('r_label')}, not r = {label}"
+            )
+        if provenances and any(
+            provenance[key] != provenances[0][key]
+            for key in ("speed_bins", "position_bins", "criterion_c", "min_step_divisor", "seed")
+        ):
+            raise UnreadableFileError(
+                f"{path}: made with other settings than {paths[0]}; rerun the stale shards"
+            )
+        try:
+            shards.append(
+                tallies_from_frame(
+                    frame,
+                    log_bins(provenance["speed_bins"]),
+                    log_bins(provenance["position_bins"]),
+                    source=str(path),
+                )
+            )
+        except (KeyError, ValueError) as error:
+            raise UnreadableFileError(f"{path}: malformed shard ({error})") from None
+        provenances.append(provenance)
+    return shards, provenances
+
+
+def main(shard_paths, restitution, p0v_path, position_path, summary_path):
+    exact = parse_restitution(restitution)
+    label = restitution_label(exact)
+    shards, provenances = read_shards(shard_paths, label)
+    first = provenances[0]
+    provenance = {
+        "rule": "merge_shards",
+        "r": exact_string(exact),
+        "r_label": label,
+        "shards": len(shards),
+        **{key: first[key] for key in (
+            "seed", "shard_time", "equilibration_time", "criterion_c",
+            "min_step_divisor", "max_steps", "speed_bins", "position_bins",
+        )},
+    }
+    summary = position_moments_summary(shards, float(exact))
+    write_table(outgoing_speed_histogram(shards), p0v_path, provenance)
+    write_table(position_histogram(shards), position_path, provenance)
+    write_table(summary, summary_path, provenance)
+    row = summary.iloc[0]
+    logging.info(
+        "r=%s: %d shards, time %.6g, <x> = %.5g +- %.2g, Delta x = %.5g +- %.2g, I = %.5g +- %.2g",
+        label, len(shards), row.total_time, row.mean_x, row.mean_x_err,
+        row.delta_x, row.delta_x_err, row.collision_rate, row.collision_rate_err,
+    )
+    if row.shards_out_of_budget:
+        logging.warning(
+            "r=%s: %d of %d shards ran out of their step budget (simulation.max_steps) "
+            "before shard_time; their shorter time is accounted for",
+            label, row.shards_out_of_budget, len(shards),
+        )
+
+
+def _command_line():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("shards", nargs="+")
+    parser.add_argument("--restitution", required=True)
+    parser.add_argument("--p0v", required=True)
+    parser.add_argument("--position", required=True)
+    parser.add_argument("--summary", required=True)
+    args = parser.parse_args()
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    main(args.shards, args.restitution, args.p0v, args.position, args.summary)
+
+
+if "snakemake" in globals():
+    logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, format="%(message)s")  # noqa: F821
+    main(
+        list(snakemake.input),  # noqa: F821
+        snakemake.params.restitution,  # noqa: F821
+        snakemake.output.p0v,  # noqa: F821
+        snakemake.output.position,  # noqa: F821
+        snakemake.output.summary,  # noqa: F821
+    )
+elif __name__ == "__main__":
+    _command_line()

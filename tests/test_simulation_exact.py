@@ -1,0 +1,139 @@
+"""The simulation against the paper's exact results at r = 1/2 and r = 1/3.
+
+CI-sized runs (a few core-seconds per r) that are still sharp: the relative
+standard error of <x>, Delta x and I is asserted to be 1% or less before the
+3-sigma comparison is made.  Seeds are fixed, so the outcome is deterministic.
+"""
+
+from concurrent.futures import ProcessPoolExecutor
+from fractions import Fraction
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from bouncing_ball import exact
+from bouncing_ball.bins import LogBins
+from bouncing_ball.histograms import (
+    outgoing_speed_histogram,
+    position_histogram,
+    position_moments_summary,
+)
+from bouncing_ball.restitution import restitution_label
+from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
+
+SHARDS = 16
+SPEED_BINS = LogBins(1e-4, 1e2, 10)
+POSITION_BINS = LogBins(1e-3, 1e3, 5)
+SHARD_TIME = {Fraction(1, 2): 4.0e5, Fraction(1, 3): 7.0e5}
+SEED = 20061121
+
+# eq. (xandDeltax) in closed form
+PAPER = {
+    Fraction(1, 2): {"mean_x": 6.0, "delta_x": 6.0 * np.sqrt(3.0), "collision_rate": 1.0 / 3.0},
+    Fraction(1, 3): {"mean_x": 35.0 / 9.0, "delta_x": np.sqrt(4781.0) / 9.0, "collision_rate": 0.75},
+}
+
+
+def _shard(arguments):
+    r, shard = arguments
+    return simulate_shard(
+        restitution=float(r),
+        seed_sequence=shard_seed_sequence(SEED, restitution_label(r), shard),
+        recorded_time=SHARD_TIME[r],
+        equilibration_time=200.0,
+        criterion_c=5.0,
+        min_step_divisor=500.0,
+        max_steps=10**12,
+        speed_bins=SPEED_BINS,
+        position_bins=POSITION_BINS,
+    )
+
+
+@pytest.fixture(scope="module")
+def shards():
+    jobs = [(r, k) for r in PAPER for k in range(SHARDS)]
+    with ProcessPoolExecutor(2) as pool:
+        results = list(pool.map(_shard, jobs))
+    return {r: [s for (rr, _), s in zip(jobs, results) if rr == r] for r in PAPER}
+
+
+@pytest.mark.parametrize("r", list(PAPER), ids=str)
+@pytest.mark.parametrize("quantity", ["mean_x", "delta_x", "collision_rate"])
+def test_moments_match_exact_values(shards, r, quantity):
+    summary = position_moments_summary(shards[r], float(r)).iloc[0]
+    value, error = summary[quantity], summary[f"{quantity}_err"]
+    expected = PAPER[r][quantity]
+    assert error / expected <= 0.01, "run too short for a sharp test"
+    z = (value - expected) / error
+    assert abs(z) < 3.0, f"{quantity} = {value} +- {error}, exact {expected}, z = {z:.2f}"
+
+
+@pytest.mark.parametrize("r", list(PAPER), ids=str)
+def test_exact_module_reproduces_paper_closed_forms(r):
+    # the comparison values above, recomputed from P(x) of eq. (P(x)2)
+    computed = exact.position_moments(r)
+    assert computed["normalization"] == pytest.approx(1.0, rel=1e-9)
+    for quantity, expected in PAPER[r].items():
+        assert computed[quantity] == pytest.approx(expected, rel=1e-9)
+
+
+def _t_squared_bounds(dof, bins, sigmas=3.0):
+    """Mean +- sigmas * sd of the mean of `bins` independent t^2 with `dof` dof."""
+    mean = dof / (dof - 2.0)
+    variance = 3.0 * dof**2 / ((dof - 2.0) * (dof - 4.0)) - mean**2
+    spread = sigmas * np.sqrt(variance / bins)
+    return mean - spread, mean + spread
+
+
+@pytest.mark.parametrize("r", list(PAPER), ids=str)
+def test_outgoing_speed_density_chi_square(shards, r):
+    """eq. (P(0,v)) with eq. (constants), no free parameter.
+
+    Each bin's z uses a jackknife error from SHARDS shards, so z is
+    Student-t with SHARDS - 1 degrees of freedom and chi^2/dof has mean
+    (n-1)/(n-3) rather than 1; the bounds account for that.
+    """
+    table = outgoing_speed_histogram(shards[r])
+    usable = (table["count"] >= 100) & np.isfinite(table.v_hi) & (table.v_lo > 0)
+    table = table[usable]
+    expected = exact.outgoing_speed_bin_average(table.v_lo, table.v_hi, r)
+    z = (table.p0v - expected) / table.p0v_err
+    chi2_per_dof = float(np.mean(z**2))
+    low, high = _t_squared_bounds(SHARDS - 1, len(z))
+    assert len(z) >= 30, "too few populated bins for a meaningful chi^2"
+    assert low < chi2_per_dof < high, f"chi^2/dof = {chi2_per_dof:.3f} over {len(z)} bins"
+    # and no single bin is off by much (Bonferroni over the bins)
+    worst = float(np.max(np.abs(z)))
+    limit = stats.t.isf(0.001 / (2 * len(z)), SHARDS - 1)
+    assert worst < limit, f"worst bin z = {worst:.2f}"
+
+
+def _position_bins_up_to_50(table):
+    return table[(table.x_lo >= 0.1 - 1e-12) & (table.x_lo < 50.0)]
+
+
+def test_position_density_half(shards):
+    """P(x) = (1/3) K0(sqrt(2x/3)) at r = 1/2, eq. (P(x)2), for x in [0.1, 50]."""
+    r = Fraction(1, 2)
+    table = _position_bins_up_to_50(position_histogram(shards[r]))
+    expected = exact.position_bin_average(table.x_lo, table.x_hi, r)
+    z = (table.px - expected) / table.px_err
+    assert len(z) >= 10
+    assert np.all(np.abs(z) < 3.0), f"z = {np.round(z.to_numpy(), 2)}"
+
+
+def test_speed_squared_given_position_half(shards):
+    """<v^2>_x of eq. (moment2) at r = 1/2 for x in [0.1, 50].
+
+    Each z is Student-t with SHARDS - 1 degrees of freedom and the bins are
+    many, so the per-bin limit is the t quantile for a family-wise false
+    alarm rate of 1e-3 (Bonferroni), fixed before looking at any run.
+    """
+    r = Fraction(1, 2)
+    table = _position_bins_up_to_50(position_histogram(shards[r]))
+    expected = exact.speed_squared_given_position_bin_average(table.x_lo, table.x_hi, r)
+    z = (table.v2_given_x - expected) / table.v2_given_x_err
+    assert float(np.max(table.v2_given_x_err / table.v2_given_x)) < 0.02
+    limit = stats.t.isf(0.001 / (2 * len(z)), SHARDS - 1)
+    assert np.all(np.abs(z) < limit), f"z = {np.round(z.to_numpy(), 2)}, limit {limit:.2f}"

@@ -1,0 +1,132 @@
+"""The workflow as a user runs it, in a temporary copy of the repository."""
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+
+from bouncing_ball.io import read_table
+
+REPOSITORY = Path(__file__).resolve().parents[1]
+SMALL = {
+    "restitution": [0.5, "1/3"],
+    "seed": 5,
+    "simulation": {
+        "shards": 3,
+        "shard_time": 2.0e3,
+        "equilibration_time": 50.0,
+        "criterion_c": 5.0,
+        "min_step_divisor": 500,
+        "max_steps": 1.0e9,
+        "speed_bins": {"lo": 1.0e-4, "hi": 1.0e2, "per_decade": 10},
+        "position_bins": {"lo": 1.0e-3, "hi": 1.0e3, "per_decade": 5},
+        "per_restitution": {"1/3": {"shards": 2}},
+    },
+}
+
+pytestmark = pytest.mark.workflow
+
+
+def _copy(tmp_path, config):
+    for name in ("Snakefile", "workflow", "scripts", "config"):
+        source = REPOSITORY / name
+        if source.is_dir():
+            shutil.copytree(source, tmp_path / name)
+        else:
+            shutil.copy(source, tmp_path / name)
+    (tmp_path / "config" / "config.yaml").write_text(yaml.safe_dump(config))
+    return tmp_path
+
+
+def snakemake(directory, *arguments):
+    return subprocess.run(
+        [sys.executable, "-m", "snakemake", "--cores", "2", *arguments],
+        cwd=directory, capture_output=True, text=True, timeout=600,
+    )
+
+
+@pytest.fixture(scope="module")
+def finished_run(tmp_path_factory):
+    directory = _copy(tmp_path_factory.mktemp("workflow"), SMALL)
+    result = snakemake(directory)
+    assert result.returncode == 0, result.stderr[-3000:]
+    return directory
+
+
+def test_run_produces_the_documented_tables(finished_run):
+    for label, shards in (("0.5", 3), ("0.333333", 2)):
+        folder = finished_run / "results" / "simulation" / f"r{label}"
+        assert sorted(p.name for p in folder.glob("shard*.parquet")) == [
+            f"shard{k}.parquet" for k in range(shards)
+        ]
+        p0v, provenance = read_table(folder / "p0v.parquet")
+        assert list(p0v.columns) == ["v_lo", "v_hi", "v", "p0v", "p0v_err", "count"]
+        assert provenance["r_label"] == label and provenance["shards"] == shards
+        position, _ = read_table(folder / "position.parquet")
+        assert list(position.columns) == [
+            "x_lo", "x_hi", "x", "px", "px_err", "v2_given_x", "v2_given_x_err"
+        ]
+        summary, _ = read_table(folder / "summary.parquet")
+        for column in ("r", "mean_x", "mean_x_err", "delta_x", "delta_x_err", "collision_rate",
+                       "collision_rate_err", "total_time", "collisions", "shards"):
+            assert column in summary.columns
+        assert summary.total_time.iloc[0] == pytest.approx(shards * 2.0e3)
+        assert p0v["count"].sum() == summary.collisions.iloc[0]
+    _, provenance = read_table(finished_run / "results/simulation/r0.333333/shard0.parquet")
+    assert provenance["r"] == "1/3" and provenance["seed"] == 5
+    assert (finished_run / "logs/simulation/r0.5/merge.log").read_text().startswith("r=0.5")
+
+
+def test_second_run_has_nothing_to_do(finished_run):
+    result = snakemake(finished_run, "--dry-run")
+    assert result.returncode == 0
+    assert "Nothing to be done" in result.stdout + result.stderr
+
+
+def test_an_r_not_in_the_config_is_a_valid_target(finished_run):
+    target = "results/simulation/r0.6/summary.parquet"
+    result = snakemake(finished_run, target)
+    assert result.returncode == 0, result.stderr[-3000:]
+    summary = pd.read_parquet(finished_run / target)
+    assert summary.r.iloc[0] == pytest.approx(0.6)
+    assert summary.shards.iloc[0] == 3
+
+
+def _with(path, value):
+    config = yaml.safe_load(yaml.safe_dump(SMALL))
+    *parents, last = path
+    node = config
+    for key in parents:
+        node = node[key]
+    node[last] = value
+    return config
+
+
+BAD = [
+    (_with(["restitution"], [0.5, 0.0]), "['restitution'][1]"),
+    (_with(["restitution"], [1.0]), "restitution"),
+    (_with(["restitution"], ["1/0"]), "restitution[0]"),
+    (_with(["restitution"], ["half"]), "['restitution'][0]"),
+    (_with(["restitution"], [0.5, "1/2"]), "restitution[1]"),
+    (_with(["restitution"], []), "restitution"),
+    (_with(["simulation", "shards"], 0), "shards"),
+    (_with(["simulation", "shard_time"], -1.0), "shard_time"),
+    (_with(["simulation", "criterion_c"], 0.0), "criterion_c"),
+    (_with(["simulation", "shard_time"], "1e5"), "shard_time"),
+    (_with(["simulation", "speed_bins", "lo"], 1.0e3), "speed_bins"),
+    (_with(["simulation", "shardz"], 4), "shardz"),
+    (_with(["sead"], 4), "sead"),
+]
+
+
+@pytest.mark.parametrize("config, key", BAD, ids=[key for _, key in BAD])
+def test_bad_config_is_refused_before_any_job_runs(tmp_path, config, key):
+    directory = _copy(tmp_path, config)
+    result = snakemake(directory)
+    assert result.returncode != 0
+    assert key in result.stderr + result.stdout
+    assert not (directory / "results").exists()

@@ -1,0 +1,35 @@
+# The simulation stage: the paper's Sec. IV, one job per (r, shard), merged per r.
+
+
+rule simulate_shard:
+    output:
+        "results/simulation/r{r}/shard{shard}.parquet",
+    params:
+        restitution=restitution_value,
+        seed=config["seed"],
+        settings=settings,
+    log:
+        "logs/simulation/r{r}/shard{shard}.log",
+    resources:
+        runtime=60,
+        mem_mb=500,
+    script:
+        "../../scripts/simulate_shard.py"
+
+
+rule merge_shards:
+    input:
+        shard_files,
+    output:
+        p0v="results/simulation/r{r}/p0v.parquet",
+        position="results/simulation/r{r}/position.parquet",
+        summary="results/simulation/r{r}/summary.parquet",
+    params:
+        restitution=restitution_value,
+    log:
+        "logs/simulation/r{r}/merge.log",
+    resources:
+        runtime=10,
+        mem_mb=1000,
+    script:
+        "../../scripts/merge_shards.py"
