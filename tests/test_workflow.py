@@ -130,3 +130,17 @@ def test_bad_config_is_refused_before_any_job_runs(tmp_path, config, key):
     assert result.returncode != 0
     assert key in result.stderr + result.stdout
     assert not (directory / "results").exists()
+
+
+def test_lint_is_clean_and_rule_files_are_formatted():
+    lint = subprocess.run(
+        [sys.executable, "-m", "snakemake", "--lint"], cwd=REPOSITORY,
+        capture_output=True, text=True, timeout=120,
+    )
+    assert lint.returncode == 0, lint.stdout + lint.stderr
+    rule_files = ["Snakefile", *map(str, (REPOSITORY / "workflow").rglob("*.smk"))]
+    formatted = subprocess.run(
+        [sys.executable, "-m", "snakefmt", "--check", *rule_files], cwd=REPOSITORY,
+        capture_output=True, text=True, timeout=120,
+    )
+    assert formatted.returncode == 0, formatted.stderr

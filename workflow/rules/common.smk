@@ -1,4 +1,4 @@
-# Helpers shared by the rule files: r labels and values, shard lists, targets.
+# Helpers for every stage: r labels and exact values, per-r settings, shard lists, targets.
 from bouncing_ball.config import check_config, simulation_settings
 from bouncing_ball.restitution import exact_string, parse_restitution
 
@@ -6,15 +6,6 @@ try:
     RESTITUTION = check_config(config)  # {label: exact r}, refused before any job runs
 except ValueError as error:
     raise ValueError(f"invalid config: {error}") from None
-
-
-localrules:
-    simulation,
-
-
-wildcard_constraints:
-    r=r"[0-9][0-9.e-]*",
-    shard=r"[0-9]+",
 
 
 def restitution_value(wildcards):

@@ -4,15 +4,17 @@
 rule simulate_shard:
     output:
         "results/simulation/r{r}/shard{shard}.parquet",
+    log:
+        "logs/simulation/r{r}/shard{shard}.log",
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=60,
+        mem_mb=500,
     params:
         restitution=restitution_value,
         seed=config["seed"],
         settings=settings,
-    log:
-        "logs/simulation/r{r}/shard{shard}.log",
-    resources:
-        runtime=60,
-        mem_mb=500,
     script:
         "../../scripts/simulate_shard.py"
 
@@ -24,12 +26,14 @@ rule merge_shards:
         p0v="results/simulation/r{r}/p0v.parquet",
         position="results/simulation/r{r}/position.parquet",
         summary="results/simulation/r{r}/summary.parquet",
-    params:
-        restitution=restitution_value,
     log:
         "logs/simulation/r{r}/merge.log",
+    conda:
+        "../envs/bouncing-ball.yaml"
     resources:
         runtime=10,
         mem_mb=1000,
+    params:
+        restitution=restitution_value,
     script:
         "../../scripts/merge_shards.py"
