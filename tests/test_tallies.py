@@ -109,3 +109,16 @@ def test_outgoing_speed_density_counts_rate_over_bin():
     table = outgoing_speed_histogram([shard])
     assert table.p0v.iloc[1] == pytest.approx(10.0 / 99.0)
     assert table["count"].sum() == 10
+
+
+def test_truncated_file_gives_an_error_that_names_it(tmp_path):
+    from bouncing_ball.io import UnreadableFileError
+
+    path = tmp_path / "shard3.parquet"
+    write_table(tallies_to_frame(ShardTallies(
+        SPEED_BINS, POSITION_BINS, np.zeros(SPEED_BINS.n + 2, dtype=np.int64),
+        np.zeros(POSITION_BINS.n + 2), np.zeros(POSITION_BINS.n + 2), 1.0, 0, 0, 0.0, 0.0, 0,
+    )), path, {})
+    path.write_bytes(path.read_bytes()[:200])
+    with pytest.raises(UnreadableFileError, match="shard3.parquet"):
+        read_table(path)

@@ -144,3 +144,36 @@ def test_lint_is_clean_and_rule_files_are_formatted():
         capture_output=True, text=True, timeout=120,
     )
     assert formatted.returncode == 0, formatted.stderr
+
+
+def test_scripts_run_by_hand(tmp_path):
+    """A failing step can be debugged outside Snakemake: the scripts take paths and values."""
+    shards = []
+    for k in range(2):
+        shards.append(tmp_path / f"shard{k}.parquet")
+        subprocess.run(
+            [sys.executable, "scripts/simulate_shard.py", "--restitution", "1/3", "--shard", str(k),
+             "--seed", "3", "--shard-time", "200", str(shards[-1])],
+            cwd=REPOSITORY, check=True, capture_output=True, timeout=300,
+        )
+    outputs = {name: tmp_path / f"{name}.parquet" for name in ("p0v", "position", "summary")}
+    subprocess.run(
+        [sys.executable, "scripts/merge_shards.py", "--restitution", "1/3",
+         *[f"--{name}={path}" for name, path in outputs.items()], *map(str, shards)],
+        cwd=REPOSITORY, check=True, capture_output=True, timeout=300,
+    )
+    summary, provenance = read_table(outputs["summary"])
+    assert provenance["r"] == "1/3" and summary.shards.iloc[0] == 2
+    # a shard of another r is refused by name
+    wrong = tmp_path / "other.parquet"
+    subprocess.run(
+        [sys.executable, "scripts/simulate_shard.py", "--restitution", "0.5", "--shard", "0",
+         "--seed", "3", "--shard-time", "50", str(wrong)],
+        cwd=REPOSITORY, check=True, capture_output=True, timeout=300,
+    )
+    refused = subprocess.run(
+        [sys.executable, "scripts/merge_shards.py", "--restitution", "1/3",
+         *[f"--{name}={path}" for name, path in outputs.items()], str(shards[0]), str(wrong)],
+        cwd=REPOSITORY, capture_output=True, text=True, timeout=300,
+    )
+    assert refused.returncode != 0 and "other.parquet" in refused.stderr
