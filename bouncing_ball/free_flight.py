@@ -14,9 +14,10 @@ interpolation reproduces the cubic drift term -t^2/2); its variances are
 uses these to integrate x, x^2 and v^2 over a step exactly in expectation and
 to place a collision inside a step.
 
-Everything here is numba-compiled scalar code (no allocation), because it
-runs once or more per step.  The mean path is carried as its four monomial
-coefficients ``a0 + a1 t + a2 t^2 + a3 t^3``.
+Everything here is numba-compiled scalar code (no allocation, no division by
+a constant: those are written as products with the reciprocal, which LLVM
+folds), because it runs once or more per step.  The mean path is carried as
+its four monomial coefficients ``a0 + a1 t + a2 t^2 + a3 t^3``.
 """
 
 import math
@@ -25,6 +26,33 @@ import numpy as np
 from numba import njit
 
 SQRT3 = math.sqrt(3.0)
+SQRT1_12 = math.sqrt(1.0 / 12.0)
+
+# Rational fits (see largest_safe_step) to the positive root of the cubic
+# c s^3 = x + v s^2, in units of a = (x/c)^(1/3), with t = |v| / (c a):
+#   v >= 0:  s / a ~ t + (1 + P t) / (1 + (P + 2/3) t + Q t^2 + P t^3)   (0.2 %)
+#   v < 0:   s / a ~ (t + (1 + N3 t) / (1 + N1 t + N2 t^2))^(-1/2)      (0.04 %)
+_P, _Q = 0.44356066, 0.56163652
+_N1, _N2, _N3 = 0.40104058, 0.00211799, 0.06071102
+
+# Kahan's cube root estimate: the bits of y, read as an integer, divided by 3
+# plus this bias give y^(1/3) to 3 % for normal y > 0 (fdlibm's B1 << 32).
+_CBRT_BIAS = np.int64(715094163 << 32)
+_SMALLEST_NORMAL = np.finfo(np.float64).tiny
+
+
+@njit(cache=True)
+def cube_root(y):
+    """y^(1/3) for y >= 0, good to 2e-5 (np.cbrt costs several times more).
+
+    Kahan's bit-level estimate refined by one Halley step for a^3 = y.
+    Zero and subnormal y go to np.cbrt.
+    """
+    if y < _SMALLEST_NORMAL:
+        return np.cbrt(y)
+    a = np.int64(np.float64(y).view(np.int64) // 3 + _CBRT_BIAS).view(np.float64)
+    a3 = a * a * a
+    return a * ((a3 + 2.0 * y) / (2.0 * a3 + y))
 
 
 @njit(cache=True)
@@ -33,44 +61,57 @@ def free_flight_step(x, v, dt, normal_r, normal_s):
 
     ``normal_r`` and ``normal_s`` are independent standard normals; the same
     ``normal_r`` enters both equations, which gives the correct x-v covariance.
+    The two noise amplitudes share one square root:
+    sqrt(dt^3 / 6) = dt sqrt(2 dt) / sqrt(12).
     """
-    x_new = (
-        x
-        + v * dt
-        - 0.5 * dt * dt
-        + math.sqrt(dt * dt * dt / 6.0) * (normal_s + SQRT3 * normal_r)
-    )
-    v_new = v - dt + math.sqrt(2.0 * dt) * normal_r
+    root_2dt = math.sqrt(2.0 * dt)
+    x_new = x + v * dt - 0.5 * dt * dt + dt * root_2dt * SQRT1_12 * (normal_s + SQRT3 * normal_r)
+    v_new = v - dt + root_2dt * normal_r
     return x_new, v_new
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def largest_safe_step(x, v, c):
     """The largest step D(x, v) allowed by eq. (criterion).
 
     With s = sqrt(Delta) the criterion reads f(s) = x + v s^2 - c s^3 - s^4/2 > 0.
-    By Descartes' rule f has exactly one positive root s*; f is convex and
-    increasing from s = 0 up to its inflection point, so s* lies where f is
-    concave and decreasing, and Newton's method started above s* decreases
-    monotonically onto it.  Returns s*^2 (0 when x <= 0 and v <= 0).
+    By Descartes' rule f has exactly one positive root s*, where f' < 0;
+    returns s*^2 (0 when x <= 0 and v <= 0; x below the smallest normal
+    double counts as 0).
+
+    At x = 0 the root is that of a quadratic.  Otherwise the start is the
+    root of the cubic without the s^4/2 term, from the rational fits above
+    (homogeneous in a and v/c, one division); near the floor, where most
+    steps are taken, that term is a small correction.  Halley's method then
+    converges cubically: two iterations from a start good to ~1 %, and a
+    last step of relative size <= 1e-5 leaves s* good to ~1e-14.  A Newton
+    step stands in where the Halley denominator is not positive (only far
+    from s*), and the iteration stops where f' >= 0 (only on underflow).
     """
-    vp = v if v > 0.0 else 0.0
-    if x < 0.0:
-        x = 0.0
-    if x == 0.0 and vp == 0.0:
-        return 0.0
-    # Two upper bounds: c s^3 alone, or s^4/2 alone, outweighs x + v s^2.
-    bound_cubic = max(np.cbrt(2.0 * x / c), 2.0 * vp / c)
-    bound_quartic = max(math.sqrt(2.0 * math.sqrt(x)), 2.0 * math.sqrt(vp))
-    s = min(bound_cubic, bound_quartic)
+    if x < _SMALLEST_NORMAL:
+        if v <= 0.0:
+            return 0.0
+        s = 2.0 * v / (c + math.sqrt(c * c + 2.0 * v))  # s^2 (v - c s - s^2/2) = 0
+        return s * s
+    a3 = x / c
+    a = cube_root(a3)
+    b = v / c
+    if b >= 0.0:
+        a2 = a * a
+        s = b + a * ((a3 + _P * a2 * b) / (a3 + b * (a2 * (_P + 2.0 / 3.0) + b * (_Q * a + _P * b))))
+    else:
+        a2 = a * a
+        s = math.sqrt(a3 / (-b + a2 * (a - _N3 * b) / (a2 - b * (_N1 * a - _N2 * b))))
     for _ in range(100):
         f = x + s * s * (v - s * (c + 0.5 * s))
         fp = s * (2.0 * v - s * (3.0 * c + 2.0 * s))
-        if fp >= 0.0:  # impossible above s*; guards against round-off
+        if not fp < 0.0:
             break
-        step = f / fp
+        fpp = 2.0 * v - s * (6.0 * c + 6.0 * s)
+        denominator = 2.0 * fp * fp - f * fpp
+        step = 2.0 * f * fp / denominator if denominator > 0.0 else f / fp
         s -= step
-        if step <= 1e-7 * s:  # quadratic convergence: s is now good to ~1e-14
+        if abs(step) <= 1e-5 * s:
             break
     return s * s
 
@@ -78,9 +119,10 @@ def largest_safe_step(x, v, c):
 @njit(cache=True)
 def hermite_cubic(x0, v0, x1, v1, dt):
     """Monomial coefficients of the bridge mean path m(t) on [0, dt]."""
-    slope = (x1 - x0) / dt
-    a2 = (3.0 * slope - 2.0 * v0 - v1) / dt
-    a3 = (v0 + v1 - 2.0 * slope) / (dt * dt)
+    inv_dt = 1.0 / dt
+    slope = (x1 - x0) * inv_dt
+    a2 = (3.0 * slope - 2.0 * v0 - v1) * inv_dt
+    a3 = (v0 + v1 - 2.0 * slope) * (inv_dt * inv_dt)
     return x0, v0, a2, a3
 
 
@@ -101,7 +143,7 @@ def mean_path_integrals(a0, a1, a2, a3, dt, tau):
     The first is the integral of the mean path; the second adds the bridge
     variance of x to its square.
     """
-    int_x = tau * (a0 + tau * (a1 / 2.0 + tau * (a2 / 3.0 + tau * a3 / 4.0)))
+    int_x = tau * (a0 + tau * (0.5 * a1 + tau * ((1.0 / 3.0) * a2 + tau * 0.25 * a3)))
     c0 = a0 * a0
     c1 = 2.0 * a0 * a1
     c2 = a1 * a1 + 2.0 * a0 * a2
@@ -113,50 +155,65 @@ def mean_path_integrals(a0, a1, a2, a3, dt, tau):
         c0
         + tau
         * (
-            c1 / 2.0
+            0.5 * c1
             + tau
-            * (c2 / 3.0 + tau * (c3 / 4.0 + tau * (c4 / 5.0 + tau * (c5 / 6.0 + tau * c6 / 7.0))))
+            * (
+                (1.0 / 3.0) * c2
+                + tau
+                * (
+                    0.25 * c3
+                    + tau * ((1.0 / 5.0) * c4 + tau * ((1.0 / 6.0) * c5 + tau * (1.0 / 7.0) * c6))
+                )
+            )
         )
     )
     # int_0^tau 2 t^3 (dt - t)^3 / (3 dt^3) dt
     u = tau / dt
-    int_var = (2.0 / 3.0) * dt**4 * u**4 * (
-        0.25 - u * (3.0 / 5.0 - u * (0.5 - u / 7.0))
-    )
+    tau2 = tau * tau
+    int_var = (2.0 / 3.0) * tau2 * tau2 * (0.25 - u * (3.0 / 5.0 - u * (0.5 - u * (1.0 / 7.0))))
     return int_x, int_m2 + int_var
 
 
 @njit(cache=True)
-def speed_squared_antiderivative(a1, a2, a3, dt, t):
-    """int_0^t E[v(t')^2 | ends] dt' : the mean slope squared plus Var[v]."""
-    # (a1 + 2 a2 t + 3 a3 t^2)^2
-    d0 = a1 * a1
-    d1 = 4.0 * a1 * a2
-    d2 = 4.0 * a2 * a2 + 6.0 * a1 * a3
-    d3 = 12.0 * a2 * a3
-    d4 = 9.0 * a3 * a3
-    mean_part = t * (d0 + t * (d1 / 2.0 + t * (d2 / 3.0 + t * (d3 / 4.0 + t * d4 / 5.0))))
-    # int_0^t 2 t'(dt - t')(dt^2 - 3 t' dt + 3 t'^2) / dt^3 dt'
-    u = t / dt
-    var_part = 2.0 * dt * dt * u * u * (0.5 - u * (4.0 / 3.0 - u * (1.5 - u * 3.0 / 5.0)))
-    return mean_part + var_part
+def speed_squared_coefficients(a1, a2, a3, dt):
+    """S(t) = int_0^t E[v(t')^2 | ends] dt' = t (s1 + t (s2 + t (s3 + t (s4 + t s5)))).
+
+    The mean slope squared, (a1 + 2 a2 t + 3 a3 t^2)^2, plus Var[v(t) | ends],
+    2 t (dt - t)(dt^2 - 3 t dt + 3 t^2) / dt^3 = 2 t - 8 t^2/dt + 12 t^3/dt^2 - 6 t^4/dt^3.
+    """
+    inv_dt = 1.0 / dt
+    s1 = a1 * a1
+    s2 = 2.0 * a1 * a2 + 1.0
+    s3 = (4.0 / 3.0) * a2 * a2 + 2.0 * a1 * a3 - (8.0 / 3.0) * inv_dt
+    s4 = 3.0 * a2 * a3 + 3.0 * inv_dt * inv_dt
+    s5 = (9.0 / 5.0) * a3 * a3 - (6.0 / 5.0) * inv_dt * inv_dt * inv_dt
+    return s1, s2, s3, s4, s5
 
 
 @njit(cache=True)
-def cubic_level_time(a0, a1, a2, a3, level, t_lo, t_hi):
+def quintic_antiderivative_value(s1, s2, s3, s4, s5, t):
+    return t * (s1 + t * (s2 + t * (s3 + t * (s4 + t * s5))))
+
+
+@njit(cache=True, inline="always")
+def cubic_level_time(a0, a1, a2, a3, level, t_lo, t_hi, f_lo, f_hi):
     """The t in [t_lo, t_hi] where m(t) = level, m monotone there and bracketing.
 
-    Safeguarded Newton: a Newton step that leaves the bracket is replaced by
-    bisection, so it always converges.
+    ``f_lo`` and ``f_hi`` are m - level at the two ends (opposite signs, or
+    f_lo = 0).  Safeguarded Halley iteration from the linear interpolation of
+    the ends: a step that leaves the bracket is replaced by bisection, so it
+    always converges.  It stops when t is known to 1e-10 of the bracket: after
+    a Halley step below 1e-10 of it, or below 1e-6 of it and 1e-3 of the step
+    before (cubic convergence under way, so the error left is below ~1e-15
+    of the bracket), or when bisection has shrunk the bracket to 1e-10.
     """
-    f_lo = cubic_value(a0, a1, a2, a3, t_lo) - level
     if f_lo == 0.0:
         return t_lo
     rising = f_lo < 0.0
+    width = t_hi - t_lo
     lo, hi = t_lo, t_hi
-    # start from the linear interpolation between the bracket ends
-    f_hi = cubic_value(a0, a1, a2, a3, t_hi) - level
-    t = t_lo + (t_hi - t_lo) * f_lo / (f_lo - f_hi) if f_lo != f_hi else 0.5 * (t_lo + t_hi)
+    t = t_lo + width * f_lo / (f_lo - f_hi)
+    last_step = width
     for _ in range(200):
         f = cubic_value(a0, a1, a2, a3, t) - level
         if f == 0.0:
@@ -165,13 +222,19 @@ def cubic_level_time(a0, a1, a2, a3, level, t_lo, t_hi):
             lo = t
         else:
             hi = t
-        d = cubic_slope(a1, a2, a3, t)
-        t_new = t - f / d if d != 0.0 else 0.5 * (lo + hi)
-        if not (lo < t_new < hi):
+        d1 = cubic_slope(a1, a2, a3, t)
+        d2 = 2.0 * a2 + 6.0 * a3 * t
+        t_new = t - 2.0 * f * d1 / (2.0 * d1 * d1 - f * d2)
+        if lo < t_new < hi:  # false also for a zero or NaN denominator
+            step = abs(t_new - t)
+            if step <= 1e-10 * width or (step <= 1e-6 * width and step <= 1e-3 * last_step):
+                return t_new
+            last_step = step
+        else:
             t_new = 0.5 * (lo + hi)
-        # 1e-10 of the bracket: far below any statistical resolution of a bin
-        if abs(t_new - t) <= 1e-10 * (t_hi - t_lo) or hi - lo <= 1e-15 * hi:
-            return t_new
+            last_step = hi - lo
+            if last_step <= 1e-10 * width:
+                return t_new
         t = t_new
     return t
 
@@ -212,21 +275,25 @@ def slope_zeros(a1, a2, a3, t_end):
 
 
 @njit(cache=True)
-def first_crossing_time(a0, a1, a2, a3, t_end):
+def first_crossing_time(a0, a1, a2, a3, t_end, x_end):
     """First t in (0, t_end] where the mean path reaches 0.
 
-    Requires m(0) > 0 >= m(t_end).  The path is split at the zeros of m' into
-    monotone pieces; the first piece that ends at or below 0 holds the crossing.
+    Requires m(0) = a0 > 0 >= m(t_end) = x_end.  The path is split at the
+    zeros of m' into monotone pieces; the first piece that ends at or below 0
+    holds the crossing.
     """
     n, t1, t2 = slope_zeros(a1, a2, a3, t_end)
     start = 0.0
+    m_start = a0
     for k in range(n + 1):
         stop = t_end
         if k == 0 and n >= 1:
             stop = t1
         elif k == 1 and n == 2:
             stop = t2
-        if cubic_value(a0, a1, a2, a3, stop) <= 0.0:
-            return cubic_level_time(a0, a1, a2, a3, 0.0, start, stop)
+        m_stop = x_end if stop == t_end else cubic_value(a0, a1, a2, a3, stop)
+        if m_stop <= 0.0:
+            return cubic_level_time(a0, a1, a2, a3, 0.0, start, stop, m_start, m_stop)
         start = stop
+        m_start = m_stop
     return t_end

@@ -44,8 +44,9 @@ from .free_flight import (
     hermite_cubic,
     largest_safe_step,
     mean_path_integrals,
+    quintic_antiderivative_value,
     slope_zeros,
-    speed_squared_antiderivative,
+    speed_squared_coefficients,
 )
 from .tallies import ShardTallies
 
@@ -83,17 +84,21 @@ def _bin_index(value, log_lo, per_ln, n, edges):
     return k + 1
 
 
-@njit(cache=True)
-def _tally_position(a0, a1, a2, a3, dt, t_a, t_b, k, edges, time_in, v2_in):
+@njit(cache=True, inline="always")
+def _tally_position(a, sq, t_a, t_b, x_a, x_b, k, edges, time_in, v2_in):
     """Add the time and int v^2 dt of the monotone piece [t_a, t_b] to x bins.
 
-    ``k`` is the bin of m(t_a); the walk crosses one bin edge at a time (no
-    logarithms) and returns the bin of m(t_b).
+    ``a`` are the mean path's coefficients, ``sq`` those of S(t) (see
+    ``speed_squared_coefficients``), x_a and x_b the path at the piece's ends
+    and ``k`` the bin of x_a.  The walk crosses one bin edge at a time (no
+    logarithms) and returns the bin of x_b.
     """
+    a0, a1, a2, a3 = a
+    s1, s2, s3, s4, s5 = sq
     n = edges.shape[0] - 1
-    x_b = cubic_value(a0, a1, a2, a3, t_b)
     t_prev = t_a
-    s_prev = speed_squared_antiderivative(a1, a2, a3, dt, t_a)
+    x_prev = x_a
+    s_prev = quintic_antiderivative_value(s1, s2, s3, s4, s5, t_a)
     while True:
         if k <= n and x_b >= edges[k]:  # leaves bin k through its upper edge
             level = edges[k]
@@ -103,15 +108,61 @@ def _tally_position(a0, a1, a2, a3, dt, t_a, t_b, k, edges, time_in, v2_in):
             k_next = k - 1
         else:
             break
-        t_e = cubic_level_time(a0, a1, a2, a3, level, t_prev, t_b)
-        s_e = speed_squared_antiderivative(a1, a2, a3, dt, t_e)
+        t_e = cubic_level_time(a0, a1, a2, a3, level, t_prev, t_b, x_prev - level, x_b - level)
+        s_e = quintic_antiderivative_value(s1, s2, s3, s4, s5, t_e)
         time_in[k] += t_e - t_prev
         v2_in[k] += s_e - s_prev
-        t_prev, s_prev = t_e, s_e
+        t_prev, x_prev, s_prev = t_e, level, s_e
         k = k_next
-    s_b = speed_squared_antiderivative(a1, a2, a3, dt, t_b)
+    s_b = quintic_antiderivative_value(s1, s2, s3, s4, s5, t_b)
     time_in[k] += t_b - t_prev
     v2_in[k] += s_b - s_prev
+    return k
+
+
+@njit(cache=True, inline="always")
+def _tally_step(a, dt, tau, x_tau, slope_tau, k, edges, bin_lower, bin_upper, time_in, v2_in):
+    """Add the mean path's time and int v^2 dt over [0, tau] to the x bins.
+
+    ``k`` is the bin of m(0); returns the bin of m(tau) = x_tau, where the
+    slope is slope_tau.  The common case is a step that stays in its bin: the
+    cubic on [0, tau] lies inside the hull of its Bernstein control points
+    m(0), m(0) + m'(0) tau/3, m(tau) - m'(tau) tau/3, m(tau), so when those
+    all lie in bin k the whole step is tallied there at once.  Otherwise
+    the path is split at the zeros of m' into monotone pieces (none when the
+    control points of m' share a sign), which are walked edge by edge.
+    """
+    a0, a1, a2, a3 = a
+    sq = speed_squared_coefficients(a1, a2, a3, dt)
+    c1 = a0 + a1 * tau * (1.0 / 3.0)
+    c2 = x_tau - slope_tau * tau * (1.0 / 3.0)
+    lowest = min(min(a0, x_tau), min(c1, c2))
+    highest = max(max(a0, x_tau), max(c1, c2))
+    if bin_lower[k] <= lowest and highest < bin_upper[k]:
+        time_in[k] += tau
+        v2_in[k] += quintic_antiderivative_value(sq[0], sq[1], sq[2], sq[3], sq[4], tau)
+        return k
+    # m' is a quadratic with Bernstein control points m'(0), m'(0) + a2 tau,
+    # m'(tau): when they share a sign, m is monotone and needs no split
+    slope_mid = a1 + a2 * tau
+    if (a1 > 0.0 and slope_mid > 0.0 and slope_tau > 0.0) or (
+        a1 < 0.0 and slope_mid < 0.0 and slope_tau < 0.0
+    ):
+        n_zero, t1, t2 = 0, tau, tau
+    else:
+        n_zero, t1, t2 = slope_zeros(a1, a2, a3, tau)
+    t_a = 0.0
+    x_a = a0
+    for piece in range(n_zero + 1):
+        t_b = tau
+        if piece == 0 and n_zero >= 1:
+            t_b = t1
+        elif piece == 1 and n_zero == 2:
+            t_b = t2
+        x_b = x_tau if t_b == tau else cubic_value(a0, a1, a2, a3, t_b)
+        k = _tally_position(a, sq, t_a, t_b, x_a, x_b, k, edges, time_in, v2_in)
+        t_a = t_b
+        x_a = x_b
     return k
 
 
@@ -137,12 +188,20 @@ def _run(
     nx = x_edges.shape[0] - 1
     x_log_lo = math.log(x_edges[0])
     x_per_ln = nx / (math.log(x_edges[nx]) - x_log_lo)
+    # the two ends of every x bin, the under- and overflow bins unbounded
+    x_bin_lower = np.empty(nx + 2)
+    x_bin_upper = np.empty(nx + 2)
+    x_bin_lower[0] = -np.inf
+    x_bin_lower[1:] = x_edges
+    x_bin_upper[: nx + 1] = x_edges
+    x_bin_upper[nx + 1] = np.inf
 
     # start at rest one unit above the floor; equilibration forgets this
     x = 1.0
     v = 0.0
     x_bin = _bin_index(x, x_log_lo, x_per_ln, nx, x_edges)  # kept while recording
-    delta = 0.5 * (1.0 / min_step_divisor) ** 2
+    min_root_2delta = 1.0 / min_step_divisor
+    delta = 0.5 * min_root_2delta * min_root_2delta
     recording = equilibration_time <= 0.0
     t = 0.0
     t_stop = recorded_time if recording else equilibration_time
@@ -170,37 +229,35 @@ def _run(
         normal_r = rng.standard_normal()
         normal_s = rng.standard_normal()
         x1, v1 = free_flight_step(x, v, dt, normal_r, normal_s)
-        a0, a1, a2, a3 = hermite_cubic(x, v, x1, v1, dt)
+        a = hermite_cubic(x, v, x1, v1, dt)
+        a0, a1, a2, a3 = a
         collided = x1 < 0.0
-        tau = first_crossing_time(a0, a1, a2, a3, dt) if collided else dt
+        if collided:  # the step ends where the mean path first reaches 0
+            tau = first_crossing_time(a0, a1, a2, a3, dt, x1)
+            x_tau = 0.0
+            v_tau = cubic_slope(a1, a2, a3, tau)
+        else:
+            tau, x_tau, v_tau = dt, x1, v1
         steps += 1
         if recording:
             ix, ix2 = mean_path_integrals(a0, a1, a2, a3, dt, tau)
             int_x += ix
             int_x2 += ix2
-            n_zero, t1, t2 = slope_zeros(a1, a2, a3, tau)
-            t_a = 0.0
-            for piece in range(n_zero + 1):
-                t_b = tau
-                if piece == 0 and n_zero >= 1:
-                    t_b = t1
-                elif piece == 1 and n_zero == 2:
-                    t_b = t2
-                x_bin = _tally_position(
-                    a0, a1, a2, a3, dt, t_a, t_b, x_bin,
-                    x_edges, position_time, position_v2_time,
-                )
-                t_a = t_b
+            x_bin = _tally_step(
+                a, dt, tau, x_tau, v_tau, x_bin,
+                x_edges, x_bin_lower, x_bin_upper, position_time, position_v2_time,
+            )
         t += tau
         if collided:
-            v_out = restitution * abs(cubic_slope(a1, a2, a3, tau))  # eq. (restitution)
+            v_out = restitution * abs(v_tau)  # eq. (restitution)
             if recording:
                 collisions += 1
                 speed_counts[_bin_index(v_out, v_log_lo, v_per_ln, nv, v_edges)] += 1
             x = 0.0
             x_bin = 0
             v = v_out
-            delta = 0.5 * (v_out / min_step_divisor) ** 2
+            root_2delta = v_out * min_root_2delta
+            delta = 0.5 * root_2delta * root_2delta
         else:
             x = x1
             v = v1
