@@ -274,6 +274,16 @@ def slope_zeros(a1, a2, a3, t_end):
     return n, t1, t2
 
 
+@njit(cache=True, inline="always")
+def monotone_piece_end(piece, n_zero, t1, t2, t_end):
+    """End of monotone piece ``piece`` of [0, t_end] split at the slope zeros t1 < t2."""
+    if piece == 0 and n_zero >= 1:
+        return t1
+    if piece == 1 and n_zero == 2:
+        return t2
+    return t_end
+
+
 @njit(cache=True)
 def first_crossing_time(a0, a1, a2, a3, t_end, x_end):
     """First t in (0, t_end] where the mean path reaches 0.
@@ -286,11 +296,7 @@ def first_crossing_time(a0, a1, a2, a3, t_end, x_end):
     start = 0.0
     m_start = a0
     for k in range(n + 1):
-        stop = t_end
-        if k == 0 and n >= 1:
-            stop = t1
-        elif k == 1 and n == 2:
-            stop = t2
+        stop = monotone_piece_end(k, n, t1, t2, t_end)
         m_stop = x_end if stop == t_end else cubic_value(a0, a1, a2, a3, stop)
         if m_stop <= 0.0:
             return cubic_level_time(a0, a1, a2, a3, 0.0, start, stop, m_start, m_stop)

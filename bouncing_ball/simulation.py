@@ -44,6 +44,7 @@ from .free_flight import (
     hermite_cubic,
     largest_safe_step,
     mean_path_integrals,
+    monotone_piece_end,
     quintic_antiderivative_value,
     slope_zeros,
     speed_squared_coefficients,
@@ -154,11 +155,7 @@ def _tally_step(a, dt, tau, x_tau, slope_tau, k, edges, bin_lower, bin_upper, ti
     t_a = 0.0
     x_a = a0
     for piece in range(n_zero + 1):
-        t_b = tau
-        if piece == 0 and n_zero >= 1:
-            t_b = t1
-        elif piece == 1 and n_zero == 2:
-            t_b = t2
+        t_b = monotone_piece_end(piece, n_zero, t1, t2, tau)
         x_b = x_tau if t_b == tau else cubic_value(a0, a1, a2, a3, t_b)
         k = _tally_position(a, sq, t_a, t_b, x_a, x_b, k, edges, time_in, v2_in)
         t_a = t_b
