@@ -96,6 +96,21 @@ def test_an_r_not_in_the_config_is_a_valid_target(finished_run):
     assert summary.shards.iloc[0] == 3
 
 
+def test_results_do_not_depend_on_cores(finished_run, tmp_path):
+    """The same config with --cores 1 gives bit-identical tables."""
+    directory = _copy(tmp_path, SMALL)
+    result = subprocess.run(
+        [sys.executable, "-m", "snakemake", "--cores", "1", "results/simulation/r0.5/p0v.parquet",
+         "results/simulation/r0.5/summary.parquet", "results/simulation/r0.5/position.parquet"],
+        cwd=directory, capture_output=True, text=True, timeout=600,
+    )
+    assert result.returncode == 0, result.stderr[-3000:]
+    for table in ("p0v", "position", "summary"):
+        one, _ = read_table(directory / f"results/simulation/r0.5/{table}.parquet")
+        two, _ = read_table(finished_run / f"results/simulation/r0.5/{table}.parquet")
+        pd.testing.assert_frame_equal(one, two, check_exact=True)
+
+
 def _with(path, value):
     config = yaml.safe_load(yaml.safe_dump(SMALL))
     *parents, last = path
