@@ -1,26 +1,39 @@
 """Equilibrium statistics of an inelastically bouncing ball (Burkhardt & Kotsev 2006)."""
 
 import hashlib
-import os
-import sys
 from pathlib import Path
 
 __version__ = "0.1.0"
 
+PACKAGE = Path(__file__).parent
 
-def _numba_cache_directory() -> str:
-    """A numba cache folder named after a hash of this package's source.
 
-    numba's ``cache=True`` checks only the timestamp of the file that holds a
-    compiled function, not of the files it calls into: after an edit of
-    free_flight.py the cached simulation loop would silently keep the old
-    code.  Keying the folder on all sources makes any edit a fresh compile.
+def source_digest(modules=None) -> str:
+    """A short hash of the source of the named modules of this package (all if None).
+
+    The workflow passes it to its rules as a parameter, so that editing the
+    code behind a stage re-runs that stage and nothing else.
     """
+    names = sorted(path.stem for path in PACKAGE.glob("*.py")) if modules is None else sorted(modules)
     digest = hashlib.sha256()
-    for source in sorted(Path(__file__).parent.glob("*.py")):
-        digest.update(source.read_bytes())
-    return str(Path(__file__).parent / "__pycache__" / f"numba-{digest.hexdigest()[:16]}")
+    for name in names:
+        digest.update(name.encode())
+        digest.update((PACKAGE / f"{name}.py").read_bytes())
+    return digest.hexdigest()[:16]
 
 
-if "NUMBA_CACHE_DIR" not in os.environ and "numba" not in sys.modules:
-    os.environ["NUMBA_CACHE_DIR"] = _numba_cache_directory()
+def _use_source_keyed_numba_cache():
+    """Keep numba's compiled code in a folder named after the package's source.
+
+    ``cache=True`` checks only the file that holds a compiled function, not
+    the files it calls into: after an edit of free_flight.py a cached
+    simulation loop would silently keep the old code.  A user's
+    NUMBA_CACHE_DIR is respected.
+    """
+    import numba
+
+    if not numba.config.CACHE_DIR:
+        numba.config.CACHE_DIR = str(PACKAGE / "__pycache__" / f"numba-{source_digest()}")
+
+
+_use_source_keyed_numba_cache()

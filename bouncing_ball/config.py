@@ -35,6 +35,18 @@ def check_config(config: dict) -> dict[str, Fraction]:
     return grid
 
 
+# the keys of config["simulation"] that change the numbers a shard produces
+SHARD_SETTINGS = (
+    "shard_time",
+    "equilibration_time",
+    "criterion_c",
+    "min_step_divisor",
+    "max_steps",
+    "speed_bins",
+    "position_bins",
+)
+
+
 def simulation_settings(config: dict, label: str) -> dict:
     """The simulation parameters of one r: the defaults with its overrides applied."""
     simulation = config["simulation"]
@@ -43,6 +55,20 @@ def simulation_settings(config: dict, label: str) -> dict:
         if restitution_label(parse_restitution(key)) == label:
             settings.update(override)
     return settings
+
+
+def shard_settings(config: dict, label: str) -> dict:
+    """What a shard of r = ``label`` is run with: only what changes its result.
+
+    The number of shards is not among them, so adding shards leaves the
+    existing ones alone.
+    """
+    settings = simulation_settings(config, label)
+    return {key: settings[key] for key in SHARD_SETTINGS}
+
+
+def shard_count(config: dict, label: str) -> int:
+    return int(simulation_settings(config, label)["shards"])
 
 
 def log_bins(spec: dict) -> LogBins:

@@ -86,7 +86,7 @@ def position_bin_average(lo, hi, restitution):
 
         return (primitive(hi) - primitive(lo)) / (hi - lo)
     averages = [
-        integrate.quad(lambda x: _position_density_third(x), a, b, epsrel=1e-10)[0] / (b - a)
+        integrate.quad(_position_density_third, a, b, epsrel=1e-10)[0] / (b - a)
         for a, b in zip(np.atleast_1d(lo), np.atleast_1d(hi))
     ]
     return np.asarray(averages).reshape(np.shape(lo))

@@ -29,30 +29,17 @@ SQRT3 = math.sqrt(3.0)
 SQRT1_12 = math.sqrt(1.0 / 12.0)
 
 # Rational fits (see largest_safe_step) to the positive root of the cubic
-# c s^3 = x + v s^2, in units of a = (x/c)^(1/3), with t = |v| / (c a):
+# c s^3 = x + v s^2, in units of a = (x/c)^(1/3), with t = |v| / (c a).
+# The forms have the right limits (s/a -> 1 at t = 0; s/a -> t, resp.
+# t^(-1/2), for t -> inf); the constants are least-squares fits of the
+# relative error over a log grid of t.  They only set Halley's starting
+# point: any start within a few per cent gives the same root.
 #   v >= 0:  s / a ~ t + (1 + P t) / (1 + (P + 2/3) t + Q t^2 + P t^3)   (0.2 %)
 #   v < 0:   s / a ~ (t + (1 + N3 t) / (1 + N1 t + N2 t^2))^(-1/2)      (0.04 %)
 _P, _Q = 0.44356066, 0.56163652
 _N1, _N2, _N3 = 0.40104058, 0.00211799, 0.06071102
 
-# Kahan's cube root estimate: the bits of y, read as an integer, divided by 3
-# plus this bias give y^(1/3) to 3 % for normal y > 0 (fdlibm's B1 << 32).
-_CBRT_BIAS = np.int64(715094163 << 32)
 _SMALLEST_NORMAL = np.finfo(np.float64).tiny
-
-
-@njit(cache=True)
-def cube_root(y):
-    """y^(1/3) for y >= 0, good to 2e-5 (np.cbrt costs several times more).
-
-    Kahan's bit-level estimate refined by one Halley step for a^3 = y.
-    Zero and subnormal y go to np.cbrt.
-    """
-    if y < _SMALLEST_NORMAL:
-        return np.cbrt(y)
-    a = np.int64(np.float64(y).view(np.int64) // 3 + _CBRT_BIAS).view(np.float64)
-    a3 = a * a * a
-    return a * ((a3 + 2.0 * y) / (2.0 * a3 + y))
 
 
 @njit(cache=True)
@@ -94,7 +81,7 @@ def largest_safe_step(x, v, c):
         s = 2.0 * v / (c + math.sqrt(c * c + 2.0 * v))  # s^2 (v - c s - s^2/2) = 0
         return s * s
     a3 = x / c
-    a = cube_root(a3)
+    a = np.cbrt(a3)
     b = v / c
     if b >= 0.0:
         a2 = a * a

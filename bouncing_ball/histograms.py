@@ -11,6 +11,9 @@ import pandas as pd
 
 from .tallies import ShardTallies, merge_shards
 
+# the modules whose code decides the merged tables (see ``source_digest``)
+SOURCES = ("bins", "histograms", "tallies")
+
 
 def jackknife(estimator, *per_shard):
     """Value and jackknife standard error of ``estimator`` of summed tallies.
@@ -42,7 +45,8 @@ def outgoing_speed_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
 
     Columns v_lo, v_hi, v (the geometric centre; the arithmetic one for the
     underflow bin), p0v, p0v_err, count.  Bin averages mean
-    p0v = int_bin v P(0,v) dv / int_bin v dv.  The overflow bin has p0v = NaN.
+    p0v = int_bin v P(0,v) dv / int_bin v dv.  The overflow bin has p0v = NaN;
+    an empty bin has p0v = 0 and p0v_err = NaN (no scatter to measure).
     """
     bins = shards[0].speed_bins
     lower, upper = bins.lower, bins.upper
@@ -51,6 +55,9 @@ def outgoing_speed_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
     p0v, err = jackknife(
         lambda c, t: _outgoing_speed_density(c, t, lower, upper), counts, times
     )
+    total = counts.sum(axis=0)
+    p0v[~np.isfinite(upper)] = np.nan
+    err[~np.isfinite(upper) | (total == 0)] = np.nan
     return pd.DataFrame(
         {
             "v_lo": lower,
@@ -58,13 +65,17 @@ def outgoing_speed_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
             "v": _bin_centres(lower, upper),
             "p0v": p0v,
             "p0v_err": err,
-            "count": counts.sum(axis=0).astype(np.int64),
+            "count": total.astype(np.int64),
         }
     )
 
 
 def position_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
-    """P(x) (bin averages) and <v^2>_x, eq. (moment2), per bin of x."""
+    """P(x) (bin averages) and <v^2>_x, eq. (moment2), per bin of x.
+
+    NaN where a value is undefined: P(x) in the overflow bin, errors and
+    <v^2>_x in bins the particle never visited.
+    """
     bins = shards[0].position_bins
     lower, upper = bins.lower, bins.upper
     in_bin = np.stack([s.position_time for s in shards])
@@ -72,6 +83,9 @@ def position_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
     times = np.array([s.time for s in shards])[:, None]
     px, px_err = jackknife(lambda b, t: b / (t * (upper - lower)), in_bin, times)
     v2x, v2x_err = jackknife(lambda w, b: w / b, v2, in_bin)
+    empty = in_bin.sum(axis=0) == 0
+    px[~np.isfinite(upper)] = np.nan
+    px_err[~np.isfinite(upper) | empty] = np.nan
     return pd.DataFrame(
         {
             "x_lo": lower,

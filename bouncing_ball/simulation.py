@@ -15,18 +15,21 @@ instead adds the whole step's noise sqrt(2 Delta) >= sqrt(2 delta) to the
 impact speed, which biases P(0, v) upward at speeds comparable to it; the
 interpolated crossing does not.
 
-What a shard records after its equilibration time (all exact in expectation
-given the ends of each step, not left-point sums, because Delta depends on
-the state):
+What a shard records after its equilibration time (integrals over each step
+given both its ends, not left-point sums, which are biased because Delta
+depends on the state):
   * outgoing speeds at collisions, on log bins;
-  * the time, collisions and steps;
-  * int x dt and int x^2 dt (mean path plus bridge variance);
-  * the time spent in each log bin of x along the mean path, and
-    int v^2 dt in each bin (slope squared plus bridge variance of v), which
-    give P(x) and <v^2>_x of eq. (moment2).
+  * the time, collisions and steps (all after equilibration);
+  * int x dt and int x^2 dt, exact in expectation given the ends (mean path
+    plus bridge variance);
+  * the time spent in each log bin of x along the mean path, and int v^2 dt
+    in each bin (slope squared plus bridge variance of v), which give P(x)
+    and <v^2>_x of eq. (moment2).  Assigning time by the mean path ignores
+    the bridge's spread sigma_x ~ (Delta^3 / 96)^(1/2) about it; that
+    changes a bin by about (sigma_x^2 / 2) P''/P, second order, ~1e-4.
 
-A shard's work is bounded: it stops after ``max_steps`` steps even if the
-simulated time has not been reached, and says so.
+A shard's work is bounded: it stops after ``max_steps`` steps (equilibration
+included) even if the simulated time has not been reached, and says so.
 """
 
 import math
@@ -50,6 +53,9 @@ from .free_flight import (
     speed_squared_coefficients,
 )
 from .tallies import ShardTallies
+
+# the modules whose code decides a shard's numbers (see ``source_digest``)
+SOURCES = ("bins", "free_flight", "simulation", "tallies")
 
 # indices into the scalar tally array of the compiled loop
 _TIME, _COLLISIONS, _STEPS, _INT_X, _INT_X2, _EXHAUSTED = range(6)
@@ -202,7 +208,8 @@ def _run(
     recording = equilibration_time <= 0.0
     t = 0.0
     t_stop = recorded_time if recording else equilibration_time
-    steps = 0
+    steps = 0  # all steps, against the budget
+    recorded_steps = 0
     collisions = 0
     int_x = 0.0
     int_x2 = 0.0
@@ -237,6 +244,7 @@ def _run(
             tau, x_tau, v_tau = dt, x1, v1
         steps += 1
         if recording:
+            recorded_steps += 1
             ix, ix2 = mean_path_integrals(a0, a1, a2, a3, dt, tau)
             int_x += ix
             int_x2 += ix2
@@ -261,7 +269,7 @@ def _run(
 
     scalars[_TIME] = t if recording else 0.0
     scalars[_COLLISIONS] = collisions
-    scalars[_STEPS] = steps
+    scalars[_STEPS] = recorded_steps
     scalars[_INT_X] = int_x
     scalars[_INT_X2] = int_x2
     scalars[_EXHAUSTED] = exhausted

@@ -9,8 +9,10 @@ Snakemake (rule merge_shards), or by hand:
 import argparse
 import logging
 
-from bouncing_ball.config import log_bins
+from bouncing_ball.config import SHARD_SETTINGS, log_bins
+from bouncing_ball import source_digest
 from bouncing_ball.histograms import (
+    SOURCES,
     outgoing_speed_histogram,
     position_histogram,
     position_moments_summary,
@@ -21,7 +23,8 @@ from bouncing_ball.tallies import tallies_from_frame
 
 
 def read_shards(paths, label):
-    """The tallies of every shard, checked to belong to r = ``label`` and to share bins."""
+    """The tallies of every shard, checked to belong to r = ``label``, to share
+    settings, to be distinct shards, and to have recorded some time."""
     shards, provenances = [], []
     for path in paths:
         frame, provenance = read_table(path)
@@ -29,9 +32,12 @@ def read_shards(paths, label):
             raise UnreadableFileError(
                 f"{path}: simulated for r = {provenance.get('r_label')}, not r = {label}"
             )
+        repeated = [p for p, q in zip(paths, provenances) if q.get("shard") == provenance.get("shard")]
+        if repeated:
+            raise UnreadableFileError(f"{path}: the same shard as {repeated[0]}")
         if provenances and any(
-            provenance[key] != provenances[0][key]
-            for key in ("speed_bins", "position_bins", "criterion_c", "min_step_divisor", "seed")
+            provenance.get(key) != provenances[0].get(key)
+            for key in ("seed", "code", *SHARD_SETTINGS)
         ):
             raise UnreadableFileError(
                 f"{path}: made with other settings than {paths[0]}; rerun the stale shards"
@@ -47,6 +53,12 @@ def read_shards(paths, label):
             )
         except (KeyError, ValueError) as error:
             raise UnreadableFileError(f"{path}: malformed shard ({error})") from None
+        if not shards[-1].time > 0.0:
+            raise UnreadableFileError(
+                f"{path}: recorded no time: its step budget (simulation.max_steps = "
+                f"{provenance['max_steps']}) ran out during equilibration. Raise the budget "
+                "or shorten equilibration_time, then rerun this shard."
+            )
         provenances.append(provenance)
     return shards, provenances
 
@@ -61,10 +73,9 @@ def main(shard_paths, restitution, p0v_path, position_path, summary_path):
         "r": exact_string(exact),
         "r_label": label,
         "shards": len(shards),
-        **{key: first[key] for key in (
-            "seed", "shard_time", "equilibration_time", "criterion_c",
-            "min_step_divisor", "max_steps", "speed_bins", "position_bins",
-        )},
+        "code": source_digest(SOURCES),
+        "simulation_code": first["code"],
+        **{key: first[key] for key in ("seed", *SHARD_SETTINGS)},
     }
     summary = position_moments_summary(shards, float(exact))
     write_table(outgoing_speed_histogram(shards), p0v_path, provenance)
@@ -79,7 +90,7 @@ def main(shard_paths, restitution, p0v_path, position_path, summary_path):
     if row.shards_out_of_budget:
         logging.warning(
             "r=%s: %d of %d shards ran out of their step budget (simulation.max_steps) "
-            "before shard_time; their shorter time is accounted for",
+            "before shard_time; the estimates weight every shard by the time it recorded",
             label, row.shards_out_of_budget, len(shards),
         )
 

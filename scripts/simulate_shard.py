@@ -1,32 +1,28 @@
 """Simulate one shard of one r: results/simulation/r{r}/shard{k}.parquet.
 
-Run by Snakemake (rule simulate_shard), or by hand, e.g.
-    python scripts/simulate_shard.py --restitution 1/3 --shard 0 --seed 1 \
-        --shard-time 1e4 out.parquet
+Run by Snakemake (rule simulate_shard), or by hand with the settings of a
+config file, e.g.
+    python scripts/simulate_shard.py --restitution 1/3 --shard 0 out.parquet
+    python scripts/simulate_shard.py --restitution 0.5 --shard 2 --shard-time 1e4 \
+        --config config/config.yaml out.parquet
 """
 
 import argparse
 import logging
 import time
 
-from bouncing_ball.config import log_bins
+import yaml
+
+from bouncing_ball import source_digest
+from bouncing_ball.config import check_config, log_bins, shard_settings
 from bouncing_ball.io import write_table
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
-from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
+from bouncing_ball.simulation import SOURCES, shard_seed_sequence, simulate_shard
 from bouncing_ball.tallies import tallies_to_frame
-
-DEFAULTS = {
-    "equilibration_time": 1.0e3,
-    "criterion_c": 5.0,
-    "min_step_divisor": 500.0,
-    "max_steps": 1.0e11,
-    "speed_bins": {"lo": 1.0e-4, "hi": 1.0e2, "per_decade": 10},
-    "position_bins": {"lo": 1.0e-3, "hi": 1.0e3, "per_decade": 5},
-}
 
 
 def main(output, restitution, shard, seed, settings):
-    """Simulate and write one shard; ``settings`` as in config key ``simulation``."""
+    """Simulate and write one shard; ``settings`` as from ``config.shard_settings``."""
     exact = parse_restitution(restitution)
     label = restitution_label(exact)
     started = time.perf_counter()
@@ -48,31 +44,35 @@ def main(output, restitution, shard, seed, settings):
         "r_label": label,
         "shard": shard,
         "seed": seed,
-        **{key: settings[key] for key in DEFAULTS | {"shard_time": None}},
+        "code": source_digest(SOURCES),
+        **settings,
     }
     write_table(tallies_to_frame(tallies), output, provenance)
     logging.info(
         "r=%s shard %d: time %.6g, %d collisions, %d steps, %.1f s%s",
         label, shard, tallies.time, tallies.collisions, tallies.steps, elapsed,
-        " -- STEP BUDGET EXHAUSTED" if tallies.budget_exhausted else "",
+        " -- STEP BUDGET EXHAUSTED (simulation.max_steps)" if tallies.budget_exhausted else "",
     )
 
 
 def _command_line():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("output")
     parser.add_argument("--restitution", required=True, help='r, e.g. 0.25 or "1/3"')
     parser.add_argument("--shard", type=int, required=True)
-    parser.add_argument("--seed", type=int, required=True)
-    parser.add_argument("--shard-time", type=float, required=True)
-    parser.add_argument("--equilibration-time", type=float, default=DEFAULTS["equilibration_time"])
-    parser.add_argument("--criterion-c", type=float, default=DEFAULTS["criterion_c"])
-    parser.add_argument("--min-step-divisor", type=float, default=DEFAULTS["min_step_divisor"])
-    parser.add_argument("--max-steps", type=float, default=DEFAULTS["max_steps"])
+    parser.add_argument("--config", default="config/config.yaml", help="settings and seed from here")
+    parser.add_argument("--shard-time", type=float, help="override the config's shard_time")
     args = parser.parse_args()
-    settings = {**DEFAULTS, **{k: v for k, v in vars(args).items() if k in DEFAULTS or k == "shard_time"}}
+    with open(args.config) as handle:
+        config = yaml.safe_load(handle)
+    check_config(config)
+    settings = shard_settings(config, restitution_label(parse_restitution(args.restitution)))
+    if args.shard_time is not None:
+        settings["shard_time"] = args.shard_time
     logging.basicConfig(level=logging.INFO, format="%(message)s")
-    main(args.output, args.restitution, args.shard, args.seed, settings)
+    main(args.output, args.restitution, args.shard, config["seed"], settings)
 
 
 if "snakemake" in globals():

@@ -2,6 +2,7 @@
 
 import copy
 from fractions import Fraction
+from pathlib import Path
 
 import pytest
 import yaml
@@ -42,7 +43,7 @@ def test_repeated_r_refused_also_in_another_spelling():
 
 
 def _default_config():
-    with open("config/config.yaml") as handle:
+    with open(Path(__file__).resolve().parents[1] / "config" / "config.yaml") as handle:
         return yaml.safe_load(handle)
 
 

@@ -1,5 +1,6 @@
 """The workflow as a user runs it, in a temporary copy of the repository."""
 
+import os
 import shutil
 import subprocess
 import sys
@@ -96,6 +97,51 @@ def test_an_r_not_in_the_config_is_a_valid_target(finished_run):
     assert summary.shards.iloc[0] == 3
 
 
+def planned_jobs(directory, env=None):
+    """{rule: count} of the jobs a dry run would execute (empty if nothing to do)."""
+    result = subprocess.run(
+        [sys.executable, "-m", "snakemake", "--cores", "2", "--dry-run", "--quiet", "rules"],
+        cwd=directory, capture_output=True, text=True, timeout=300, env=env,
+    )
+    assert result.returncode == 0, result.stderr[-3000:]
+    jobs = {}
+    lines = (result.stdout + result.stderr).splitlines()
+    if "Job stats:" in lines:
+        for line in lines[lines.index("Job stats:") + 3:]:
+            parts = line.split()
+            if len(parts) != 2 or parts[0] == "total":
+                break
+            jobs[parts[0]] = int(parts[1])
+    return jobs
+
+
+def test_adding_a_shard_runs_only_that_shard(finished_run, tmp_path):
+    directory = tmp_path / "copy"
+    shutil.copytree(finished_run, directory)  # results, logs and .snakemake, mtimes kept
+    config = yaml.safe_load(yaml.safe_dump(SMALL))
+    config["simulation"]["per_restitution"]["0.5"] = {"shards": 4}
+    (directory / "config" / "config.yaml").write_text(yaml.safe_dump(config))
+    assert planned_jobs(directory) == {"simulate_shard": 1, "merge_shards": 1, "all": 1}
+
+
+def _package_copy(tmp_path):
+    """A copy of the library that PYTHONPATH puts in front of the installed one."""
+    shutil.copytree(REPOSITORY / "bouncing_ball", tmp_path / "lib" / "bouncing_ball",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    return tmp_path / "lib" / "bouncing_ball", {**os.environ, "PYTHONPATH": str(tmp_path / "lib")}
+
+
+def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
+    package, env = _package_copy(tmp_path)
+    assert planned_jobs(finished_run, env) == {}
+    with open(package / "histograms.py", "a") as handle:
+        handle.write("\n# an edit\n")
+    assert planned_jobs(finished_run, env) == {"merge_shards": 2, "all": 1}
+    with open(package / "free_flight.py", "a") as handle:
+        handle.write("\n# an edit\n")
+    assert planned_jobs(finished_run, env) == {"simulate_shard": 5, "merge_shards": 2, "all": 1}
+
+
 def test_results_do_not_depend_on_cores(finished_run, tmp_path):
     """The same config with --cores 1 gives bit-identical tables."""
     directory = _copy(tmp_path, SMALL)
@@ -111,6 +157,12 @@ def test_results_do_not_depend_on_cores(finished_run, tmp_path):
         pd.testing.assert_frame_equal(one, two, check_exact=True)
 
 
+def test_a_non_canonical_label_is_refused(finished_run):
+    result = snakemake(finished_run, "--dry-run", "results/simulation/r0.50/summary.parquet")
+    assert result.returncode != 0
+    assert "use r0.5" in result.stdout + result.stderr
+
+
 def _with(path, value):
     config = yaml.safe_load(yaml.safe_dump(SMALL))
     *parents, last = path
@@ -122,23 +174,25 @@ def _with(path, value):
 
 
 BAD = [
-    (_with(["restitution"], [0.5, 0.0]), "['restitution'][1]"),
-    (_with(["restitution"], [1.0]), "restitution"),
-    (_with(["restitution"], ["1/0"]), "restitution[0]"),
-    (_with(["restitution"], ["half"]), "['restitution'][0]"),
-    (_with(["restitution"], [0.5, "1/2"]), "restitution[1]"),
-    (_with(["restitution"], []), "restitution"),
+    (_with(["restitution"], [0.5, 0.0]), "restitution[1]: r = 0.0 is outside the allowed range 0 < r < 1"),
+    (_with(["restitution"], [1.0]), "restitution[0]: r = 1.0 is outside"),
+    (_with(["restitution"], ["1/0"]), "restitution[0]: '1/0' divides by zero"),
+    (_with(["restitution"], ["half"]), "restitution[0]: 'half' is not a number"),
+    (_with(["restitution"], [0.5, "1/2"]), "restitution[1]: r = '1/2' repeats"),
+    (_with(["restitution"], []), "instance['restitution']"),
+    (_with(["restitution"], [[0.5]]), "instance['restitution'][0]"),
     (_with(["simulation", "shards"], 0), "shards"),
     (_with(["simulation", "shard_time"], -1.0), "shard_time"),
     (_with(["simulation", "criterion_c"], 0.0), "criterion_c"),
     (_with(["simulation", "shard_time"], "1e5"), "shard_time"),
     (_with(["simulation", "speed_bins", "lo"], 1.0e3), "speed_bins"),
-    (_with(["simulation", "shardz"], 4), "shardz"),
-    (_with(["sead"], 4), "sead"),
+    (_with(["simulation", "shardz"], 4), "'shardz' was unexpected"),
+    (_with(["sead"], 4), "'sead' was unexpected"),
+    (_with(["simulation", "per_restitution"], {"2": {"shards": 2}}), "per_restitution.2"),
 ]
 
 
-@pytest.mark.parametrize("config, key", BAD, ids=[key for _, key in BAD])
+@pytest.mark.parametrize("config, key", BAD, ids=[key.split(":")[0] for _, key in BAD])
 def test_bad_config_is_refused_before_any_job_runs(tmp_path, config, key):
     directory = _copy(tmp_path, config)
     result = snakemake(directory)
@@ -159,16 +213,23 @@ def test_lint_is_clean_and_rule_files_are_formatted():
         capture_output=True, text=True, timeout=120,
     )
     assert formatted.returncode == 0, formatted.stderr
+    quick = subprocess.run(
+        [sys.executable, "-m", "snakemake", "--dry-run", "--configfile", "config/quick.yaml"],
+        cwd=REPOSITORY, capture_output=True, text=True, timeout=120,
+    )
+    assert quick.returncode == 0, quick.stderr[-2000:]
 
 
 def test_scripts_run_by_hand(tmp_path):
     """A failing step can be debugged outside Snakemake: the scripts take paths and values."""
+    config = tmp_path / "config.yaml"
+    config.write_text(yaml.safe_dump(SMALL))
     shards = []
     for k in range(2):
         shards.append(tmp_path / f"shard{k}.parquet")
         subprocess.run(
             [sys.executable, "scripts/simulate_shard.py", "--restitution", "1/3", "--shard", str(k),
-             "--seed", "3", "--shard-time", "200", str(shards[-1])],
+             "--config", str(config), "--shard-time", "200", str(shards[-1])],
             cwd=REPOSITORY, check=True, capture_output=True, timeout=300,
         )
     outputs = {name: tmp_path / f"{name}.parquet" for name in ("p0v", "position", "summary")}
@@ -179,11 +240,12 @@ def test_scripts_run_by_hand(tmp_path):
     )
     summary, provenance = read_table(outputs["summary"])
     assert provenance["r"] == "1/3" and summary.shards.iloc[0] == 2
+    assert summary.total_time.iloc[0] == pytest.approx(400.0)
     # a shard of another r is refused by name
     wrong = tmp_path / "other.parquet"
     subprocess.run(
         [sys.executable, "scripts/simulate_shard.py", "--restitution", "0.5", "--shard", "0",
-         "--seed", "3", "--shard-time", "50", str(wrong)],
+         "--config", str(config), "--shard-time", "200", str(wrong)],
         cwd=REPOSITORY, check=True, capture_output=True, timeout=300,
     )
     refused = subprocess.run(

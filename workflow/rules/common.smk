@@ -1,29 +1,40 @@
 # Helpers for every stage: r labels and exact values, per-r settings, shard lists, targets.
-from bouncing_ball.config import check_config, simulation_settings
-from bouncing_ball.restitution import exact_string, parse_restitution
+from bouncing_ball import histograms, simulation, source_digest
+from bouncing_ball.config import check_config, shard_count, shard_settings
+from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 
 try:
     RESTITUTION = check_config(config)  # {label: exact r}, refused before any job runs
 except ValueError as error:
     raise ValueError(f"invalid config: {error}") from None
 
+# passed as params: an edit of a stage's library code re-runs that stage only
+SIMULATION_CODE = source_digest(simulation.SOURCES)
+MERGE_CODE = source_digest(histograms.SOURCES)
+
 
 def restitution_value(wildcards):
     """Exact r of a label: from the config, or the label itself read as a number."""
     if wildcards.r in RESTITUTION:
         return exact_string(RESTITUTION[wildcards.r])
-    return exact_string(parse_restitution(wildcards.r, f"r label '{wildcards.r}'"))
+    exact = parse_restitution(wildcards.r, f"r label '{wildcards.r}'")
+    if restitution_label(exact) != wildcards.r:
+        raise ValueError(
+            f"r label '{wildcards.r}' is not canonical: use r{restitution_label(exact)} "
+            "(6 significant digits, trailing zeros dropped)"
+        )
+    return exact_string(exact)
 
 
 def settings(wildcards):
-    return simulation_settings(config, wildcards.r)
+    return shard_settings(config, wildcards.r)
 
 
 def shard_files(wildcards):
     return expand(
         "results/simulation/r{r}/shard{shard}.parquet",
         r=wildcards.r,
-        shard=range(settings(wildcards)["shards"]),
+        shard=range(shard_count(config, wildcards.r)),
     )
 
 

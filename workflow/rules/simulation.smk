@@ -15,6 +15,7 @@ rule simulate_shard:
         restitution=restitution_value,
         seed=config["seed"],
         settings=settings,
+        code=SIMULATION_CODE,
     script:
         "../../scripts/simulate_shard.py"
 
@@ -35,5 +36,6 @@ rule merge_shards:
         mem_mb=1000,
     params:
         restitution=restitution_value,
+        code=MERGE_CODE,
     script:
         "../../scripts/merge_shards.py"
