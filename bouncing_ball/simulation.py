@@ -64,7 +64,7 @@ _TIME, _COLLISIONS, _STEPS, _INT_X, _INT_X2, _EXHAUSTED = range(6)
 def shard_seed_sequence(seed: int, label: str, shard: int) -> np.random.SeedSequence:
     """The random stream of one (r, shard): independent of job order and cores.
 
-    The r label (see ``restitution.label``) enters the spawn key as the integer
+    The r label (see ``restitution.restitution_label``) enters the spawn key as the integer
     spelled by its ASCII bytes, so different r never share a stream.
     """
     r_key = int.from_bytes(label.encode("ascii"), "big")
