@@ -35,7 +35,7 @@ def jackknife(estimator, *per_shard):
     return value, np.sqrt((n - 1) / n * (spread**2).sum(axis=0))
 
 
-def _outgoing_speed_density(counts, time, lower, upper):
+def outgoing_speed_density(counts, time, lower, upper):
     """eq. (collrate): the rate of collisions in a bin is int v P(0,v) dv."""
     return counts / (time * 0.5 * (upper**2 - lower**2))
 
@@ -53,7 +53,7 @@ def outgoing_speed_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
     counts = np.stack([s.speed_counts for s in shards])
     times = np.array([s.time for s in shards])[:, None]
     p0v, err = jackknife(
-        lambda c, t: _outgoing_speed_density(c, t, lower, upper), counts, times
+        lambda c, t: outgoing_speed_density(c, t, lower, upper), counts, times
     )
     total = counts.sum(axis=0)
     p0v[~np.isfinite(upper)] = np.nan

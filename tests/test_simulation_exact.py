@@ -14,6 +14,7 @@ import pytest
 from bouncing_ball import exact
 from bouncing_ball.bins import LogBins
 from bouncing_ball.histograms import (
+    outgoing_speed_density,
     outgoing_speed_histogram,
     position_histogram,
     position_moments_summary,
@@ -116,7 +117,7 @@ def test_outgoing_speed_density_chi_square(shards, r):
     usable = ((table["count"] >= 100) & np.isfinite(table.v_hi) & (table.v_lo > 0)).to_numpy()
     lower, upper = table.v_lo.to_numpy()[usable], table.v_hi.to_numpy()[usable]
     per_shard = np.stack(
-        [s.speed_counts[usable] / (s.time * 0.5 * (upper**2 - lower**2)) for s in shards[r]]
+        [outgoing_speed_density(s.speed_counts[usable], s.time, lower, upper) for s in shards[r]]
     )
     deviations = per_shard - exact.outgoing_speed_bin_average(lower, upper, r)
     assert usable.sum() >= 30, "too few populated bins for a meaningful chi^2"
