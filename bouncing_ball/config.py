@@ -12,9 +12,6 @@ from fractions import Fraction
 from .bins import LogBins
 from .restitution import parse_restitution, restitution_grid, restitution_label
 
-OVERRIDABLE = ("shards", "shard_time")
-
-
 def check_config(config: dict) -> dict[str, Fraction]:
     """Raise ValueError naming the key if the config is inconsistent; return the r grid."""
     grid = restitution_grid(config["restitution"])
