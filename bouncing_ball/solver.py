@@ -1,0 +1,211 @@
+"""P(0, v) for any r in (0, 1): the integral equation (inteq), solved and absolutely normalised.
+
+Method (Nystrom).  Put v -> v / r in eq. (inteq):
+
+    P(0, v) = r^-2 int_0^inf du u G_g(v / r, u) P(0, u),
+
+so the unknown is needed only at quadrature nodes and the kernel is
+evaluated at (v / r, u) exactly, with no interpolation.  The integral is a
+trapezoidal rule, uniform in
+
+    s = ln u + b u^(1/2):
+
+ln u where the kernel is scale-free (u << 1: there G_g(v, u) du u is a
+function of ln(v / u), analytic in the strip |Im ln(v/u)| < pi / 3, so the
+rule converges like exp(-2 pi^2 / (3 h))), and u^(1/2) where a fast
+particle comes back with its speed spread by ~ 2 u^(1/2), so the spacing
+keeps pace with the kernel's width.  Below the lowest node u_0 the power
+law of eq. (asym1), P = P(0, u_0) (u / u_0)^-beta with beta from
+eq. (asym2), is built in: the rule's nodes continue below u_0, their sum is
+done directly for 25 e-folds and in closed form (a geometric series, with
+the u -> 0 form of the kernel) beyond.  Above the highest node P(0, v) is
+below exp(-36) of its value at v = 20 (from q(r) of eqs. (asym4), (asym6)),
+and is dropped.
+
+The discrete operator is positive; its eigenvalue nearest 1 belongs to the
+solution.  It is found by inverse iteration on (A - 1), with the unknowns
+scaled by exp(-q v) so that values spanning hundreds of decades at small r
+keep their relative digits.  How far that eigenvalue is from 1 is one
+measure of the discretisation error.
+
+Normalisation, eq. (normalization), from the momentum balance: Ito's
+formula for v + t (dv = -dt + noise between collisions, v -> -r v at a
+collision) gives, in the steady state, 1 = (1 + r) I <v_in>, i.e.
+
+    M_2 = int_0^inf v^2 P(0, v) dv = r / (1 + r).                 (momentum)
+
+The energy balance, Ito on v^2/2 + x (dE = dt + noise, E loses
+(1 - r^2) v_in^2 / 2 at a collision), is an independent check:
+
+    M_3 = 2 r^2 / (1 - r^2).                                         (energy)
+
+Time averages from Ito's formula on x v, x^2 v, x v^3, v^3 and v^5 (no jump
+where the function vanishes at x = 0; a jump (1 + r^n) v_in^n in v^n):
+
+    I = M_1,   <x> = <v^2> = (1 + r^3) M_4 / (3 r^3),
+    <x^2> = (2/3) <v^4>,   <v^4> = (1 + r^5) M_6 / (5 r^5) - 8 <x>.
+
+I is infinite where beta >= 2 (r <= r_c).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import linalg, special
+
+from .asymptotics import large_speed_decay_rate, small_speed_exponent
+from .kernel import kernel_small_u_limit, return_speed_kernel_matrix
+
+# the modules whose code decides the solver's numbers
+SOURCES = ("asymptotics", "kernel", "solver")
+
+DEFAULT_STEP = 0.25  # trapezoidal step in s; ~1e-11 relative error at r = 1/2, 1/3
+SQRT_WEIGHT = 1.0  # b in s = ln u + b u^(1/2)
+TAIL_EFOLDS = 25.0  # lower tail summed node by node over this many e-folds of u
+DROP_EFOLDS = 36.0  # P(0, v_max) ~ exp(-36) P(0, 20)
+UNDERFLOW_EFOLDS = 700.0  # exp(-700) ~ 1e-304 is still a normal double
+
+
+def speed_of_coordinate(s, b=SQRT_WEIGHT):
+    """u(s) for s = ln u + b u^(1/2), through the Lambert W function."""
+    w = (2.0 / b) * special.lambertw(0.5 * b * np.exp(0.5 * np.asarray(s, dtype=float))).real
+    return w * w
+
+
+def coordinate_of_speed(u, b=SQRT_WEIGHT):
+    u = np.asarray(u, dtype=float)
+    return np.log(u) + b * np.sqrt(u)
+
+
+def _jacobian(u, b=SQRT_WEIGHT):
+    """du / ds."""
+    return u / (1.0 + 0.5 * b * np.sqrt(u))
+
+
+def default_lowest_speed(beta: float) -> float:
+    """Lowest node.  Corrections to the built-in power law are ~ u_0^(1/2) relative; the
+    error they cause at v >= 1e-3 grows as beta -> 5/2 (r -> 0), where the
+    tail carries more weight, so the lowest node goes deeper there."""
+    return 1e-12 if beta < 2.0 else 1e-20
+
+
+def default_highest_speed(restitution: float) -> float:
+    """Highest node: P(0, v) has fallen by exp(-36) from v = 20, and stays above the
+    double-precision range (q v < 700; at r < 0.016 this cap, not the exp(-36), decides)."""
+    q = large_speed_decay_rate(restitution)
+    return min(max(60.0, 20.0 + DROP_EFOLDS / q), UNDERFLOW_EFOLDS / q)
+
+
+@dataclass(frozen=True)
+class OutgoingSpeedSolution:
+    """P(0, v) on the outgoing side at the solver's nodes, with what is needed to evaluate it anywhere."""
+
+    restitution: float
+    small_speed_exponent: float
+    step: float
+    speeds: np.ndarray  # nodes u_j
+    density: np.ndarray  # P(0, u_j), absolutely normalised
+    eigenvalue: float  # of the discrete operator, 1 in the continuum limit
+
+    @property
+    def quadrature_weights(self):
+        """w_j with int f(u) du ~ sum_j w_j f(u_j) (plus the lower tail)."""
+        return self.step * _jacobian(self.speeds)
+
+    def _tail_speeds(self):
+        count = int(np.ceil(TAIL_EFOLDS / self.step))
+        s0 = coordinate_of_speed(self.speeds[0])
+        return speed_of_coordinate(s0 - self.step * np.arange(1, count + 1)), count
+
+    def _rows(self, incoming):
+        """Rows of r^2 x the operator: int du u G_g(V, u) P(u) = rows @ P for V = incoming."""
+        u = self.speeds
+        rows = return_speed_kernel_matrix(incoming, u) * (self.quadrature_weights * u)
+        tail_u, count = self._tail_speeds()
+        beta = self.small_speed_exponent
+        tail_weights = self.step * _jacobian(tail_u) * tail_u * (tail_u / u[0]) ** -beta
+        tail = return_speed_kernel_matrix(incoming, tail_u) @ tail_weights
+        # beyond the last tail node, G(V, u) = kernel_small_u_limit (relative error ~ u / V)
+        alpha = 2.5 - beta
+        remainder = (
+            self.step
+            * kernel_small_u_limit(incoming, 1.0)
+            * u[0] ** 2.5
+            * np.exp(-alpha * (count + 1) * self.step)
+            / -np.expm1(-alpha * self.step)
+        )
+        rows[:, 0] += tail + remainder
+        return rows
+
+    def outgoing_speed_density(self, v):
+        """P(0, v) anywhere, by the Nystrom formula: r^-2 int du u G_g(v / r, u) P(0, u)."""
+        v = np.asarray(v, dtype=float)
+        r = self.restitution
+        flat = self._rows(np.ascontiguousarray(v.ravel()) / r) @ self.density / (r * r)
+        return flat.reshape(v.shape)
+
+    def moment(self, k: float) -> float:
+        """M_k = int_0^inf v^k P(0, v) dv on the outgoing side (inf where it diverges at v -> 0)."""
+        u = self.speeds
+        main = np.sum(self.quadrature_weights * u**k * self.density)
+        exponent = k + 1.0 - self.small_speed_exponent
+        if exponent <= 0.0:
+            return np.inf
+        # the rule's nodes below u_0, summed in closed form (du/ds = u there)
+        tail = self.step * self.density[0] * u[0] ** (k + 1.0) / np.expm1(exponent * self.step)
+        return float(main + tail)
+
+
+def solve_outgoing_speed_density(restitution, step=DEFAULT_STEP, lowest_speed=None, highest_speed=None):
+    """Solve eq. (inteq) for P(0, v), v > 0, normalised by the momentum balance M_2 = r / (1 + r)."""
+    r = float(restitution)
+    if not 0.0 < r < 1.0:
+        raise ValueError(f"restitution must lie in (0, 1), got {restitution}")
+    if not step > 0.0:
+        raise ValueError(f"quadrature step must be positive, got {step}")
+    beta = small_speed_exponent(r)
+    lowest = default_lowest_speed(beta) if lowest_speed is None else float(lowest_speed)
+    highest = default_highest_speed(r) if highest_speed is None else float(highest_speed)
+    s_lo, s_hi = coordinate_of_speed(lowest), coordinate_of_speed(highest)
+    count = int(np.floor((s_hi - s_lo) / step)) + 1  # last node <= highest
+    speeds = speed_of_coordinate(s_lo + step * np.arange(count))
+    draft = OutgoingSpeedSolution(r, beta, step, speeds, np.ones(count), 1.0)
+    operator = draft._rows(speeds / r) / (r * r)
+    # unknowns y = P / scale: keeps relative digits where P spans many decades
+    q = large_speed_decay_rate(r)
+    scale = np.exp(-q * speeds)
+    scaled = operator * np.exp(q * (speeds[:, None] - speeds[None, :]))
+    factors = linalg.lu_factor(scaled - np.eye(count), check_finite=False)
+    y = np.ones(count)
+    for _ in range(3):
+        y = linalg.lu_solve(factors, y, check_finite=False)
+        y /= y[np.argmax(np.abs(y))]
+    image = scaled @ y
+    eigenvalue = float(np.dot(image, y) / np.dot(y, y))
+    density = y * scale
+    unnormalised = OutgoingSpeedSolution(r, beta, step, speeds, density, eigenvalue)
+    norm = (r / (1.0 + r)) / unnormalised.moment(2)
+    return OutgoingSpeedSolution(r, beta, step, speeds, density * norm, eigenvalue)
+
+
+def momentum_balance_residual(solution) -> float:
+    r = solution.restitution
+    return solution.moment(2) / (r / (1.0 + r)) - 1.0
+
+
+def energy_balance_residual(solution) -> float:
+    r = solution.restitution
+    return solution.moment(3) / (2.0 * r * r / (1.0 - r * r)) - 1.0
+
+
+def time_averages(solution) -> dict:
+    """<x>, Delta x and the collision rate I from the moments of P(0, v) (Ito identities above)."""
+    r = solution.restitution
+    mean_x = (1.0 + r**3) * solution.moment(4) / (3.0 * r**3)
+    fourth_speed = (1.0 + r**5) * solution.moment(6) / (5.0 * r**5) - 8.0 * mean_x
+    mean_x_squared = 2.0 / 3.0 * fourth_speed
+    return {
+        "mean_x": mean_x,
+        "delta_x": float(np.sqrt(mean_x_squared - mean_x**2)),
+        "collision_rate": solution.moment(1),
+    }
