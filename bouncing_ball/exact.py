@@ -142,3 +142,69 @@ def position_moments(restitution) -> dict:
         "delta_x": np.sqrt(second / norm - mean_x**2),
         "collision_rate": rate,
     }
+
+
+def weight_function(force, restitution):
+    """w(F) of eq. (weightfunc2) with the constants of eq. (constants)."""
+    force = np.asarray(force, dtype=float)
+    a = normalization_constant(restitution)
+    z = 1.0 / (12.0 * force)
+    if _which(restitution) == Fraction(1, 2):
+        return 0.5 * a * force**-0.5 * np.exp(-z)
+    return np.sqrt(2.0 / (27.0 * np.pi)) * a * force**-0.5 * special.kve(1.0 / 6.0, z) * np.exp(-z)
+
+
+def _distribution_integrand(log_force, x, v, restitution):
+    # e^{-v/2} w(F) e^{-F x} psi_{1/4,F}(-v) F, eqs. (fpsol), (psi); dF = F d(ln F)
+    f = np.exp(log_force)
+    argument = -(f ** (1.0 / 3.0)) * v + 0.25 * f ** (-2.0 / 3.0)
+    airy = special.airy(argument)[0]
+    return np.exp(-0.5 * v - f * x) * weight_function(f, restitution) * f ** (-1.0 / 6.0) * airy * f
+
+
+def distribution(x, v, restitution):
+    """P(x, v) of eqs. (fpsol), (psi), (weightfunc2), by integration over F.
+
+    At x = 0 the F integral of the outgoing side converges only
+    conditionally; there P(0, v) is eq. (P(0,v)) for v > 0 and the boundary
+    condition eq. (bc), P(0, -v) = r^2 P(0, r v), for v < 0.
+    """
+    x, v = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(v, dtype=float))
+    out = np.empty(x.shape)
+    r = float(_which(restitution))
+    for index in np.ndindex(x.shape):
+        xi, vi = float(x[index]), float(v[index])
+        if xi == 0.0:
+            if vi > 0.0:
+                out[index] = outgoing_speed_density(vi, restitution)
+            elif vi < 0.0:
+                out[index] = r * r * outgoing_speed_density(-r * vi, restitution)
+            else:
+                out[index] = np.inf
+            continue
+        # the weight w(F) vanishes like e^{-1/(6F)} at small F; e^{-F x} cuts large F
+        upper = np.log(60.0 / xi)
+        value, _ = integrate.quad(
+            _distribution_integrand,
+            -6.0,
+            upper,
+            args=(xi, vi, restitution),
+            limit=2000,
+            epsabs=0.0,
+            epsrel=1e-10,
+        )
+        out[index] = value
+    return out
+
+
+def mean_speed_squared_given_position(x, restitution):
+    """<v^2>_x = P(x)^-1 int_x^inf P(x') dx', eq. (moment2)."""
+    x = np.asarray(x, dtype=float)
+    if _which(restitution) == Fraction(1, 2):
+        u = np.sqrt(2.0 * x / 3.0)
+        return u * special.k1(u) / (special.k0(u) / 3.0)
+
+    def tail(xi):
+        return integrate.quad(_position_density_third, xi, np.inf, epsrel=1e-11, limit=400)[0]
+
+    return np.vectorize(tail)(x) / position_density(x, restitution)

@@ -1,0 +1,79 @@
+"""The exact r = 1/2 and 1/3 solutions: w(F), P(x, v), and the identities they must obey."""
+
+import warnings
+from fractions import Fraction
+
+import numpy as np
+import pytest
+from scipy import integrate
+
+from bouncing_ball import exact
+
+EXACT = [Fraction(1, 2), Fraction(1, 3)]
+
+
+@pytest.mark.parametrize("r", EXACT, ids=str)
+def test_weight_function_normalised(r):
+    """eq. (normalization2): int dF F^(-3/2) w(F) exp(-1/(12F)) = 1 with w of eq. (weightfunc2)."""
+
+    def integrand(log_f):
+        f = np.exp(log_f)
+        return f**-0.5 * exact.weight_function(f, r) * np.exp(-1.0 / (12.0 * f))
+
+    value, _ = integrate.quad(integrand, -10.0, 40.0, limit=400, epsrel=1e-12)
+    assert value == pytest.approx(1.0, rel=1e-10)
+
+
+@pytest.mark.parametrize("r", EXACT, ids=str)
+@pytest.mark.parametrize("x", [0.05, 3.0])
+def test_position_density_from_weight_function(r, x):
+    """eq. (P(x)1) with w of eq. (weightfunc2) gives eq. (P(x)2)."""
+
+    def integrand(log_f):
+        f = np.exp(log_f)
+        return f * f**-0.5 * exact.weight_function(f, r) * np.exp(-1.0 / (12.0 * f) - f * x)
+
+    value, _ = integrate.quad(integrand, -10.0, np.log(80.0 / x), limit=400, epsrel=1e-12)
+    assert value == pytest.approx(float(exact.position_density(x, r)), rel=1e-9)
+
+
+def _speed_moments(x, r):
+    """int v^n P(x, v) dv for n = 0, 1, 2 on a composite Gauss-Legendre grid in v."""
+    nodes, weights = np.polynomial.legendre.leggauss(24)
+    edges = [-80.0, -30.0, -10.0, -3.0, -1.0, 0.0, 1.0, 3.0, 7.0, 14.0, 26.0]
+    v = np.concatenate([0.5 * (b - a) * nodes + 0.5 * (b + a) for a, b in zip(edges[:-1], edges[1:])])
+    w = np.concatenate([0.5 * (b - a) * weights for a, b in zip(edges[:-1], edges[1:])])
+    with warnings.catch_warnings():
+        # far out on the outgoing side the F integral cancels to e^{-v/2}; its error there is negligible
+        warnings.simplefilter("ignore", integrate.IntegrationWarning)
+        p = exact.distribution(x, v, r)
+    return [float(np.sum(w * v**n * p)) for n in (0, 1, 2)], float(np.sum(w * np.abs(v) * p))
+
+
+@pytest.mark.parametrize("r", EXACT, ids=str)
+@pytest.mark.parametrize("x", [0.1, 1.0])
+def test_distribution_obeys_moment_identities(r, x):
+    """P(x, v) of eqs. (fpsol), (psi) integrates to P(x), has <v>_x = 0, eq. (moment1),
+    and <v^2>_x of eq. (moment2)."""
+    (zeroth, first, second), absolute_first = _speed_moments(x, r)
+    px = float(exact.position_density(x, r))
+    assert zeroth == pytest.approx(px, rel=1e-6)
+    assert abs(first) <= 1e-6 * absolute_first
+    assert second / zeroth == pytest.approx(float(exact.mean_speed_squared_given_position(x, r)), rel=1e-6)
+
+
+@pytest.mark.parametrize("r", EXACT, ids=str)
+def test_distribution_tends_to_boundary_values(r):
+    """As x -> 0, P(x, v) tends to eq. (P(0,v)) for v > 0 and to eq. (bc) for v < 0."""
+    v = np.array([-3.0, -1.0, 1.0, 3.0])
+    at_zero = exact.distribution(0.0, v, r)
+    errors = [np.max(np.abs(exact.distribution(x, v, r) / at_zero - 1.0)) for x in (1e-3, 1e-5)]
+    assert errors[1] < errors[0] and errors[1] < 0.02, errors
+
+
+def test_mean_speed_squared_agrees_between_forms():
+    # r = 1/2 has the closed form u K1(u) / P(x); the r = 1/3 route (quadrature) must agree with it
+    x = np.array([0.01, 1.0, 10.0])
+    closed = exact.mean_speed_squared_given_position(x, Fraction(1, 2))
+    tail = [integrate.quad(lambda y: float(exact.position_density(y, 0.5)), xi, np.inf)[0] for xi in x]
+    np.testing.assert_allclose(closed, np.array(tail) / exact.position_density(x, 0.5), rtol=1e-9)

@@ -1,0 +1,88 @@
+"""The solver of eq. (inteq) against the exact solutions and the exact identities."""
+
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from bouncing_ball import exact, solver
+from bouncing_ball.asymptotics import small_speed_exponent
+
+# eq. (xandDeltax) in closed form
+PAPER = {
+    Fraction(1, 2): {"mean_x": 6.0, "delta_x": 6.0 * np.sqrt(3.0), "collision_rate": 1.0 / 3.0},
+    Fraction(1, 3): {"mean_x": 35.0 / 9.0, "delta_x": np.sqrt(4781.0) / 9.0, "collision_rate": 0.75},
+}
+SPEEDS = np.geomspace(1e-3, 20.0, 400)
+
+
+@pytest.fixture(scope="module", params=list(PAPER), ids=str)
+def exact_case(request):
+    r = request.param
+    return r, solver.solve_outgoing_speed_density(float(r))
+
+
+def test_matches_exact_outgoing_speed_density(exact_case):
+    """eq. (P(0,v)) with eq. (constants): relative error <= 1e-8 for v in [1e-3, 20]."""
+    r, solution = exact_case
+    relative = solution.outgoing_speed_density(SPEEDS) / exact.outgoing_speed_density(SPEEDS, r) - 1.0
+    assert np.max(np.abs(relative)) <= 1e-8
+    # also at the nodes themselves, over the whole grid where P is a normal number
+    nodes = solution.speeds[(solution.speeds >= 1e-10) & (solution.speeds <= 40.0)]
+    exact_at_nodes = exact.outgoing_speed_density(nodes, r)
+    at_nodes = np.interp(np.log(nodes), np.log(solution.speeds), solution.density)
+    assert np.max(np.abs(at_nodes / exact_at_nodes - 1.0)) <= 1e-8
+
+
+@pytest.mark.parametrize("quantity", ["mean_x", "delta_x", "collision_rate"])
+def test_time_averages_match_paper(exact_case, quantity):
+    r, solution = exact_case
+    assert solver.time_averages(solution)[quantity] == pytest.approx(PAPER[r][quantity], rel=1e-8)
+
+
+@pytest.mark.parametrize("r", [0.2, 0.4, 0.6, 0.8])
+def test_energy_balance(r):
+    """M_3 = 2 r^2 / (1 - r^2); the solver normalises with M_2 = r / (1 + r), so this is a check."""
+    solution = solver.solve_outgoing_speed_density(r)
+    assert solver.momentum_balance_residual(solution) == pytest.approx(0.0, abs=1e-12)
+    assert abs(solver.energy_balance_residual(solution)) <= 1e-8
+
+
+@pytest.mark.parametrize("r", [0.05, 0.1, 0.25, 0.75, 0.9])
+def test_converged_in_its_settings(r):
+    """Any r: a finer step, a deeper lowest node and a higher top change P(0, v) by < 1e-8."""
+    default = solver.solve_outgoing_speed_density(r)
+    q = solver.large_speed_decay_rate(r)
+    fine = solver.solve_outgoing_speed_density(
+        r,
+        step=0.18,
+        lowest_speed=1e-4 * default.speeds[0],
+        highest_speed=min(1.3 * default.speeds[-1], 690.0 / q),
+    )
+    relative = default.outgoing_speed_density(SPEEDS) / fine.outgoing_speed_density(SPEEDS) - 1.0
+    assert np.max(np.abs(relative)) <= 1e-8
+    assert abs(default.eigenvalue - 1.0) <= 1e-9
+
+
+@pytest.mark.parametrize("r", [0.25, 0.75])
+def test_small_speed_power_law(r):
+    """The local log-slope of P(0, v) tends to -beta of eq. (asym2) as v -> 0."""
+    solution = solver.solve_outgoing_speed_density(r)
+    v = np.array([1e-8, 1e-6, 1e-4])
+    slope = np.log(solution.outgoing_speed_density(1.01 * v) / solution.outgoing_speed_density(v)) / np.log(1.01)
+    beta = small_speed_exponent(r)
+    deviation = np.abs(slope + beta)
+    assert deviation[0] < 1e-3 and np.all(np.diff(deviation) > 0), f"slopes {slope}, beta {beta}"
+
+
+def test_collision_rate_infinite_at_and_below_critical():
+    solution = solver.solve_outgoing_speed_density(0.1)  # r_c = 0.163
+    assert solution.small_speed_exponent > 2.0
+    assert np.isinf(solver.time_averages(solution)["collision_rate"])
+    assert abs(solver.energy_balance_residual(solution)) <= 1e-8
+
+
+@pytest.mark.parametrize("bad", [0.0, 1.0, -0.5, 1.5])
+def test_refuses_restitution_outside_unit_interval(bad):
+    with pytest.raises(ValueError, match="restitution"):
+        solver.solve_outgoing_speed_density(bad)
