@@ -19,19 +19,37 @@ wildcard_constraints:
 localrules:
     all,
     simulation,
+    solver,
+    exact,
 
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/simulation.smk"
+include: "workflow/rules/solver.smk"
+include: "workflow/rules/exact.smk"
 
 
 rule all:
     default_target: True
     input:
         simulation_targets(),
+        solver_targets(),
+        exact_targets(),
 
 
 # stage target: every simulated r, merged
 rule simulation:
     input:
         simulation_targets(),
+
+
+# stage target: the solver at every r of the config
+rule solver:
+    input:
+        solver_targets(),
+
+
+# stage target: the exact solutions at r = 1/2 and 1/3
+rule exact:
+    input:
+        exact_targets(),

@@ -9,8 +9,11 @@ is asked for as a target.
 
 from fractions import Fraction
 
+import numpy as np
+
 from .bins import LogBins
 from .restitution import parse_restitution, restitution_grid, restitution_label
+
 
 def check_config(config: dict) -> dict[str, Fraction]:
     """Raise ValueError naming the key if the config is inconsistent; return the r grid."""
@@ -22,6 +25,17 @@ def check_config(config: dict) -> dict[str, Fraction]:
             raise ValueError(
                 f"simulation.{name}: lo = {bins['lo']} must be smaller than hi = {bins['hi']}"
             )
+    for name, positive in (
+        ("solver.output_speeds", True),
+        ("exact.speeds", False),
+        ("exact.position_grid", True),
+    ):
+        section, key = name.split(".")
+        points = config[section][key]
+        if not points["min"] < points["max"]:
+            raise ValueError(f"{name}: min = {points['min']} must be smaller than max = {points['max']}")
+        if positive and not points["min"] > 0:
+            raise ValueError(f"{name}: min = {points['min']} must be positive (the grid is logarithmic)")
     seen = {}
     for key in simulation.get("per_restitution", {}):
         where = f"simulation.per_restitution.{key}"
@@ -66,6 +80,14 @@ def shard_settings(config: dict, label: str) -> dict:
 
 def shard_count(config: dict, label: str) -> int:
     return int(simulation_settings(config, label)["shards"])
+
+
+def log_grid(spec: dict):
+    return np.geomspace(float(spec["min"]), float(spec["max"]), int(spec["points"]))
+
+
+def linear_grid(spec: dict):
+    return np.linspace(float(spec["min"]), float(spec["max"]), int(spec["points"]))
 
 
 def log_bins(spec: dict) -> LogBins:

@@ -1,5 +1,5 @@
 # Helpers for every stage: r labels and exact values, per-r settings, shard lists, targets.
-from bouncing_ball import histograms, simulation, source_digest
+from bouncing_ball import exact, histograms, simulation, solver, source_digest
 from bouncing_ball.config import check_config, shard_count, shard_settings
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 
@@ -11,6 +11,11 @@ except ValueError as error:
 # passed as params: an edit of a stage's library code re-runs that stage only
 SIMULATION_CODE = source_digest(simulation.SOURCES)
 MERGE_CODE = source_digest(histograms.SOURCES)
+SOLVER_CODE = source_digest(solver.SOURCES)
+EXACT_CODE = source_digest(("exact",))
+
+# the r values with an exact solution, eq. (P(0,v)): always computed (Figs. 3 and 5)
+EXACT_LABELS = [restitution_label(value) for value in exact.EXACT_RESTITUTIONS]
 
 
 def restitution_value(wildcards):
@@ -43,4 +48,22 @@ def simulation_targets():
         "results/simulation/r{r}/{table}.parquet",
         r=RESTITUTION,
         table=("p0v", "position", "summary"),
+    )
+
+
+def exact_settings(wildcards):
+    return {"output_speeds": config["solver"]["output_speeds"], **config["exact"]}
+
+
+def solver_targets():
+    return expand(
+        "results/solver/r{r}/{table}.parquet", r=RESTITUTION, table=("p0v", "summary")
+    )
+
+
+def exact_targets():
+    return expand(
+        "results/exact/r{r}/{table}.parquet",
+        r=EXACT_LABELS,
+        table=("p0v", "distribution", "position", "summary"),
     )

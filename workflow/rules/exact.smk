@@ -1,0 +1,24 @@
+# The exact solutions at r = 1/2 and 1/3: P(0,v), P(x,v) of Fig. 3, P(x), <v^2>_x and the moments.
+
+
+rule exact_solution:
+    output:
+        p0v="results/exact/r{r}/p0v.parquet",
+        distribution="results/exact/r{r}/distribution.parquet",
+        position="results/exact/r{r}/position.parquet",
+        summary="results/exact/r{r}/summary.parquet",
+    log:
+        "logs/exact/r{r}.log",
+    wildcard_constraints:
+        r="|".join(EXACT_LABELS),
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=10,
+        mem_mb=500,
+    params:
+        restitution=restitution_value,
+        settings=exact_settings,
+        code=EXACT_CODE,
+    script:
+        "../../scripts/exact_solution.py"
