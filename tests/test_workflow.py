@@ -27,6 +27,12 @@ SMALL = {
         "position_bins": {"lo": 1.0e-3, "hi": 1.0e3, "per_decade": 5},
         "per_restitution": {"1/3": {"shards": 2}},
     },
+    "solver": {"quadrature_step": 0.25, "output_speeds": {"min": 1.0e-4, "max": 50, "points": 41}},
+    "exact": {
+        "positions": [0, 0.1],
+        "speeds": {"min": -2, "max": 3, "points": 6},
+        "position_grid": {"min": 1.0e-3, "max": 100, "points": 6},
+    },
 }
 
 pytestmark = pytest.mark.workflow
@@ -80,6 +86,21 @@ def test_run_produces_the_documented_tables(finished_run):
     _, provenance = read_table(finished_run / "results/simulation/r0.333333/shard0.parquet")
     assert provenance["r"] == "1/3" and provenance["seed"] == 5
     assert (finished_run / "logs/simulation/r0.5/merge.log").read_text().startswith("r=0.5")
+    for label in ("0.5", "0.333333"):
+        p0v, provenance = read_table(finished_run / f"results/solver/r{label}/p0v.parquet")
+        assert list(p0v.columns) == ["v", "p0v"] and len(p0v) == 41
+        assert provenance["r_label"] == label
+        summary, _ = read_table(finished_run / f"results/solver/r{label}/summary.parquet")
+        for column in ("r", "mean_x", "delta_x", "collision_rate", "momentum_balance_residual",
+                       "energy_balance_residual", "grid_size", "accuracy_estimate"):
+            assert column in summary.columns
+        assert summary.accuracy_estimate.iloc[0] < 1e-8
+        distribution, _ = read_table(finished_run / f"results/exact/r{label}/distribution.parquet")
+        assert list(distribution.columns) == ["x", "v", "pxv"] and len(distribution) == 12
+        for table in ("p0v", "position", "summary"):
+            assert (finished_run / f"results/exact/r{label}/{table}.parquet").exists()
+    solved, _ = read_table(finished_run / "results/solver/r0.5/summary.parquet")
+    assert solved.mean_x.iloc[0] == pytest.approx(6.0, rel=1e-8)
 
 
 def test_second_run_has_nothing_to_do(finished_run):
@@ -95,6 +116,15 @@ def test_an_r_not_in_the_config_is_a_valid_target(finished_run):
     summary = pd.read_parquet(finished_run / target)
     assert summary.r.iloc[0] == pytest.approx(0.6)
     assert summary.shards.iloc[0] == 3
+    solved = "results/solver/r0.6/summary.parquet"
+    result = snakemake(finished_run, solved)
+    assert result.returncode == 0, result.stderr[-3000:]
+    assert pd.read_parquet(finished_run / solved).r.iloc[0] == pytest.approx(0.6)
+
+
+def test_exact_solutions_exist_only_for_one_half_and_one_third(finished_run):
+    result = snakemake(finished_run, "--dry-run", "results/exact/r0.6/summary.parquet")
+    assert result.returncode != 0
 
 
 def planned_jobs(directory, env=None):
@@ -140,6 +170,14 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
     with open(package / "free_flight.py", "a") as handle:
         handle.write("\n# an edit\n")
     assert planned_jobs(finished_run, env) == {"simulate_shard": 5, "merge_shards": 2, "all": 1}
+    shutil.rmtree(package.parent)
+    package, env = _package_copy(tmp_path)
+    with open(package / "kernel.py", "a") as handle:
+        handle.write("\n# an edit\n")
+    assert planned_jobs(finished_run, env) == {"solve": 2, "all": 1}
+    with open(package / "exact.py", "a") as handle:
+        handle.write("\n# an edit\n")
+    assert planned_jobs(finished_run, env) == {"solve": 2, "exact_solution": 2, "all": 1}
 
 
 def test_results_do_not_depend_on_cores(finished_run, tmp_path):
@@ -189,6 +227,12 @@ BAD = [
     (_with(["simulation", "shardz"], 4), "'shardz' was unexpected"),
     (_with(["sead"], 4), "'sead' was unexpected"),
     (_with(["simulation", "per_restitution"], {"2": {"shards": 2}}), "per_restitution.2"),
+    (_with(["solver", "quadrature_step"], 0.0), "quadrature_step"),
+    (_with(["solver", "quadrature_step"], 0.7), "quadrature_step"),
+    (_with(["solver", "output_speeds", "min"], 0.0), "solver.output_speeds: min = 0.0 must be positive"),
+    (_with(["exact", "speeds", "max"], -3), "exact.speeds: min = -2 must be smaller"),
+    (_with(["exact", "positions"], [-0.1]), "positions"),
+    (_with(["solvr"], {}), "'solvr' was unexpected"),
 ]
 
 
@@ -254,3 +298,11 @@ def test_scripts_run_by_hand(tmp_path):
         cwd=REPOSITORY, capture_output=True, text=True, timeout=300,
     )
     assert refused.returncode != 0 and "other.parquet" in refused.stderr
+    solved = {name: tmp_path / f"solver_{name}.parquet" for name in ("p0v", "summary")}
+    subprocess.run(
+        [sys.executable, "scripts/solve.py", "--restitution", "0.6",
+         *[f"--{name}={path}" for name, path in solved.items()]],
+        cwd=REPOSITORY, check=True, capture_output=True, timeout=300,
+    )
+    summary, provenance = read_table(solved["summary"])
+    assert provenance["r"] == "3/5" and abs(summary.energy_balance_residual.iloc[0]) < 1e-8
