@@ -162,39 +162,59 @@ def _distribution_integrand(log_force, x, v, restitution):
     return np.exp(-0.5 * v - f * x) * weight_function(f, restitution) * f ** (-1.0 / 6.0) * airy * f
 
 
-def distribution(x, v, restitution):
-    """P(x, v) of eqs. (fpsol), (psi), (weightfunc2), by integration over F.
+def distribution_by_force_integral(x, v, restitution):
+    """P(x, v) of eqs. (fpsol), (psi), (weightfunc2) by integration over F, and quad's error estimate.
 
-    At x = 0 the F integral of the outgoing side converges only
-    conditionally; there P(0, v) is eq. (P(0,v)) for v > 0 and the boundary
-    condition eq. (bc), P(0, -v) = r^2 P(0, r v), for v < 0.
+    Converges absolutely for x > 0, and for x = 0 on the incoming side v < 0
+    (there the Airy function decays); at x = 0, v > 0 only conditionally.
+    Returns (value, estimated absolute error).
+    """
+    xi, vi = float(x), float(v)
+    if xi < 0.0 or (xi == 0.0 and vi >= 0.0):
+        raise ValueError(f"the F integral of eq. (fpsol) needs x > 0, or x = 0 with v < 0 (x = {x}, v = {v})")
+    # w(F) vanishes like e^{-1/(6F)} at small F; e^{-F x} cuts large F (at x = 0, v < 0 the
+    # Airy factor ~ exp(-(2/3) F^(1/2) |v|^(3/2)) does)
+    upper = np.log(60.0 / xi) if xi > 0.0 else np.log((90.0 / abs(vi) ** 1.5) ** 2 + 1.0)
+    value, error, *_ = integrate.quad(
+        _distribution_integrand,
+        -6.0,
+        upper,
+        args=(xi, vi, restitution),
+        limit=2000,
+        epsabs=0.0,
+        epsrel=1e-10,
+        full_output=1,
+    )
+    return value, error
+
+
+def distribution_with_error(x, v, restitution):
+    """P(x, v) and an estimate of its absolute error, for broadcast arrays x >= 0 and v.
+
+    At x = 0 the outgoing side is eq. (P(0,v)) and the incoming side the
+    boundary condition eq. (bc), P(0, -v) = r^2 P(0, r v) (the F integral
+    converges only conditionally there); P(0, 0) diverges and is NaN.
     """
     x, v = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(v, dtype=float))
-    out = np.empty(x.shape)
+    values, errors = np.empty(x.shape), np.zeros(x.shape)
     r = float(_which(restitution))
     for index in np.ndindex(x.shape):
         xi, vi = float(x[index]), float(v[index])
         if xi == 0.0:
             if vi > 0.0:
-                out[index] = outgoing_speed_density(vi, restitution)
+                values[index] = outgoing_speed_density(vi, restitution)
             elif vi < 0.0:
-                out[index] = r * r * outgoing_speed_density(-r * vi, restitution)
+                values[index] = r * r * outgoing_speed_density(-r * vi, restitution)
             else:
-                out[index] = np.inf
+                values[index] = np.nan
             continue
-        # the weight w(F) vanishes like e^{-1/(6F)} at small F; e^{-F x} cuts large F
-        upper = np.log(60.0 / xi)
-        value, _ = integrate.quad(
-            _distribution_integrand,
-            -6.0,
-            upper,
-            args=(xi, vi, restitution),
-            limit=2000,
-            epsabs=0.0,
-            epsrel=1e-10,
-        )
-        out[index] = value
-    return out
+        values[index], errors[index] = distribution_by_force_integral(xi, vi, restitution)
+    return values, errors
+
+
+def distribution(x, v, restitution):
+    """P(x, v), eqs. (fpsol), (psi), (weightfunc2); see ``distribution_with_error``."""
+    return distribution_with_error(x, v, restitution)[0]
 
 
 def mean_speed_squared_given_position(x, restitution):

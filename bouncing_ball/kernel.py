@@ -106,7 +106,7 @@ def kernel_small_u_limit(v, u):
     """Leading form of G_g(v, u) for u << v: (3 / 2 pi) u^(1/2) v^(-5/2) (1 + v) e^(-v/2).
 
     From eq. (kernel3) at u -> 0 (z -> v for every y).  The relative
-    correction is O(u / v).
+    correction is O(u max(1, 1 / v)) (the exponent (v + u) / 2 - z moves by O(u)).
     """
     v = np.asarray(v, dtype=float)
     return 1.5 / np.pi * np.sqrt(u) * v**-2.5 * (1.0 + v) * np.exp(-0.5 * v)

@@ -125,6 +125,21 @@ def test_an_r_not_in_the_config_is_a_valid_target(finished_run):
 def test_exact_solutions_exist_only_for_one_half_and_one_third(finished_run):
     result = snakemake(finished_run, "--dry-run", "results/exact/r0.6/summary.parquet")
     assert result.returncode != 0
+    assert "exact solutions exist only for r0.5 (r = 1/2) and r0.333333 (r = 1/3)" in result.stdout + result.stderr
+
+
+def test_exact_one_third_does_not_need_one_third_in_the_config(finished_run, tmp_path):
+    """rule all always asks for r0.333333: its value is 1/3 exactly, not the label read as a number."""
+    directory = tmp_path / "copy"
+    shutil.copytree(finished_run, directory)
+    config = yaml.safe_load(yaml.safe_dump(SMALL))
+    config["restitution"] = [0.5]
+    (directory / "config" / "config.yaml").write_text(yaml.safe_dump(config))
+    shutil.rmtree(directory / "results" / "exact" / "r0.333333")
+    result = snakemake(directory, "exact")
+    assert result.returncode == 0, result.stderr[-3000:]
+    _, provenance = read_table(directory / "results/exact/r0.333333/summary.parquet")
+    assert provenance["r"] == "1/3"
 
 
 def planned_jobs(directory, env=None):
@@ -170,14 +185,12 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
     with open(package / "free_flight.py", "a") as handle:
         handle.write("\n# an edit\n")
     assert planned_jobs(finished_run, env) == {"simulate_shard": 5, "merge_shards": 2, "all": 1}
-    shutil.rmtree(package.parent)
-    package, env = _package_copy(tmp_path)
-    with open(package / "kernel.py", "a") as handle:
-        handle.write("\n# an edit\n")
-    assert planned_jobs(finished_run, env) == {"solve": 2, "all": 1}
-    with open(package / "exact.py", "a") as handle:
-        handle.write("\n# an edit\n")
-    assert planned_jobs(finished_run, env) == {"solve": 2, "exact_solution": 2, "all": 1}
+    for module, expected in (("kernel", {"solve": 2}), ("solver", {"solve": 2}), ("exact", {"exact_solution": 2})):
+        shutil.rmtree(package.parent)
+        package, env = _package_copy(tmp_path)
+        with open(package / f"{module}.py", "a") as handle:
+            handle.write("\n# an edit\n")
+        assert planned_jobs(finished_run, env) == {**expected, "all": 1}, module
 
 
 def test_results_do_not_depend_on_cores(finished_run, tmp_path):
@@ -227,11 +240,12 @@ BAD = [
     (_with(["simulation", "shardz"], 4), "'shardz' was unexpected"),
     (_with(["sead"], 4), "'sead' was unexpected"),
     (_with(["simulation", "per_restitution"], {"2": {"shards": 2}}), "per_restitution.2"),
-    (_with(["solver", "quadrature_step"], 0.0), "quadrature_step"),
+    (_with(["solver", "quadrature_step"], 0.05), "quadrature_step"),
     (_with(["solver", "quadrature_step"], 0.7), "quadrature_step"),
     (_with(["solver", "output_speeds", "min"], 0.0), "solver.output_speeds: min = 0.0 must be positive"),
     (_with(["exact", "speeds", "max"], -3), "exact.speeds: min = -2 must be smaller"),
     (_with(["exact", "positions"], [-0.1]), "positions"),
+    (_with(["exact", "positions"], [0, 1.0e-5]), "positions"),
     (_with(["solvr"], {}), "'solvr' was unexpected"),
 ]
 

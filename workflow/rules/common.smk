@@ -15,7 +15,8 @@ SOLVER_CODE = source_digest(solver.SOURCES)
 EXACT_CODE = source_digest(("exact",))
 
 # the r values with an exact solution, eq. (P(0,v)): always computed (Figs. 3 and 5)
-EXACT_LABELS = [restitution_label(value) for value in exact.EXACT_RESTITUTIONS]
+EXACT_BY_LABEL = {restitution_label(value): value for value in exact.EXACT_RESTITUTIONS}
+EXACT_LABELS = list(EXACT_BY_LABEL)
 
 
 def restitution_value(wildcards):
@@ -49,6 +50,19 @@ def simulation_targets():
         r=RESTITUTION,
         table=("p0v", "position", "summary"),
     )
+
+
+def exact_value(wildcards):
+    """Exact r of an exact-solution label: 1/2 or 1/3 whatever the config says."""
+    if wildcards.r not in EXACT_BY_LABEL:
+        raise ValueError(
+            f"results/exact/r{wildcards.r}: exact solutions exist only for "
+            + " and ".join(
+                f"r{label} (r = {exact_string(value)})"
+                for label, value in EXACT_BY_LABEL.items()
+            )
+        )
+    return exact_string(EXACT_BY_LABEL[wildcards.r])
 
 
 def exact_settings(wildcards):

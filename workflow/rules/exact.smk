@@ -9,15 +9,13 @@ rule exact_solution:
         summary="results/exact/r{r}/summary.parquet",
     log:
         "logs/exact/r{r}.log",
-    wildcard_constraints:
-        r="|".join(EXACT_LABELS),
     conda:
         "../envs/bouncing-ball.yaml"
     resources:
         runtime=10,
         mem_mb=500,
     params:
-        restitution=restitution_value,
+        restitution=exact_value,
         settings=exact_settings,
         code=EXACT_CODE,
     script:

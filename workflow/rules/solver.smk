@@ -11,7 +11,7 @@ rule solve:
         "../envs/bouncing-ball.yaml"
     resources:
         runtime=5,
-        mem_mb=500,
+        mem_mb=1000,
     params:
         restitution=restitution_value,
         settings=config["solver"],
