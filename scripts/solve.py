@@ -75,7 +75,7 @@ def main(restitution, step, speeds_spec, p0v_path, summary_path):
     write_table(summary, summary_path, provenance)
     row = summary.iloc[0]
     logging.info(
-        "r=%s: %d nodes, solved in %.1f ms; <x> = %.10g, Delta x = %.10g, I = %.10g; "
+        "r=%s: %d nodes, solved in %.1f ms (first call: includes loading the compiled kernel); <x> = %.10g, Delta x = %.10g, I = %.10g; "
         "energy balance residual %.1e, eigenvalue - 1 = %.1e, accuracy estimate %.1e",
         label, row.grid_size, 1e3 * elapsed, row.mean_x, row.delta_x, row.collision_rate,
         row.energy_balance_residual, row.eigenvalue_residual, row.accuracy_estimate,
