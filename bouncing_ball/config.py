@@ -82,6 +82,11 @@ def shard_count(config: dict, label: str) -> int:
     return int(simulation_settings(config, label)["shards"])
 
 
+def exact_settings(config: dict) -> dict:
+    """What the exact-solution stage is run with: its section plus the solver's output speeds."""
+    return {"output_speeds": config["solver"]["output_speeds"], **config["exact"]}
+
+
 def log_grid(spec: dict):
     return np.geomspace(float(spec["min"]), float(spec["max"]), int(spec["points"]))
 

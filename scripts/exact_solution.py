@@ -1,8 +1,8 @@
 """The exact solution at r = 1/2 or 1/3: P(0,v), P(x,v) (Fig. 3), P(x), <v^2>_x, <x>, Delta x, I.
 
 Writes results/exact/r{r}/{p0v,distribution,position,summary}.parquet.
-Run by Snakemake (rule exact_solution), or by hand:
-    python scripts/exact_solution.py --restitution 1/2 --outdir results/exact/r0.5
+Run by Snakemake (rule exact_solution), or by hand with the settings of a config file:
+    python scripts/exact_solution.py --restitution 1/2 --outdir results/exact/r0.5 [--config config/config.yaml]
 """
 
 import argparse
@@ -11,19 +11,12 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import yaml
 
 from bouncing_ball import exact, source_digest
-from bouncing_ball.config import linear_grid, log_grid
+from bouncing_ball.config import check_config, exact_settings, linear_grid, log_grid
 from bouncing_ball.io import write_table
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
-
-DEFAULTS = {
-    "output_speeds": {"min": 1.0e-4, "max": 50.0, "points": 401},
-    "positions": [0.0, 0.001, 0.01, 0.1],
-    "speeds": {"min": -4.0, "max": 6.0, "points": 201},
-    "position_grid": {"min": 1.0e-4, "max": 1.0e3, "points": 141},
-}
-
 
 def distribution_table(positions, speeds, r):
     """P(x, v) for every x in ``positions`` and v in ``speeds`` (long format), and the
@@ -95,11 +88,15 @@ def _command_line():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--restitution", required=True, help="1/2 or 1/3")
     parser.add_argument("--outdir", required=True, type=Path)
+    parser.add_argument("--config", default="config/config.yaml", help="grids from here")
     args = parser.parse_args()
+    with open(args.config) as handle:
+        config = yaml.safe_load(handle)
+    check_config(config)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     args.outdir.mkdir(parents=True, exist_ok=True)
     outputs = {name: args.outdir / f"{name}.parquet" for name in ("p0v", "distribution", "position", "summary")}
-    main(args.restitution, DEFAULTS, outputs)
+    main(args.restitution, exact_settings(config), outputs)
 
 
 if "snakemake" in globals():

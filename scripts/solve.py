@@ -1,8 +1,9 @@
 """Solve eq. (inteq) for P(0, v) at one r, with <x>, Delta x, I and accuracy checks.
 
 Writes results/solver/r{r}/p0v.parquet (v, p0v) and summary.parquet (one row).
-Run by Snakemake (rule solve), or by hand:
-    python scripts/solve.py --restitution 0.6 --p0v p0v.parquet --summary summary.parquet
+Run by Snakemake (rule solve), or by hand with the settings of a config file:
+    python scripts/solve.py --restitution 0.6 --p0v p0v.parquet --summary summary.parquet \
+        [--config config/config.yaml] [--step 0.2]
 """
 
 import argparse
@@ -11,13 +12,13 @@ import time
 
 import numpy as np
 import pandas as pd
+import yaml
 
 from bouncing_ball import source_digest, solver
-from bouncing_ball.config import log_grid
+from bouncing_ball.config import check_config, log_grid
 from bouncing_ball.io import write_table
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 
-DEFAULT_SPEEDS = {"min": 1.0e-4, "max": 50.0, "points": 401}
 # where the accuracy target (1e-8 relative) is stated, independent of the output grid
 CHECKED_SPEEDS = np.geomspace(1e-3, 20.0, 400)
 
@@ -38,13 +39,15 @@ def accuracy_estimate(solution):
     return float(np.max(np.abs(solution.outgoing_speed_density(CHECKED_SPEEDS[usable]) / reference[usable] - 1.0)))
 
 
-def main(restitution, step, speeds_spec, p0v_path, summary_path):
+def main(restitution, settings, p0v_path, summary_path):
+    """Solve at r = ``restitution`` with ``settings`` = config["solver"] and write both tables."""
+    step = settings["quadrature_step"]
     exact = parse_restitution(restitution)
     label = restitution_label(exact)
     started = time.perf_counter()
     solution = solver.solve_outgoing_speed_density(float(exact), step=step)
     elapsed = time.perf_counter() - started
-    speeds = log_grid(speeds_spec)
+    speeds = log_grid(settings["output_speeds"])
     density = solution.outgoing_speed_density(speeds)
     averages = solver.time_averages(solution)
     summary = pd.DataFrame(
@@ -87,20 +90,26 @@ def main(restitution, step, speeds_spec, p0v_path, summary_path):
 def _command_line():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--restitution", required=True)
-    parser.add_argument("--step", type=float, default=solver.DEFAULT_STEP)
     parser.add_argument("--p0v", required=True)
     parser.add_argument("--summary", required=True)
+    parser.add_argument("--config", default="config/config.yaml", help="solver settings from here")
+    parser.add_argument("--step", type=float, help="override the config's solver.quadrature_step")
     args = parser.parse_args()
+    with open(args.config) as handle:
+        config = yaml.safe_load(handle)
+    check_config(config)
+    settings = dict(config["solver"])
+    if args.step is not None:
+        settings["quadrature_step"] = args.step
     logging.basicConfig(level=logging.INFO, format="%(message)s")
-    main(args.restitution, args.step, DEFAULT_SPEEDS, args.p0v, args.summary)
+    main(args.restitution, settings, args.p0v, args.summary)
 
 
 if "snakemake" in globals():
     logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, format="%(message)s")  # noqa: F821
     main(
         snakemake.params.restitution,  # noqa: F821
-        snakemake.params.settings["quadrature_step"],  # noqa: F821
-        snakemake.params.settings["output_speeds"],  # noqa: F821
+        snakemake.params.settings,  # noqa: F821
         snakemake.output.p0v,  # noqa: F821
         snakemake.output.summary,  # noqa: F821
     )

@@ -5,27 +5,17 @@ standard error of <x>, Delta x and I is asserted to be 1% or less before the
 3-sigma comparison is made.  Seeds are fixed, so the outcome is deterministic.
 """
 
-from concurrent.futures import ProcessPoolExecutor
 from fractions import Fraction
 
 import numpy as np
 import pytest
 
+from shard_statistics import outgoing_speed_bins, sign_flip_p_values, simulate_shards
+
 from bouncing_ball import exact
-from bouncing_ball.bins import LogBins
-from bouncing_ball.histograms import (
-    outgoing_speed_density,
-    outgoing_speed_histogram,
-    position_histogram,
-    position_moments_summary,
-)
-from bouncing_ball.restitution import restitution_label
-from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
-from sign_flip import sign_flip_p_values
+from bouncing_ball.histograms import position_histogram, position_moments_summary
 
 SHARDS = 16
-SPEED_BINS = LogBins(1e-4, 1e2, 10)
-POSITION_BINS = LogBins(1e-3, 1e3, 5)
 SHARD_TIME = {Fraction(1, 2): 4.0e5, Fraction(1, 3): 7.0e5}
 SEED = 20061121
 
@@ -36,27 +26,9 @@ PAPER = {
 }
 
 
-def _shard(arguments):
-    r, shard = arguments
-    return simulate_shard(
-        restitution=float(r),
-        seed_sequence=shard_seed_sequence(SEED, restitution_label(r), shard),
-        recorded_time=SHARD_TIME[r],
-        equilibration_time=200.0,
-        criterion_c=5.0,
-        min_step_divisor=500.0,
-        max_steps=10**12,
-        speed_bins=SPEED_BINS,
-        position_bins=POSITION_BINS,
-    )
-
-
 @pytest.fixture(scope="module")
 def shards():
-    jobs = [(r, k) for r in PAPER for k in range(SHARDS)]
-    with ProcessPoolExecutor(2) as pool:
-        results = list(pool.map(_shard, jobs))
-    return {r: [s for (rr, _), s in zip(jobs, results) if rr == r] for r in PAPER}
+    return simulate_shards(SHARD_TIME, SHARDS, SEED)
 
 
 @pytest.mark.parametrize("r", list(PAPER), ids=str)
@@ -84,14 +56,9 @@ def test_outgoing_speed_density_chi_square(shards, r):
     """eq. (P(0,v)) with eq. (constants), no free parameter, for every bin with
     at least 100 collisions: chi^2 per bin and the worst bin, each against its
     sign-flip null distribution, at the 1e-3 level."""
-    table = outgoing_speed_histogram(shards[r])
-    usable = ((table["count"] >= 100) & np.isfinite(table.v_hi) & (table.v_lo > 0)).to_numpy()
-    lower, upper = table.v_lo.to_numpy()[usable], table.v_hi.to_numpy()[usable]
-    per_shard = np.stack(
-        [outgoing_speed_density(s.speed_counts[usable], s.time, lower, upper) for s in shards[r]]
-    )
+    lower, upper, per_shard = outgoing_speed_bins(shards[r])
     deviations = per_shard - exact.outgoing_speed_bin_average(lower, upper, r)
-    assert usable.sum() >= 30, "too few populated bins for a meaningful chi^2"
+    assert len(lower) >= 30, "too few populated bins for a meaningful chi^2"
     chi2_per_dof, p_chi2, p_worst = sign_flip_p_values(deviations)
     assert p_chi2 > 1e-3 and p_worst > 1e-3, (
         f"chi^2/dof = {chi2_per_dof:.3f} (p = {p_chi2:.4f}), worst bin p = {p_worst:.4f}"

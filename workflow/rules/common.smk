@@ -1,6 +1,11 @@
 # Helpers for every stage: r labels and exact values, per-r settings, shard lists, targets.
 from bouncing_ball import exact, histograms, simulation, solver, source_digest
-from bouncing_ball.config import check_config, shard_count, shard_settings
+from bouncing_ball.config import (
+    check_config,
+    exact_settings,
+    shard_count,
+    shard_settings,
+)
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 
 try:
@@ -63,10 +68,6 @@ def exact_value(wildcards):
             )
         )
     return exact_string(EXACT_BY_LABEL[wildcards.r])
-
-
-def exact_settings(wildcards):
-    return {"output_speeds": config["solver"]["output_speeds"], **config["exact"]}
 
 
 def solver_targets():

@@ -16,7 +16,7 @@ rule exact_solution:
         mem_mb=500,
     params:
         restitution=exact_value,
-        settings=exact_settings,
+        settings=exact_settings(config),
         code=EXACT_CODE,
     script:
         "../../scripts/exact_solution.py"
