@@ -21,12 +21,14 @@ localrules:
     simulation,
     solver,
     exact,
+    fits,
 
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/simulation.smk"
 include: "workflow/rules/solver.smk"
 include: "workflow/rules/exact.smk"
+include: "workflow/rules/theory.smk"
 
 
 rule all:
@@ -35,6 +37,8 @@ rule all:
         simulation_targets(),
         solver_targets(),
         exact_targets(),
+        "results/theory/exponents.parquet",
+        fit_targets(),
 
 
 # stage target: every simulated r, merged
@@ -53,3 +57,10 @@ rule solver:
 rule exact:
     input:
         exact_targets(),
+
+
+# stage target: the theory's exponents and the fits at every r of the config
+rule fits:
+    input:
+        "results/theory/exponents.parquet",
+        fit_targets(),

@@ -5,7 +5,10 @@ for v -> infinity, eqs. (asym3)-(asym6).
 """
 
 import numpy as np
+import pandas as pd
 from scipy import optimize
+
+SOURCES = ("asymptotics",)  # what decides the theory table
 
 # eq. (rc): beta(r_c) = 2
 CRITICAL_RESTITUTION = float(np.exp(-np.pi / np.sqrt(3.0)))
@@ -55,3 +58,16 @@ def large_speed_exponent(restitution) -> float:
     half_minus_q = 0.5 - q
     x = 0.5 + 0.5 * np.sqrt(3.0) * half_minus_q / np.sqrt(1.0 - half_minus_q**2)  # eq. (asym5)
     return 1.0 - np.log(r) / np.log(x / r)
+
+
+def exponents_table(restitutions):
+    """beta, m, q of eqs. (asym2)-(asym6) for each r: columns r, beta, m, q."""
+    r = np.asarray(restitutions, dtype=float)
+    return pd.DataFrame(
+        {
+            "r": r,
+            "beta": [small_speed_exponent(x) for x in r],
+            "m": [large_speed_exponent(x) for x in r],
+            "q": [large_speed_decay_rate(x) for x in r],
+        }
+    )

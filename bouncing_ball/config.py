@@ -36,6 +36,16 @@ def check_config(config: dict) -> dict[str, Fraction]:
             raise ValueError(f"{name}: min = {points['min']} must be smaller than max = {points['max']}")
         if positive and not points["min"] > 0:
             raise ValueError(f"{name}: min = {points['min']} must be positive (the grid is logarithmic)")
+    theory_grid = config["theory"]["restitution_grid"]
+    if not 0 < theory_grid["min"] < theory_grid["max"] < 1:
+        raise ValueError(
+            "theory.restitution_grid: need 0 < min < max < 1, "
+            f"got min = {theory_grid['min']}, max = {theory_grid['max']}"
+        )
+    for side in ("small_speed_window", "large_speed_window"):
+        window = config["fits"][side]
+        if window != "auto" and not window["min"] < window["max"]:
+            raise ValueError(f"fits.{side}: min = {window['min']} must be smaller than max = {window['max']}")
     seen = {}
     for key in simulation.get("per_restitution", {}):
         where = f"simulation.per_restitution.{key}"

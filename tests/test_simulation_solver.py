@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from shard_statistics import outgoing_speed_bins, sign_flip_p_values, simulate_shards
 
-from bouncing_ball import solver
-from bouncing_ball.histograms import position_moments_summary
+from bouncing_ball import fits, solver
+from bouncing_ball.histograms import jackknife, outgoing_speed_density, position_moments_summary
 
 SHARDS = 16
 SHARD_TIME = {0.25: 3.0e5, 0.75: 3.0e6}
@@ -58,3 +58,23 @@ def test_detects_a_one_percent_error(shards, solutions, r):
     wrong = 1.01 * solver.outgoing_speed_bin_average(solutions[r], lower, upper)
     _, p_chi2, _ = sign_flip_p_values(per_shard - wrong)
     assert p_chi2 < 1e-3
+
+
+@pytest.mark.parametrize("r", list(SHARD_TIME))
+def test_free_exponent_fits_agree_with_theory(shards, solutions, r):
+    """beta, and m with q, fitted with free exponents in the default windows, contain the
+    theory's eqs. (asym2)-(asym6) in their 95% intervals; the fits have bins to work with."""
+    lower, upper, _ = outgoing_speed_bins(shards[r], minimum_count=50)
+    usable = np.isin(shards[r][0].speed_bins.lower, lower)
+    counts = np.stack([s.speed_counts[usable] for s in shards[r]])
+    times = np.array([s.time for s in shards[r]])
+    _, errors = jackknife(lambda c, t: outgoing_speed_density(c, t, lower, upper), counts, times)
+    reference = solver.outgoing_speed_bin_average(solutions[r], lower, upper)
+    windows = {fits.SMALL_SPEED: "auto", fits.LARGE_SPEED: "auto"}
+    table, problems = fits.asymptotic_fits(lower, upper, counts, times, errors, reference, r, windows)
+    assert problems == []
+    free = table[(table.source == "simulation") & (table.fit == "free_exponents") & (table.parameter != "prefactor")]
+    assert len(free) == 3
+    for row in free.itertuples():
+        assert row.lower_95 <= row.theory <= row.upper_95, row
+        assert row.v_max / row.v_min > 2.0 and row.dof >= 1, row

@@ -33,6 +33,8 @@ SMALL = {
         "speeds": {"min": -2, "max": 3, "points": 6},
         "position_grid": {"min": 1.0e-3, "max": 100, "points": 6},
     },
+    "theory": {"restitution_grid": {"min": 0.1, "max": 0.9, "points": 9}},
+    "fits": {"minimum_count": 5, "max_bias": 0.5, "small_speed_window": "auto", "large_speed_window": "auto"},
 }
 
 pytestmark = pytest.mark.workflow
@@ -101,6 +103,14 @@ def test_run_produces_the_documented_tables(finished_run):
             assert (finished_run / f"results/exact/r{label}/{table}.parquet").exists()
     solved, _ = read_table(finished_run / "results/solver/r0.5/summary.parquet")
     assert solved.mean_x.iloc[0] == pytest.approx(6.0, rel=1e-8)
+    exponents, _ = read_table(finished_run / "results/theory/exponents.parquet")
+    assert list(exponents.columns) == ["r", "beta", "m", "q"] and len(exponents) == 9
+    assert exponents.beta[exponents.r.round(9) == 0.5].iloc[0] == pytest.approx(1.0)
+    for label in ("0.5", "0.333333"):
+        fitted, provenance = read_table(finished_run / f"results/fits/r{label}.parquet")
+        assert list(fitted.columns) == ["source", "window", "fit", "parameter", "value", "error", "lower_95",
+                                        "upper_95", "theory", "chi2_per_dof", "dof", "v_min", "v_max"]
+        assert len(fitted) == 20 and provenance["shards"] == {"0.5": 3, "0.333333": 2}[label]
 
 
 def test_second_run_has_nothing_to_do(finished_run):
@@ -166,7 +176,7 @@ def test_adding_a_shard_runs_only_that_shard(finished_run, tmp_path):
     config = yaml.safe_load(yaml.safe_dump(SMALL))
     config["simulation"]["per_restitution"]["0.5"] = {"shards": 4}
     (directory / "config" / "config.yaml").write_text(yaml.safe_dump(config))
-    assert planned_jobs(directory) == {"simulate_shard": 1, "merge_shards": 1, "all": 1}
+    assert planned_jobs(directory) == {"simulate_shard": 1, "merge_shards": 1, "fit": 1, "all": 1}
 
 
 def _package_copy(tmp_path):
@@ -181,11 +191,17 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
     assert planned_jobs(finished_run, env) == {}
     with open(package / "histograms.py", "a") as handle:
         handle.write("\n# an edit\n")
-    assert planned_jobs(finished_run, env) == {"merge_shards": 2, "all": 1}
+    assert planned_jobs(finished_run, env) == {"merge_shards": 2, "fit": 2, "all": 1}
     with open(package / "free_flight.py", "a") as handle:
         handle.write("\n# an edit\n")
-    assert planned_jobs(finished_run, env) == {"simulate_shard": 5, "merge_shards": 2, "all": 1}
-    for module, expected in (("kernel", {"solve": 2}), ("solver", {"solve": 2}), ("exact", {"exact_solution": 2})):
+    assert planned_jobs(finished_run, env) == {"simulate_shard": 5, "merge_shards": 2, "fit": 2, "all": 1}
+    for module, expected in (
+        ("kernel", {"solve": 2, "fit": 2}),
+        ("solver", {"solve": 2, "fit": 2}),
+        ("exact", {"exact_solution": 2}),
+        ("fits", {"fit": 2}),
+        ("asymptotics", {"solve": 2, "fit": 2, "theory": 1}),
+    ):
         shutil.rmtree(package.parent)
         package, env = _package_copy(tmp_path)
         with open(package / f"{module}.py", "a") as handle:
@@ -247,6 +263,9 @@ BAD = [
     (_with(["exact", "positions"], [-0.1]), "positions"),
     (_with(["exact", "positions"], [0, 1.0e-5]), "positions"),
     (_with(["solvr"], {}), "'solvr' was unexpected"),
+    (_with(["theory", "restitution_grid", "max"], 1.0), "theory.restitution_grid: need 0 < min < max < 1"),
+    (_with(["fits", "small_speed_window"], "automatic"), "small_speed_window"),
+    (_with(["fits", "large_speed_window"], {"min": 5, "max": 2}), "fits.large_speed_window: min = 5"),
 ]
 
 

@@ -1,5 +1,13 @@
 # Helpers for every stage: r labels and exact values, per-r settings, shard lists, targets.
-from bouncing_ball import exact, histograms, simulation, solver, source_digest
+from bouncing_ball import (
+    asymptotics,
+    exact,
+    fits,
+    histograms,
+    simulation,
+    solver,
+    source_digest,
+)
 from bouncing_ball.config import (
     check_config,
     exact_settings,
@@ -18,6 +26,8 @@ SIMULATION_CODE = source_digest(simulation.SOURCES)
 MERGE_CODE = source_digest(histograms.SOURCES)
 SOLVER_CODE = source_digest(solver.SOURCES)
 EXACT_CODE = source_digest(("exact",))
+THEORY_CODE = source_digest(asymptotics.SOURCES)
+FIT_CODE = source_digest(fits.SOURCES)
 
 # the r values with an exact solution, eq. (P(0,v)): always computed (Figs. 3 and 5)
 EXACT_BY_LABEL = {restitution_label(value): value for value in exact.EXACT_RESTITUTIONS}
@@ -82,3 +92,7 @@ def exact_targets():
         r=EXACT_LABELS,
         table=("p0v", "distribution", "position", "summary"),
     )
+
+
+def fit_targets():
+    return expand("results/fits/r{r}.parquet", r=RESTITUTION)

@@ -1,0 +1,283 @@
+"""Fits of the asymptotic forms of P(0, v) to binned data, eqs. (asym1), (asym3).
+
+Small v: P(0, v) = A v^-beta, eqs. (asym1), (asym2).
+Large v: P(0, v) = A v^-m e^(-q v), eqs. (asym3)-(asym6).
+
+The data are bin averages, int_bin v P dv / int_bin v dv (what the simulation
+measures, eq. (collrate)), so the model is averaged over each bin the same
+way (Gauss-Legendre in ln v), not evaluated at a bin centre.  Fits are
+weighted least squares with the data's standard errors, taken as absolute:
+
+  * fixed exponents (the theory's): only the prefactor, a linear fit;
+  * free exponents: beta, or m and q, with the prefactor, by
+    ``scipy.optimize.curve_fit``; errors from its covariance.
+
+Errors of fitted parameters.  Low-speed collisions come in cascades that fill
+neighbouring bins together, so bins are correlated and the least-squares
+covariance (which assumes independent bins) understates the errors.  The
+errors here are delete-one jackknife errors over shards of the whole fit
+(the weights stay those of the full data).  Intervals: value +- error (68%)
+and value +- t(0.975, shards - 1) error (95%).
+
+The window.  An asymptotic form holds only approximately at finite v: fitted
+to the solver's noise-free P(0, v) its free exponents drift away from the
+theory's as the window reaches in (by ~0.1 in m at v ~ 2 for r = 0.25).
+The default window is the largest run of usable bins that starts at the
+smallest (small v) or ends at the largest (large v) one and over which that
+drift, for every free exponent, is at most ``max_bias`` times the data's
+statistical error on it: there the form's own inexactness is small beside
+the noise, and a fit of the data tests the theory.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from scipy import optimize, stats
+from scipy.interpolate import CubicSpline
+
+from .histograms import jackknife, outgoing_speed_density
+
+from .asymptotics import large_speed_decay_rate, large_speed_exponent, small_speed_exponent
+
+# the modules whose code decides a fit table (see ``source_digest``)
+SOURCES = ("asymptotics", "bins", "fits", "histograms", "io", "shards", "tallies")
+
+SMALL_SPEED = "small_speed"
+LARGE_SPEED = "large_speed"
+INTERVAL_95 = 1.959963984540054  # scipy.stats.norm.ppf(0.975)
+
+_NODES, _WEIGHTS = np.polynomial.legendre.leggauss(8)
+
+
+def small_speed_form(v, log_prefactor, beta):
+    """A v^-beta, eq. (asym1)."""
+    return np.exp(log_prefactor - beta * np.log(v))
+
+
+def large_speed_form(v, log_prefactor, m, q):
+    """A v^-m e^(-q v), eq. (asym3)."""
+    return np.exp(log_prefactor - m * np.log(v) - q * v)
+
+
+FORMS = {SMALL_SPEED: small_speed_form, LARGE_SPEED: large_speed_form}
+EXPONENT_NAMES = {SMALL_SPEED: ("beta",), LARGE_SPEED: ("m", "q")}
+
+
+def theory_exponents(side, restitution):
+    """The exponents of the asymptotic form on ``side``: (beta,) or (m, q)."""
+    if side == SMALL_SPEED:
+        return (small_speed_exponent(restitution),)
+    return (large_speed_exponent(restitution), large_speed_decay_rate(restitution))
+
+
+def bin_average(form, lower, upper, *parameters):
+    """int_lo^hi v f(v) dv / int_lo^hi v dv for each bin (Gauss-Legendre in ln v)."""
+    lower = np.asarray(lower, dtype=float)[:, None]
+    upper = np.asarray(upper, dtype=float)[:, None]
+    half = 0.5 * np.log(upper / lower)
+    v = np.exp(half * _NODES[None, :] + 0.5 * np.log(upper * lower))
+    flux = half[:, 0] * ((v * v * form(v, *parameters)) @ _WEIGHTS)
+    return flux / (0.5 * (upper[:, 0] ** 2 - lower[:, 0] ** 2))
+
+
+@dataclass(frozen=True)
+class AsymptoticFit:
+    side: str
+    free: bool
+    parameters: dict  # name -> value: "prefactor" and the exponents
+    errors: dict  # name -> standard error (0 for a fixed exponent)
+    chi2: float
+    dof: int
+    lower: float  # window
+    upper: float
+
+    @property
+    def chi2_per_dof(self):
+        return self.chi2 / self.dof if self.dof > 0 else np.nan
+
+
+def fit_asymptotic_form(side, lower, upper, values, errors, restitution, free):
+    """Weighted least-squares fit of the form on ``side`` to bin averages ``values`` +- ``errors``."""
+    lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    values, errors = np.asarray(values, dtype=float), np.asarray(errors, dtype=float)
+    form = FORMS[side]
+    theory = theory_exponents(side, restitution)
+    names = EXPONENT_NAMES[side]
+    shape = bin_average(form, lower, upper, 0.0, *theory)
+    weights = 1.0 / errors**2
+    # fixed exponents: the prefactor is linear
+    prefactor = np.sum(weights * values * shape) / np.sum(weights * shape**2)
+    if not free:
+        residual = (values - prefactor * shape) / errors
+        return AsymptoticFit(
+            side,
+            False,
+            {"prefactor": prefactor, **dict(zip(names, theory))},
+            {"prefactor": 1.0 / np.sqrt(np.sum(weights * shape**2)), **{n: 0.0 for n in names}},
+            float(np.sum(residual**2)),
+            len(values) - 1,
+            float(lower[0]),
+            float(upper[-1]),
+        )
+    start = (np.log(prefactor), *theory)
+    best, covariance = optimize.curve_fit(
+        lambda _, *p: bin_average(form, lower, upper, *p),
+        np.zeros(len(values)),
+        values,
+        p0=start,
+        sigma=errors,
+        absolute_sigma=True,
+        maxfev=20000,
+    )
+    spread = np.sqrt(np.diag(covariance))
+    residual = (values - bin_average(form, lower, upper, *best)) / errors
+    return AsymptoticFit(
+        side,
+        True,
+        {"prefactor": float(np.exp(best[0])), **dict(zip(names, map(float, best[1:])))},
+        {"prefactor": float(np.exp(best[0]) * spread[0]), **dict(zip(names, map(float, spread[1:])))},
+        float(np.sum(residual**2)),
+        len(values) - len(best),
+        float(lower[0]),
+        float(upper[-1]),
+    )
+
+
+def _parameter_vector(fit):
+    names = ("prefactor", *EXPONENT_NAMES[fit.side])
+    return np.array([fit.parameters[n] for n in names])
+
+
+def fit_shards(side, lower, upper, counts, times, errors, restitution, free):
+    """The fit of the pooled P(0, v) of shards (``counts``: shards x bins, ``times``: shards),
+    with delete-one jackknife errors over shards; ``errors`` are the weights."""
+
+    def estimator(count_sum, time_sum):
+        values = outgoing_speed_density(count_sum, time_sum, lower, upper)
+        return _parameter_vector(fit_asymptotic_form(side, lower, upper, values, errors, restitution, free))
+
+    values = outgoing_speed_density(np.sum(counts, axis=0), np.sum(times), lower, upper)
+    fit = fit_asymptotic_form(side, lower, upper, values, errors, restitution, free)
+    _, spread = jackknife(estimator, counts, np.asarray(times, dtype=float))
+    names = ("prefactor", *EXPONENT_NAMES[side])
+    jackknifed = {n: (float(e) if free or n == "prefactor" else 0.0) for n, e in zip(names, spread)}
+    return AsymptoticFit(side, free, fit.parameters, jackknifed, fit.chi2, fit.dof, fit.lower, fit.upper)
+
+
+def interval_factor(shards, level=0.95):
+    """Student t factor of a ``level`` interval from a jackknife over ``shards`` shards."""
+    return float(stats.t.ppf(0.5 + level / 2.0, shards - 1))
+
+
+def asymptotic_window(side, lower, upper, counts, times, errors, reference, restitution,
+                      max_bias=0.5, minimum_bins=4):
+    """The default window on ``side`` as a slice of the usable bins; see the module docstring.
+
+    ``reference`` are noise-free bin averages of P(0, v) (the solver's) in the same bins.
+    """
+    count = len(lower)
+    if count < minimum_bins:
+        raise ValueError(f"{side} window: only {count} usable bins, {minimum_bins} needed")
+    theory = np.array(theory_exponents(side, restitution))
+    best = None
+    for size in range(minimum_bins, count + 1):
+        window = slice(0, size) if side == SMALL_SPEED else slice(count - size, count)
+        parts = (lower[window], upper[window])
+        drift = _parameter_vector(
+            fit_asymptotic_form(side, *parts, reference[window], errors[window], restitution, free=True)
+        )[1:] - theory
+        noisy = fit_shards(side, *parts, counts[:, window], times, errors[window], restitution, free=True)
+        spread = np.array([noisy.errors[name] for name in EXPONENT_NAMES[side]])
+        if np.any(np.abs(drift) > max_bias * spread):
+            break
+        best = window
+    if best is None:
+        raise ValueError(
+            f"{side} window: fitted to the solver over the {minimum_bins} outermost usable bins, the free "
+            f"exponents already differ from the theory's by more than {max_bias} of the data's errors"
+        )
+    return best
+
+
+def window_from_range(side, lower, upper, speed_range):
+    """The usable bins inside a configured [min, max] window."""
+    inside = np.flatnonzero((lower >= speed_range["min"] * (1 - 1e-12)) & (upper <= speed_range["max"] * (1 + 1e-12)))
+    if len(inside) < 2 + len(EXPONENT_NAMES[side]):
+        raise ValueError(
+            f"{side} window [{speed_range['min']}, {speed_range['max']}] holds {len(inside)} usable bins, "
+            f"too few for a fit of {1 + len(EXPONENT_NAMES[side])} parameters"
+        )
+    return slice(inside[0], inside[-1] + 1)
+
+
+def fit_rows(source, fit, theory, shards=None):
+    """Long-format rows of one fit: one per parameter."""
+    factor = interval_factor(shards) if shards else INTERVAL_95
+    rows = []
+    for name, value in fit.parameters.items():
+        error = fit.errors[name]
+        rows.append(
+            {
+                "source": source,
+                "window": fit.side,
+                "fit": "free_exponents" if fit.free else "fixed_exponents",
+                "parameter": name,
+                "value": value,
+                "error": error,
+                "lower_95": value - factor * error,
+                "upper_95": value + factor * error,
+                "theory": theory.get(name, np.nan),
+                "chi2_per_dof": fit.chi2_per_dof,
+                "dof": fit.dof,
+                "v_min": fit.lower,
+                "v_max": fit.upper,
+            }
+        )
+    return rows
+
+
+def asymptotic_fits(lower, upper, counts, times, errors, reference, restitution, windows, max_bias=0.5):
+    """Every fit of issue 4 for one r, as a long table.
+
+    ``counts`` (shards x bins) and ``times`` are the simulation's usable bins, ``errors``
+    its standard errors (the weights), ``reference`` the solver's bin averages;
+    ``windows`` maps each side to "auto" or {"min": .., "max": ..}.  A side without a
+    usable window gets NaN rows; the reasons are returned alongside.
+    """
+    rows, problems = [], []
+    for side in (SMALL_SPEED, LARGE_SPEED):
+        theory = dict(zip(EXPONENT_NAMES[side], theory_exponents(side, restitution)))
+        try:
+            if windows[side] == "auto":
+                window = asymptotic_window(
+                    side, lower, upper, counts, times, errors, reference, restitution, max_bias
+                )
+            else:
+                window = window_from_range(side, lower, upper, windows[side])
+        except ValueError as error:
+            problems.append(str(error))
+            names = ("prefactor", *EXPONENT_NAMES[side])
+            empty = AsymptoticFit(side, False, dict.fromkeys(names, np.nan), dict.fromkeys(names, np.nan),
+                                  np.nan, 0, np.nan, np.nan)
+            for source in ("simulation", "solver"):
+                for free in (False, True):
+                    rows += fit_rows(source, AsymptoticFit(**{**empty.__dict__, "free": free}), theory)
+            continue
+        parts = (lower[window], upper[window])
+        for free in (False, True):
+            simulated = fit_shards(side, *parts, counts[:, window], times, errors[window], restitution, free)
+            rows += fit_rows("simulation", simulated, theory, shards=len(times))
+            solved = fit_asymptotic_form(side, *parts, reference[window], errors[window], restitution, free)
+            rows += fit_rows("solver", solved, theory)
+    return pd.DataFrame(rows), problems
+
+
+def bin_averages_of_curve(speeds, density, lower, upper):
+    """Bin averages of P(0, v) given on a dense log grid (the solver's output): a cubic spline
+    of ln P in ln v, averaged like the data (relative error ~1e-7 at 50 points per decade)."""
+    spline = CubicSpline(np.log(speeds), np.log(density))
+    lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    if lower.min() < speeds[0] or upper.max() > speeds[-1]:
+        raise ValueError(f"bins reach beyond the curve's speeds [{speeds[0]}, {speeds[-1]}]")
+    return bin_average(lambda v: np.exp(spline(np.log(v))), lower, upper)

@@ -1,0 +1,39 @@
+# The asymptotic theory and fits: beta, m, q over r (one job), and per r the fits of Fig. 4.
+
+
+rule theory:
+    output:
+        "results/theory/exponents.parquet",
+    log:
+        "logs/theory/exponents.log",
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=500,
+    params:
+        grid=config["theory"]["restitution_grid"],
+        code=THEORY_CODE,
+    script:
+        "../../scripts/theory.py"
+
+
+rule fit:
+    input:
+        shards=shard_files,
+        solver="results/solver/r{r}/p0v.parquet",
+    output:
+        "results/fits/r{r}.parquet",
+    log:
+        "logs/fits/r{r}.log",
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=10,
+        mem_mb=1000,
+    params:
+        restitution=restitution_value,
+        settings=config["fits"],
+        code=FIT_CODE,
+    script:
+        "../../scripts/fit.py"
