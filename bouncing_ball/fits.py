@@ -16,8 +16,12 @@ Errors of fitted parameters.  Low-speed collisions come in cascades that fill
 neighbouring bins together, so bins are correlated and the least-squares
 covariance (which assumes independent bins) understates the errors.  The
 errors here are delete-one jackknife errors over shards of the whole fit
-(the weights stay those of the full data).  Intervals: value +- error (68%)
-and value +- t(0.975, shards - 1) error (95%).
+(the weights stay those of the full data).  95% intervals are value +-
+t(0.975, shards - 1) error (on ln A for the prefactor); for free exponents the
+theory's values are also tested together (Hotelling's T^2 on the jackknife
+covariance: m and q are strongly anticorrelated, so two marginal intervals
+say less than the joint test).  chi^2 per degree of freedom uses the per-bin
+errors only and is indicative: it ignores the correlations between bins.
 
 The window.  An asymptotic form holds only approximately at finite v: fitted
 to the solver's noise-free P(0, v) its free exponents drift away from the
@@ -48,6 +52,10 @@ LARGE_SPEED = "large_speed"
 INTERVAL_95 = 1.959963984540054  # scipy.stats.norm.ppf(0.975)
 
 _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(8)
+
+
+class WindowError(ValueError):
+    """No window on one side holds enough usable bins for a fit."""
 
 
 def small_speed_form(v, log_prefactor, beta):
@@ -91,6 +99,8 @@ class AsymptoticFit:
     dof: int
     lower: float  # window
     upper: float
+    # p-value of the theory's exponents jointly, Hotelling's T^2 on the jackknife covariance
+    joint_p_value: float = np.nan
 
     @property
     def chi2_per_dof(self):
@@ -151,18 +161,41 @@ def _parameter_vector(fit):
 
 def fit_shards(side, lower, upper, counts, times, errors, restitution, free):
     """The fit of the pooled P(0, v) of shards (``counts``: shards x bins, ``times``: shards),
-    with delete-one jackknife errors over shards; ``errors`` are the weights."""
+    with delete-one jackknife errors over shards; ``errors`` are the weights.
 
-    def estimator(count_sum, time_sum):
+    For free exponents also the p-value of the theory's exponents taken together:
+    Hotelling's T^2 = d' C^-1 d with C the jackknife covariance of the fitted
+    exponents, (n - p) T^2 / (p (n - 1)) ~ F(p, n - p) for n shards and p exponents.
+    """
+    counts = np.asarray(counts, dtype=float)
+    times = np.asarray(times, dtype=float)
+    shards = len(times)
+    if shards < 2:
+        raise ValueError(f"{side} fit: {shards} shard; errors need at least 2 (simulation.shards)")
+    if not np.all(np.isfinite(errors) & (errors > 0)):
+        raise ValueError(f"{side} fit: every bin needs a finite positive error")
+
+    def fitted(count_sum, time_sum):
         values = outgoing_speed_density(count_sum, time_sum, lower, upper)
-        return _parameter_vector(fit_asymptotic_form(side, lower, upper, values, errors, restitution, free))
+        return fit_asymptotic_form(side, lower, upper, values, errors, restitution, free)
 
-    values = outgoing_speed_density(np.sum(counts, axis=0), np.sum(times), lower, upper)
-    fit = fit_asymptotic_form(side, lower, upper, values, errors, restitution, free)
-    _, spread = jackknife(estimator, counts, np.asarray(times, dtype=float))
+    fit = fitted(counts.sum(axis=0), times.sum())
+    leave_one_out = np.stack(
+        [_parameter_vector(fitted(counts.sum(axis=0) - counts[k], times.sum() - times[k])) for k in range(shards)]
+    )
+    spread = leave_one_out - leave_one_out.mean(axis=0)
+    covariance = (shards - 1) / shards * spread.T @ spread
     names = ("prefactor", *EXPONENT_NAMES[side])
-    jackknifed = {n: (float(e) if free or n == "prefactor" else 0.0) for n, e in zip(names, spread)}
-    return AsymptoticFit(side, free, fit.parameters, jackknifed, fit.chi2, fit.dof, fit.lower, fit.upper)
+    errors_out = {n: float(np.sqrt(covariance[i, i])) if free or n == "prefactor" else 0.0 for i, n in enumerate(names)}
+    joint = np.nan
+    if free:
+        exponents = len(names) - 1
+        deviation = _parameter_vector(fit)[1:] - np.array(theory_exponents(side, restitution))
+        if shards > exponents:
+            t_squared = float(deviation @ np.linalg.solve(covariance[1:, 1:], deviation))
+            statistic = (shards - exponents) * t_squared / (exponents * (shards - 1))
+            joint = float(stats.f.sf(statistic, exponents, shards - exponents))
+    return AsymptoticFit(side, free, fit.parameters, errors_out, fit.chi2, fit.dof, fit.lower, fit.upper, joint)
 
 
 def interval_factor(shards, level=0.95):
@@ -178,7 +211,7 @@ def asymptotic_window(side, lower, upper, counts, times, errors, reference, rest
     """
     count = len(lower)
     if count < minimum_bins:
-        raise ValueError(f"{side} window: only {count} usable bins, {minimum_bins} needed")
+        raise WindowError(f"{side} window: only {count} usable bins, {minimum_bins} needed")
     theory = np.array(theory_exponents(side, restitution))
     best = None
     for size in range(minimum_bins, count + 1):
@@ -193,7 +226,7 @@ def asymptotic_window(side, lower, upper, counts, times, errors, reference, rest
             break
         best = window
     if best is None:
-        raise ValueError(
+        raise WindowError(
             f"{side} window: fitted to the solver over the {minimum_bins} outermost usable bins, the free "
             f"exponents already differ from the theory's by more than {max_bias} of the data's errors"
         )
@@ -204,7 +237,7 @@ def window_from_range(side, lower, upper, speed_range):
     """The usable bins inside a configured [min, max] window."""
     inside = np.flatnonzero((lower >= speed_range["min"] * (1 - 1e-12)) & (upper <= speed_range["max"] * (1 + 1e-12)))
     if len(inside) < 2 + len(EXPONENT_NAMES[side]):
-        raise ValueError(
+        raise WindowError(
             f"{side} window [{speed_range['min']}, {speed_range['max']}] holds {len(inside)} usable bins, "
             f"too few for a fit of {1 + len(EXPONENT_NAMES[side])} parameters"
         )
@@ -212,11 +245,20 @@ def window_from_range(side, lower, upper, speed_range):
 
 
 def fit_rows(source, fit, theory, shards=None):
-    """Long-format rows of one fit: one per parameter."""
-    factor = interval_factor(shards) if shards else INTERVAL_95
+    """Long-format rows of one fit, one per parameter.
+
+    Simulation rows (``shards`` given) carry jackknife errors and 95% intervals
+    (Student t; the prefactor's on ln A, so it stays positive).  Solver rows are
+    noise-free: their value is what the method gives, with no error.
+    """
+    factor = interval_factor(shards) if shards else np.nan
     rows = []
     for name, value in fit.parameters.items():
-        error = fit.errors[name]
+        error = fit.errors[name] if shards else np.nan
+        if name == "prefactor":
+            lower, upper = value * np.exp(-factor * error / value), value * np.exp(factor * error / value)
+        else:
+            lower, upper = value - factor * error, value + factor * error
         rows.append(
             {
                 "source": source,
@@ -225,9 +267,10 @@ def fit_rows(source, fit, theory, shards=None):
                 "parameter": name,
                 "value": value,
                 "error": error,
-                "lower_95": value - factor * error,
-                "upper_95": value + factor * error,
+                "lower_95": lower,
+                "upper_95": upper,
                 "theory": theory.get(name, np.nan),
+                "joint_p_value": fit.joint_p_value,
                 "chi2_per_dof": fit.chi2_per_dof,
                 "dof": fit.dof,
                 "v_min": fit.lower,
@@ -255,7 +298,7 @@ def asymptotic_fits(lower, upper, counts, times, errors, reference, restitution,
                 )
             else:
                 window = window_from_range(side, lower, upper, windows[side])
-        except ValueError as error:
+        except WindowError as error:
             problems.append(str(error))
             names = ("prefactor", *EXPONENT_NAMES[side])
             empty = AsymptoticFit(side, False, dict.fromkeys(names, np.nan), dict.fromkeys(names, np.nan),
@@ -281,3 +324,9 @@ def bin_averages_of_curve(speeds, density, lower, upper):
     if lower.min() < speeds[0] or upper.max() > speeds[-1]:
         raise ValueError(f"bins reach beyond the curve's speeds [{speeds[0]}, {speeds[-1]}]")
     return bin_average(lambda v: np.exp(spline(np.log(v))), lower, upper)
+
+
+def expected_collisions(reference, lower, upper, total_time):
+    """Collisions a run of ``total_time`` should put in each bin, from noise-free bin averages
+    (eq. (collrate): rate = P-bar int_bin v dv)."""
+    return np.asarray(reference) * total_time * 0.5 * (np.asarray(upper) ** 2 - np.asarray(lower) ** 2)

@@ -25,17 +25,26 @@ def main(shard_paths, solver_path, restitution, settings, output):
     r = float(value)
     shards, provenances = read_shards(shard_paths, label)
     table = outgoing_speed_histogram(shards)
-    usable = (
-        (table["count"] >= settings["minimum_count"]) & np.isfinite(table.v_hi) & (table.v_lo > 0)
-    ).to_numpy()
-    lower, upper = table.v_lo.to_numpy()[usable], table.v_hi.to_numpy()[usable]
-    errors = table.p0v_err.to_numpy()[usable]
-    counts = np.stack([s.speed_counts[usable] for s in shards])
     times = np.array([s.time for s in shards])
     curve, solver_provenance = read_table(solver_path)
     if solver_provenance.get("r_label") != label:
         raise ValueError(f"{solver_path}: solved for r = {solver_provenance.get('r_label')}, not r = {label}")
-    reference = fits.bin_averages_of_curve(curve.v.to_numpy(), curve.p0v.to_numpy(), lower, upper)
+    speeds, density = curve.v.to_numpy(), curve.p0v.to_numpy()
+    # finite bins inside the solver's output speeds (solver.output_speeds)
+    inside = (np.isfinite(table.v_hi) & (table.v_lo >= speeds[0]) & (table.v_hi <= speeds[-1])).to_numpy()
+    beyond = int(np.sum(np.isfinite(table.v_hi) & (table.v_hi > speeds[-1]) & (table["count"] > 0)))
+    if beyond:
+        logging.warning("r=%s: %d populated bins above v = %g, where the solver's curve ends, are left out",
+                        label, beyond, speeds[-1])
+    lower_all, upper_all = table.v_lo.to_numpy()[inside], table.v_hi.to_numpy()[inside]
+    reference_all = fits.bin_averages_of_curve(speeds, density, lower_all, upper_all)
+    # bins chosen by the collisions they should hold, not by those they happen to hold
+    expected = fits.expected_collisions(reference_all, lower_all, upper_all, times.sum())
+    keep = expected >= settings["minimum_count"]
+    lower, upper, reference = lower_all[keep], upper_all[keep], reference_all[keep]
+    rows = np.flatnonzero(inside)[keep]
+    errors = table.p0v_err.to_numpy()[rows]
+    counts = np.stack([s.speed_counts[rows] for s in shards])
     windows = {fits.SMALL_SPEED: settings["small_speed_window"], fits.LARGE_SPEED: settings["large_speed_window"]}
     result, problems = fits.asymptotic_fits(
         lower, upper, counts, times, errors, reference, r, windows, settings["max_bias"]
@@ -56,9 +65,10 @@ def main(shard_paths, solver_path, restitution, settings, output):
     for row in result[(result.source == "simulation") & (result.fit == "free_exponents")].itertuples():
         if row.parameter != "prefactor":
             logging.info(
-                "r=%s %s [%.3g, %.3g]: %s = %.5g +- %.2g (95%%: %.5g .. %.5g), theory %.5g, chi2/dof %.2f",
+                "r=%s %s [%.3g, %.3g]: %s = %.5g +- %.2g (95%%: %.5g .. %.5g), theory %.5g; "
+                "theory's exponents together: p = %.3g; chi2/dof %.2f",
                 label, row.window, row.v_min, row.v_max, row.parameter, row.value, row.error,
-                row.lower_95, row.upper_95, row.theory, row.chi2_per_dof,
+                row.lower_95, row.upper_95, row.theory, row.joint_p_value, row.chi2_per_dof,
             )
 
 

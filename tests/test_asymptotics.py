@@ -58,7 +58,7 @@ def test_q_and_its_slope_continuous_at_one_half_but_not_its_curvature():
         return (large_speed_decay_rate(x + h) - 2 * large_speed_decay_rate(x) + large_speed_decay_rate(x - h)) / h**2
 
     below, above = second(half - 0.01, 1e-4), second(half + 0.01, 1e-4)
-    assert abs(below - above) > 1.0  # 1/r^3 = 8 below, about 0 above
+    assert abs(below - above) > 1.0  # 1/r^3 -> 8 below, -8/3 above
 
 
 def test_m_jumps_at_one_half():

@@ -62,19 +62,22 @@ def test_detects_a_one_percent_error(shards, solutions, r):
 
 @pytest.mark.parametrize("r", list(SHARD_TIME))
 def test_free_exponent_fits_agree_with_theory(shards, solutions, r):
-    """beta, and m with q, fitted with free exponents in the default windows, contain the
-    theory's eqs. (asym2)-(asym6) in their 95% intervals; the fits have bins to work with."""
-    lower, upper, _ = outgoing_speed_bins(shards[r], minimum_count=50)
-    usable = np.isin(shards[r][0].speed_bins.lower, lower)
-    counts = np.stack([s.speed_counts[usable] for s in shards[r]])
+    """beta, and m with q together (they are strongly anticorrelated), fitted with free
+    exponents in the default windows: the theory's eqs. (asym2)-(asym6) are not rejected
+    at the 1e-3 level (Hotelling's T^2 on the jackknife covariance over shards)."""
+    bins = shards[r][0].speed_bins
+    inside = np.isfinite(bins.upper) & (bins.lower > 0)
+    lower, upper = bins.lower[inside], bins.upper[inside]
     times = np.array([s.time for s in shards[r]])
-    _, errors = jackknife(lambda c, t: outgoing_speed_density(c, t, lower, upper), counts, times)
     reference = solver.outgoing_speed_bin_average(solutions[r], lower, upper)
+    keep = fits.expected_collisions(reference, lower, upper, times.sum()) >= 50
+    lower, upper, reference = lower[keep], upper[keep], reference[keep]
+    counts = np.stack([s.speed_counts[inside][keep] for s in shards[r]])
+    _, errors = jackknife(lambda c, t: outgoing_speed_density(c, t, lower, upper), counts, times)
     windows = {fits.SMALL_SPEED: "auto", fits.LARGE_SPEED: "auto"}
     table, problems = fits.asymptotic_fits(lower, upper, counts, times, errors, reference, r, windows)
     assert problems == []
     free = table[(table.source == "simulation") & (table.fit == "free_exponents") & (table.parameter != "prefactor")]
-    assert len(free) == 3
-    for row in free.itertuples():
-        assert row.lower_95 <= row.theory <= row.upper_95, row
-        assert row.v_max / row.v_min > 2.0 and row.dof >= 1, row
+    assert sorted(free.parameter) == ["beta", "m", "q"]
+    for window, rows in free.groupby("window"):
+        assert rows.joint_p_value.iloc[0] > 1e-3, rows.to_string()

@@ -109,7 +109,8 @@ def test_run_produces_the_documented_tables(finished_run):
     for label in ("0.5", "0.333333"):
         fitted, provenance = read_table(finished_run / f"results/fits/r{label}.parquet")
         assert list(fitted.columns) == ["source", "window", "fit", "parameter", "value", "error", "lower_95",
-                                        "upper_95", "theory", "chi2_per_dof", "dof", "v_min", "v_max"]
+                                        "upper_95", "theory", "joint_p_value", "chi2_per_dof", "dof",
+                                        "v_min", "v_max"]
         assert len(fitted) == 20 and provenance["shards"] == {"0.5": 3, "0.333333": 2}[label]
 
 
@@ -265,6 +266,8 @@ BAD = [
     (_with(["solvr"], {}), "'solvr' was unexpected"),
     (_with(["theory", "restitution_grid", "max"], 1.0), "theory.restitution_grid: need 0 < min < max < 1"),
     (_with(["fits", "small_speed_window"], "automatic"), "small_speed_window"),
+    (_with(["fits", "max_bias"], 2.0), "max_bias"),
+    (_with(["simulation", "shards"], 1), "shards"),
     (_with(["fits", "large_speed_window"], {"min": 5, "max": 2}), "fits.large_speed_window: min = 5"),
 ]
 
