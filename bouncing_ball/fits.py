@@ -40,7 +40,7 @@ import pandas as pd
 from scipy import optimize, stats
 from scipy.interpolate import CubicSpline
 
-from .histograms import jackknife, outgoing_speed_density
+from .histograms import outgoing_speed_density
 
 from .asymptotics import large_speed_decay_rate, large_speed_exponent, small_speed_exponent
 
