@@ -10,9 +10,18 @@ is asked for as a target.
 from fractions import Fraction
 
 import numpy as np
+import yaml
 
 from .bins import LogBins
 from .restitution import parse_restitution, restitution_grid, restitution_label
+
+
+def read_config(path) -> dict:
+    """A config file, checked as the workflow checks it (for scripts run by hand)."""
+    with open(path) as handle:
+        config = yaml.safe_load(handle)
+    check_config(config)
+    return config
 
 
 def check_config(config: dict) -> dict[str, Fraction]:

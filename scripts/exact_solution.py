@@ -11,10 +11,9 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import yaml
 
 from bouncing_ball import exact, source_digest
-from bouncing_ball.config import check_config, exact_settings, linear_grid, log_grid
+from bouncing_ball.config import exact_settings, linear_grid, log_grid, read_config
 from bouncing_ball.io import write_table
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 
@@ -90,9 +89,7 @@ def _command_line():
     parser.add_argument("--outdir", required=True, type=Path)
     parser.add_argument("--config", default="config/config.yaml", help="grids from here")
     args = parser.parse_args()
-    with open(args.config) as handle:
-        config = yaml.safe_load(handle)
-    check_config(config)
+    config = read_config(args.config)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     args.outdir.mkdir(parents=True, exist_ok=True)
     outputs = {name: args.outdir / f"{name}.parquet" for name in ("p0v", "distribution", "position", "summary")}

@@ -10,10 +10,9 @@ import argparse
 import logging
 
 import numpy as np
-import yaml
 
 from bouncing_ball import fits, source_digest
-from bouncing_ball.config import check_config
+from bouncing_ball.config import read_config
 from bouncing_ball.histograms import outgoing_speed_histogram
 from bouncing_ball.io import read_table, write_table
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
@@ -80,9 +79,7 @@ def _command_line():
     parser.add_argument("--output", required=True)
     parser.add_argument("--config", default="config/config.yaml", help="fit settings from here")
     args = parser.parse_args()
-    with open(args.config) as handle:
-        config = yaml.safe_load(handle)
-    check_config(config)
+    config = read_config(args.config)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     main(args.shards, args.solver, args.restitution, config["fits"], args.output)
 

@@ -12,10 +12,9 @@ import time
 
 import numpy as np
 import pandas as pd
-import yaml
 
 from bouncing_ball import source_digest, solver
-from bouncing_ball.config import check_config, log_grid
+from bouncing_ball.config import log_grid, read_config
 from bouncing_ball.io import write_table
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 
@@ -95,9 +94,7 @@ def _command_line():
     parser.add_argument("--config", default="config/config.yaml", help="solver settings from here")
     parser.add_argument("--step", type=float, help="override the config's solver.quadrature_step")
     args = parser.parse_args()
-    with open(args.config) as handle:
-        config = yaml.safe_load(handle)
-    check_config(config)
+    config = read_config(args.config)
     settings = dict(config["solver"])
     if args.step is not None:
         settings["quadrature_step"] = args.step

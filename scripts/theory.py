@@ -8,11 +8,10 @@ Writes results/theory/exponents.parquet (r, beta, m, q).  Run by Snakemake
 import argparse
 import logging
 
-import yaml
 
 from bouncing_ball import source_digest
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION, SOURCES, exponents_table
-from bouncing_ball.config import check_config, linear_grid
+from bouncing_ball.config import linear_grid, read_config
 from bouncing_ball.io import write_table
 
 
@@ -34,9 +33,7 @@ def _command_line():
     parser.add_argument("output")
     parser.add_argument("--config", default="config/config.yaml", help="the r grid from here")
     args = parser.parse_args()
-    with open(args.config) as handle:
-        config = yaml.safe_load(handle)
-    check_config(config)
+    config = read_config(args.config)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     main(config["theory"]["restitution_grid"], args.output)
 
