@@ -11,6 +11,9 @@ configfile: "config/config.yaml"
 validate(config, "workflow/schemas/config.schema.yaml")
 
 
+report: "workflow/report/workflow.rst"
+
+
 wildcard_constraints:
     r=r"[0-9][0-9.e-]*",
     shard=r"[0-9]+",
@@ -22,6 +25,8 @@ localrules:
     solver,
     exact,
     fits,
+    figures,
+    tables,
 
 
 include: "workflow/rules/common.smk"
@@ -29,6 +34,8 @@ include: "workflow/rules/simulation.smk"
 include: "workflow/rules/solver.smk"
 include: "workflow/rules/exact.smk"
 include: "workflow/rules/theory.smk"
+include: "workflow/rules/figures.smk"
+include: "workflow/rules/tables.smk"
 
 
 rule all:
@@ -39,6 +46,9 @@ rule all:
         exact_targets(),
         "results/theory/exponents.parquet",
         fit_targets(),
+        "results/solver/time_averages.parquet",
+        figure_targets(),
+        table_targets(),
 
 
 # stage target: every simulated r, merged
@@ -51,6 +61,7 @@ rule simulation:
 rule solver:
     input:
         solver_targets(),
+        "results/solver/time_averages.parquet",
 
 
 # stage target: the exact solutions at r = 1/2 and 1/3
@@ -64,3 +75,15 @@ rule fits:
     input:
         "results/theory/exponents.parquet",
         fit_targets(),
+
+
+# stage target: Figs. 1-7, PDF and PNG
+rule figures:
+    input:
+        figure_targets(),
+
+
+# stage target: the moments table, CSV and Markdown
+rule tables:
+    input:
+        table_targets(),

@@ -13,6 +13,7 @@ import numpy as np
 import yaml
 
 from .bins import LogBins
+from .exact import EXACT_RESTITUTIONS
 from .restitution import parse_restitution, restitution_grid, restitution_label
 
 
@@ -51,6 +52,14 @@ def check_config(config: dict) -> dict[str, Fraction]:
             "theory.restitution_grid: need 0 < min < max < 1, "
             f"got min = {theory_grid['min']}, max = {theory_grid['max']}"
         )
+    solver_grid = config["solver"]["restitution_grid"]
+    low, high = SOLVER_RESTITUTION_RANGE
+    if not low <= solver_grid["min"] < solver_grid["max"] <= high:
+        raise ValueError(
+            f"solver.restitution_grid: need {low} <= min < max <= {high} (the solver's accurate range), "
+            f"got min = {solver_grid['min']}, max = {solver_grid['max']}"
+        )
+    _check_figure_restitutions(config["figures"], grid)
     for side in ("small_speed_window", "large_speed_window"):
         window = config["fits"][side]
         if window != "auto" and not window["min"] < window["max"]:
@@ -63,6 +72,28 @@ def check_config(config: dict) -> dict[str, Fraction]:
             raise ValueError(f"{where}: the same r as simulation.per_restitution.{seen[label]}")
         seen[label] = key
     return grid
+
+
+# where the solver meets its 1e-8 target at the default step (below 0.02, P(0, v)
+# ~ exp(-v / (2r)) leaves the range of doubles; above 0.999 the grid gets large)
+SOLVER_RESTITUTION_RANGE = (0.02, 0.999)
+
+
+def _check_figure_restitutions(figures: dict, grid: dict) -> None:
+    """The r of Figs. 4 and 5 must be simulated; Fig. 5's must have an exact solution."""
+    for figure in ("fig4", "fig5"):
+        labels = restitution_grid(figures[figure], f"figures.{figure}")
+        for index, (label, value) in enumerate(labels.items()):
+            where = f"figures.{figure}[{index}]"
+            if label not in grid:
+                raise ValueError(
+                    f"{where}: r = {figures[figure][index]!r} is not in restitution "
+                    f"({', '.join(grid)}); add it there or remove it here"
+                )
+            if grid[label] != value:
+                raise ValueError(f"{where}: r = {value} differs from restitution's r = {grid[label]} (label {label})")
+            if figure == "fig5" and value not in EXACT_RESTITUTIONS:
+                raise ValueError(f"{where}: r = {figures[figure][index]!r} has no exact solution (only 1/2 and 1/3)")
 
 
 # the keys of config["simulation"] that change the numbers a shard produces
@@ -99,6 +130,11 @@ def shard_settings(config: dict, label: str) -> dict:
 
 def shard_count(config: dict, label: str) -> int:
     return int(simulation_settings(config, label)["shards"])
+
+
+def solver_settings(config: dict) -> dict:
+    """What one solve is run with (not the r grid of Fig. 6, which has its own job)."""
+    return {key: config["solver"][key] for key in ("quadrature_step", "output_speeds")}
 
 
 def exact_settings(config: dict) -> dict:

@@ -7,6 +7,7 @@ JSON under the key ``bouncing_ball`` of the Parquet key-value metadata.
 import json
 import os
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
 
 import pandas as pd
@@ -22,6 +23,22 @@ class UnreadableFileError(RuntimeError):
     """An input file is missing, truncated or not what it should be."""
 
 
+@contextmanager
+def atomic_path(path):
+    """A temporary name next to ``path`` to write to; renamed to ``path`` only if the
+    block finishes, removed otherwise, so a reader never sees a half-written file."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+    os.close(handle)
+    try:
+        yield temporary
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
 def write_table(frame: pd.DataFrame, path, provenance: dict) -> None:
     """Write ``frame`` to ``path`` with ``provenance``; atomic (temp file, then rename)."""
     path = Path(path)
@@ -32,14 +49,8 @@ def write_table(frame: pd.DataFrame, path, provenance: dict) -> None:
         {"package_version": __version__, **provenance}, sort_keys=True, default=str
     ).encode()
     table = table.replace_schema_metadata(metadata)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(handle)
-    try:
+    with atomic_path(path) as temporary:
         pq.write_table(table, temporary)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
 
 
 def read_table(path) -> tuple[pd.DataFrame, dict]:

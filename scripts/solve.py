@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from bouncing_ball import source_digest, solver
-from bouncing_ball.config import log_grid, read_config
+from bouncing_ball.config import log_grid, read_config, solver_settings
 from bouncing_ball.io import write_table
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 
@@ -39,7 +39,7 @@ def accuracy_estimate(solution):
 
 
 def main(restitution, settings, p0v_path, summary_path):
-    """Solve at r = ``restitution`` with ``settings`` = config["solver"] and write both tables."""
+    """Solve at r = ``restitution`` with ``settings`` = config.solver_settings(config) and write both tables."""
     step = settings["quadrature_step"]
     exact = parse_restitution(restitution)
     label = restitution_label(exact)
@@ -95,7 +95,7 @@ def _command_line():
     parser.add_argument("--step", type=float, help="override the config's solver.quadrature_step")
     args = parser.parse_args()
     config = read_config(args.config)
-    settings = dict(config["solver"])
+    settings = solver_settings(config)
     if args.step is not None:
         settings["quadrature_step"] = args.step
     logging.basicConfig(level=logging.INFO, format="%(message)s")

@@ -1,9 +1,11 @@
 # Helpers for every stage: r labels and exact values, per-r settings, shard lists, targets.
 from bouncing_ball import (
     asymptotics,
+    comparison,
     exact,
     fits,
     histograms,
+    plotting,
     simulation,
     solver,
     source_digest,
@@ -11,10 +13,16 @@ from bouncing_ball import (
 from bouncing_ball.config import (
     check_config,
     exact_settings,
+    solver_settings,
     shard_count,
     shard_settings,
 )
-from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
+from bouncing_ball.restitution import (
+    exact_string,
+    parse_restitution,
+    restitution_grid,
+    restitution_label,
+)
 
 try:
     RESTITUTION = check_config(config)  # {label: exact r}, refused before any job runs
@@ -28,6 +36,9 @@ SOLVER_CODE = source_digest(solver.SOURCES)
 EXACT_CODE = source_digest(("exact",))
 THEORY_CODE = source_digest(asymptotics.SOURCES)
 FIT_CODE = source_digest(fits.SOURCES)
+FIGURE_CODE = source_digest(plotting.SOURCES)
+RESIDUALS_CODE = source_digest(plotting.SOURCES + comparison.SOURCES)
+TABLE_CODE = source_digest(comparison.SOURCES)
 
 # the r values with an exact solution, eq. (P(0,v)): always computed (Figs. 3 and 5)
 EXACT_BY_LABEL = {restitution_label(value): value for value in exact.EXACT_RESTITUTIONS}
@@ -96,3 +107,16 @@ def exact_targets():
 
 def fit_targets():
     return expand("results/fits/r{r}.parquet", r=RESTITUTION)
+
+
+def figure_labels(figure):
+    """The r labels of a figure's panels, config["figures"][figure] (checked to be simulated)."""
+    return list(restitution_grid(config["figures"][figure], f"figures.{figure}"))
+
+
+def figure_targets():
+    return expand("results/figures/fig{n}.{ext}", n=range(1, 8), ext=("pdf", "png"))
+
+
+def table_targets():
+    return ["results/tables/moments.csv", "results/tables/moments.md"]

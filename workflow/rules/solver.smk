@@ -14,7 +14,25 @@ rule solve:
         mem_mb=1000,
     params:
         restitution=restitution_value,
-        settings=config["solver"],
+        settings=solver_settings(config),
         code=SOLVER_CODE,
     script:
         "../../scripts/solve.py"
+
+
+rule solve_grid:
+    output:
+        "results/solver/time_averages.parquet",
+    log:
+        "logs/solver/time_averages.log",
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=10,
+        mem_mb=1000,
+    params:
+        grid=config["solver"]["restitution_grid"],
+        step=config["solver"]["quadrature_step"],
+        code=SOLVER_CODE,
+    script:
+        "../../scripts/solve_grid.py"

@@ -1,0 +1,187 @@
+# The figures: one rule and one script per figure; they read tables only, so a plotting
+# edit never re-runs a simulation or a solve.
+
+
+# Fig. 1: beta(r) and m(r) from the theory table.
+rule fig1:
+    input:
+        exponents="results/theory/exponents.parquet",
+    output:
+        "results/figures/fig1.pdf",
+        report(
+            "results/figures/fig1.png",
+            caption="../report/fig1.rst",
+            category="Figures",
+        ),
+    log:
+        "logs/figures/fig1.log",
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=1000,
+    params:
+        dpi=config["figures"]["png_dpi"],
+        code=FIGURE_CODE,
+    script:
+        "../../scripts/figures/fig1.py"
+
+
+# Fig. 2: q(r) from the theory table.
+rule fig2:
+    input:
+        exponents="results/theory/exponents.parquet",
+    output:
+        "results/figures/fig2.pdf",
+        report(
+            "results/figures/fig2.png",
+            caption="../report/fig2.rst",
+            category="Figures",
+        ),
+    log:
+        "logs/figures/fig2.log",
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=1000,
+    params:
+        dpi=config["figures"]["png_dpi"],
+        code=FIGURE_CODE,
+    script:
+        "../../scripts/figures/fig2.py"
+
+
+# Fig. 3: the exact P(x,v) at r = 1/2 and 1/3.
+rule fig3:
+    input:
+        distributions=expand("results/exact/r{r}/distribution.parquet", r=EXACT_LABELS),
+    output:
+        "results/figures/fig3.pdf",
+        report(
+            "results/figures/fig3.png",
+            caption="../report/fig3.rst",
+            category="Figures",
+        ),
+    log:
+        "logs/figures/fig3.log",
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=1000,
+    params:
+        dpi=config["figures"]["png_dpi"],
+        code=FIGURE_CODE,
+    script:
+        "../../scripts/figures/fig3.py"
+
+
+# Fig. 4: P(0,v), the asymptotic forms and the solver, r of figures.fig4.
+rule fig4:
+    input:
+        simulation=expand(
+            "results/simulation/r{r}/p0v.parquet", r=figure_labels("fig4")
+        ),
+        solver=expand("results/solver/r{r}/p0v.parquet", r=figure_labels("fig4")),
+        fits=expand("results/fits/r{r}.parquet", r=figure_labels("fig4")),
+    output:
+        "results/figures/fig4.pdf",
+        report(
+            "results/figures/fig4.png",
+            caption="../report/fig4.rst",
+            category="Figures",
+        ),
+    log:
+        "logs/figures/fig4.log",
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=1000,
+    params:
+        dpi=config["figures"]["png_dpi"],
+        code=FIGURE_CODE,
+    script:
+        "../../scripts/figures/fig4.py"
+
+
+# Fig. 5: P(0,v) against the exact solution, r of figures.fig5.
+rule fig5:
+    input:
+        simulation=expand(
+            "results/simulation/r{r}/p0v.parquet", r=figure_labels("fig5")
+        ),
+        exact=expand("results/exact/r{r}/p0v.parquet", r=figure_labels("fig5")),
+    output:
+        "results/figures/fig5.pdf",
+        report(
+            "results/figures/fig5.png",
+            caption="../report/fig5.rst",
+            category="Figures",
+        ),
+    log:
+        "logs/figures/fig5.log",
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=1000,
+    params:
+        dpi=config["figures"]["png_dpi"],
+        code=FIGURE_CODE,
+    script:
+        "../../scripts/figures/fig5.py"
+
+
+# Fig. 6: <x>, Delta x, I against r: solver grid, simulated r, exact values.
+rule fig6:
+    input:
+        grid="results/solver/time_averages.parquet",
+        simulation=expand("results/simulation/r{r}/summary.parquet", r=RESTITUTION),
+        exact=expand("results/exact/r{r}/summary.parquet", r=EXACT_LABELS),
+    output:
+        "results/figures/fig6.pdf",
+        report(
+            "results/figures/fig6.png",
+            caption="../report/fig6.rst",
+            category="Figures",
+        ),
+    log:
+        "logs/figures/fig6.log",
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=1000,
+    params:
+        dpi=config["figures"]["png_dpi"],
+        code=FIGURE_CODE,
+    script:
+        "../../scripts/figures/fig6.py"
+
+
+# Fig. 7: (simulation - solver) / sigma of P(0,v), every simulated r.
+rule fig7:
+    input:
+        simulation=expand("results/simulation/r{r}/p0v.parquet", r=RESTITUTION),
+        solver=expand("results/solver/r{r}/p0v.parquet", r=RESTITUTION),
+    output:
+        "results/figures/fig7.pdf",
+        report(
+            "results/figures/fig7.png",
+            caption="../report/fig7.rst",
+            category="Figures",
+        ),
+    log:
+        "logs/figures/fig7.log",
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=1000,
+    params:
+        dpi=config["figures"]["png_dpi"],
+        code=RESIDUALS_CODE,
+    script:
+        "../../scripts/figures/fig7.py"
