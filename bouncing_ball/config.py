@@ -59,7 +59,7 @@ def check_config(config: dict) -> dict[str, Fraction]:
             f"solver.restitution_grid: need {low} <= min < max <= {high} (the solver's accurate range), "
             f"got min = {solver_grid['min']}, max = {solver_grid['max']}"
         )
-    _check_figure_restitutions(config["figures"], grid)
+    figure_restitutions(config, grid)
     for side in ("small_speed_window", "large_speed_window"):
         window = config["fits"][side]
         if window != "auto" and not window["min"] < window["max"]:
@@ -79,21 +79,32 @@ def check_config(config: dict) -> dict[str, Fraction]:
 SOLVER_RESTITUTION_RANGE = (0.02, 0.999)
 
 
-def _check_figure_restitutions(figures: dict, grid: dict) -> None:
-    """The r of Figs. 4 and 5 must be simulated; Fig. 5's must have an exact solution."""
+def figure_restitutions(config: dict, grid: dict | None = None) -> dict[str, Fraction]:
+    """{label: exact r} of the panels of Figs. 4 and 5 (config["figures"]).
+
+    They need not be in ``restitution``: a figure asks for what it shows.  Fig. 5's
+    r must have an exact solution; an r that shares a label with one of
+    ``restitution`` must be the same r.
+    """
+    grid = restitution_grid(config["restitution"]) if grid is None else grid
+    shown = {}
     for figure in ("fig4", "fig5"):
-        labels = restitution_grid(figures[figure], f"figures.{figure}")
-        for index, (label, value) in enumerate(labels.items()):
+        values = config["figures"][figure]
+        for index, (label, value) in enumerate(restitution_grid(values, f"figures.{figure}").items()):
             where = f"figures.{figure}[{index}]"
-            if label not in grid:
-                raise ValueError(
-                    f"{where}: r = {figures[figure][index]!r} is not in restitution "
-                    f"({', '.join(grid)}); add it there or remove it here"
-                )
-            if grid[label] != value:
-                raise ValueError(f"{where}: r = {value} differs from restitution's r = {grid[label]} (label {label})")
             if figure == "fig5" and value not in EXACT_RESTITUTIONS:
-                raise ValueError(f"{where}: r = {figures[figure][index]!r} has no exact solution (only 1/2 and 1/3)")
+                raise ValueError(f"{where}: r = {values[index]!r} has no exact solution (only 1/2 and 1/3)")
+            for other in (grid, shown):
+                if label in other and other[label] != value:
+                    raise ValueError(f"{where}: r = {value} and r = {other[label]} share the label {label}")
+            shown[label] = value
+    return shown
+
+
+def known_restitutions(config: dict) -> dict[str, Fraction]:
+    """{label: exact r} of every r the config names: ``restitution`` and the figures' panels."""
+    grid = restitution_grid(config["restitution"])
+    return {**figure_restitutions(config, grid), **grid}
 
 
 # the keys of config["simulation"] that change the numbers a shard produces

@@ -46,8 +46,12 @@ def outgoing_speed_bin_average(lo, hi, restitution):
         rate = a * (np.exp(-lo) - np.exp(-hi))  # int v^0 e^{-v}
     else:
         # int v^{-1/2} e^{-3v/2} dv = Gamma(1/2) (3/2)^{-1/2} [P(1/2, 3v/2)]
+        # (the upper functions Q in the tail, where P -> 1 would cancel)
         scale = special.gamma(0.5) / np.sqrt(1.5)
-        rate = a * scale * (special.gammainc(0.5, 1.5 * hi) - special.gammainc(0.5, 1.5 * lo))
+        tail = 1.5 * lo > 0.5
+        lower = special.gammainc(0.5, 1.5 * hi) - special.gammainc(0.5, 1.5 * lo)
+        upper = special.gammaincc(0.5, 1.5 * lo) - special.gammaincc(0.5, 1.5 * hi)
+        rate = a * scale * np.where(tail, upper, lower)
     return rate / (0.5 * (hi**2 - lo**2))
 
 

@@ -89,3 +89,13 @@ def test_mean_speed_squared_agrees_between_forms():
     closed = exact.mean_speed_squared_given_position(x, Fraction(1, 2))
     tail = [integrate.quad(lambda y: float(exact.position_density(y, 0.5)), xi, np.inf)[0] for xi in x]
     np.testing.assert_allclose(closed, np.array(tail) / exact.position_density(x, 0.5), rtol=1e-9)
+
+
+@pytest.mark.parametrize("r", EXACT, ids=str)
+@pytest.mark.parametrize("lo, hi", [(1e-4, 1.26e-4), (0.3, 0.4), (25.0, 31.6), (40.0, 50.0)])
+def test_bin_average_of_the_outgoing_density(r, lo, hi):
+    """int v P(0,v) dv / int v dv over a bin, closed form against quadrature of eq. (P(0,v)),
+    also far in the tail (where a difference of regularised gamma functions near 1 would cancel)."""
+    direct, _ = integrate.quad(lambda v: v * exact.outgoing_speed_density(v, r), lo, hi, epsrel=1e-13)
+    closed = exact.outgoing_speed_bin_average(np.array([lo]), np.array([hi]), r)[0]
+    assert closed == pytest.approx(direct / (0.5 * (hi * hi - lo * lo)), rel=1e-12)

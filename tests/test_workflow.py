@@ -27,7 +27,11 @@ SMALL = {
         "position_bins": {"lo": 1.0e-3, "hi": 1.0e3, "per_decade": 5},
         "per_restitution": {"1/3": {"shards": 2}},
     },
-    "solver": {"quadrature_step": 0.25, "output_speeds": {"min": 1.0e-4, "max": 50, "points": 41}},
+    "solver": {
+        "quadrature_step": 0.25,
+        "output_speeds": {"min": 1.0e-4, "max": 50, "points": 41},
+        "restitution_grid": {"min": 0.1, "max": 0.9, "points": 5},
+    },
     "exact": {
         "positions": [0, 0.1],
         "speeds": {"min": -2, "max": 3, "points": 6},
@@ -35,7 +39,9 @@ SMALL = {
     },
     "theory": {"restitution_grid": {"min": 0.1, "max": 0.9, "points": 9}},
     "fits": {"minimum_count": 5, "max_bias": 0.5, "small_speed_window": "auto", "large_speed_window": "auto"},
+    "figures": {"fig4": [0.5], "fig5": ["1/3", "1/2"], "png_dpi": 60},
 }
+FIGURES = [f"results/figures/fig{n}.{ext}" for n in range(1, 8) for ext in ("pdf", "png")]
 
 pytestmark = pytest.mark.workflow
 
@@ -114,6 +120,55 @@ def test_run_produces_the_documented_tables(finished_run):
         assert len(fitted) == 20 and provenance["shards"] == {"0.5": 3, "0.333333": 2}[label]
 
 
+MOMENT_COLUMNS = ["r_label", "r", "quantity", "paper", "exact", "solver", "simulation", "simulation_err",
+                  "reference", "z"]
+
+
+def test_run_draws_every_figure_and_writes_the_moments_table(finished_run):
+    for name in FIGURES:
+        content = (finished_run / name).read_bytes()
+        assert content.startswith(b"%PDF" if name.endswith(".pdf") else b"\x89PNG"), name
+        assert (finished_run / "logs/figures" / (Path(name).stem + ".log")).exists()
+    table = pd.read_csv(finished_run / "results/tables/moments.csv")
+    assert list(table.columns) == MOMENT_COLUMNS and len(table) == 6
+    assert sorted(table.r_label.astype(str).unique()) == ["0.333333", "0.5"]
+    assert (table.reference == "exact").all()
+    for label, paper in (("0.5", {"mean_x": 6.0, "delta_x": 10.4}), ("0.333333", {"mean_x": 3.89, "delta_x": 7.68})):
+        summary, _ = read_table(finished_run / f"results/simulation/r{label}/summary.parquet")
+        exact, _ = read_table(finished_run / f"results/exact/r{label}/summary.parquet")
+        rows = table[table.r_label.astype(str) == label].set_index("quantity")
+        for quantity in ("mean_x", "delta_x", "collision_rate"):
+            row = rows.loc[quantity]
+            assert row.exact == pytest.approx(exact[quantity].iloc[0], rel=1e-11)
+            assert row.solver == pytest.approx(row.exact, rel=1e-8)
+            assert row.simulation == pytest.approx(summary[quantity].iloc[0], rel=1e-11)
+            z = (summary[quantity].iloc[0] - exact[quantity].iloc[0]) / summary[f"{quantity}_err"].iloc[0]
+            assert row.z == pytest.approx(z, rel=1e-9)
+            if quantity in paper:
+                assert row.paper == paper[quantity]
+    markdown = (finished_run / "results/tables/moments.md").read_text()
+    assert markdown.count("(vs exact)") == 6 and "±" in markdown
+    grid, _ = read_table(finished_run / "results/solver/time_averages.parquet")
+    assert grid.r.tolist() == pytest.approx([0.1, 0.3, 0.5, 0.7, 0.9])
+    assert grid.collision_rate.iloc[0] == float("inf")  # r = 0.1 < r_c
+    assert grid.mean_x.iloc[2] == pytest.approx(6.0, rel=1e-8)
+    assert grid.collision_rate.iloc[2] == pytest.approx(1.0 / 3.0, rel=1e-8)
+
+
+def test_the_report_has_every_figure_and_table_with_its_caption(finished_run, tmp_path):
+    report = tmp_path / "report.html"
+    result = snakemake(finished_run, "--report", str(report))
+    assert result.returncode == 0, result.stderr[-3000:]
+    text = report.read_text()
+    for name in [*(f"fig{n}.png" for n in range(1, 8)), "moments.csv"]:
+        assert name in text, name
+    for phrase in ("The exponents beta(r)", "The decay rate q(r)", "The exact P(x,v) against v",
+                   "Double-logarithmic plot of P(0,v)", "exact solution, eq. (P(0,v))",
+                   "The mean height", "Residuals (simulation - solver) / sigma",
+                   "The time averages of eq. (xandDeltax)"):
+        assert phrase in text, phrase
+
+
 def test_second_run_has_nothing_to_do(finished_run):
     result = snakemake(finished_run, "--dry-run")
     assert result.returncode == 0
@@ -151,12 +206,14 @@ def test_exact_one_third_does_not_need_one_third_in_the_config(finished_run, tmp
     assert result.returncode == 0, result.stderr[-3000:]
     _, provenance = read_table(directory / "results/exact/r0.333333/summary.parquet")
     assert provenance["r"] == "1/3"
+    # Fig. 5 still shows r = 1/3 (figures.fig5): its shards keep the exact value, nothing re-runs
+    assert planned_jobs(directory, None, "results/figures/fig5.pdf") == {}
 
 
-def planned_jobs(directory, env=None):
+def planned_jobs(directory, env=None, *targets):
     """{rule: count} of the jobs a dry run would execute (empty if nothing to do)."""
     result = subprocess.run(
-        [sys.executable, "-m", "snakemake", "--cores", "2", "--dry-run", "--quiet", "rules"],
+        [sys.executable, "-m", "snakemake", "--cores", "2", "--dry-run", *targets, "--quiet", "rules"],
         cwd=directory, capture_output=True, text=True, timeout=300, env=env,
     )
     assert result.returncode == 0, result.stderr[-3000:]
@@ -177,7 +234,63 @@ def test_adding_a_shard_runs_only_that_shard(finished_run, tmp_path):
     config = yaml.safe_load(yaml.safe_dump(SMALL))
     config["simulation"]["per_restitution"]["0.5"] = {"shards": 4}
     (directory / "config" / "config.yaml").write_text(yaml.safe_dump(config))
-    assert planned_jobs(directory) == {"simulate_shard": 1, "merge_shards": 1, "fit": 1, "all": 1}
+    assert planned_jobs(directory) == {
+        "simulate_shard": 1, "merge_shards": 1, "fit": 1, "fig4": 1, "fig5": 1, **AGGREGATES
+    }
+
+
+AGGREGATES = {"fig6": 1, "fig7": 1, "moments_table": 1, "all": 1}
+
+
+def test_adding_an_r_runs_only_its_jobs_and_the_aggregates(finished_run, tmp_path):
+    directory = tmp_path / "copy"
+    shutil.copytree(finished_run, directory)
+    config = yaml.safe_load(yaml.safe_dump(SMALL))
+    config["restitution"].append(0.6)
+    (directory / "config" / "config.yaml").write_text(yaml.safe_dump(config))
+    planned = planned_jobs(directory)
+    assert planned == {"simulate_shard": 3, "merge_shards": 1, "solve": 1, "fit": 1, **AGGREGATES}, planned
+    before = {path: path.stat().st_mtime_ns for path in (directory / "results").rglob("*") if path.is_file()}
+    result = snakemake(directory)
+    assert result.returncode == 0, result.stderr[-3000:]
+    changed = sorted(
+        str(path.relative_to(directory)) for path in (directory / "results").rglob("*")
+        if path.is_file() and before.get(path) != path.stat().st_mtime_ns
+    )
+    assert changed == sorted([
+        *(f"results/simulation/r0.6/{name}.parquet" for name in ("shard0", "shard1", "shard2", "p0v",
+                                                                 "position", "summary")),
+        "results/solver/r0.6/p0v.parquet", "results/solver/r0.6/summary.parquet", "results/fits/r0.6.parquet",
+        *(f"results/figures/fig{n}.{ext}" for n in (6, 7) for ext in ("pdf", "png")),
+        "results/tables/moments.csv", "results/tables/moments.md",
+    ])
+    assert len(pd.read_csv(directory / "results/tables/moments.csv")) == 9
+
+
+def test_editing_a_plotting_script_reruns_only_figures(finished_run, tmp_path):
+    directory = tmp_path / "copy"
+    shutil.copytree(finished_run, directory)
+    with open(directory / "scripts/figures/fig4.py", "a") as handle:
+        handle.write("\n# an edit\n")
+    assert planned_jobs(directory) == {"fig4": 1, "all": 1}
+    package, env = _package_copy(tmp_path)
+    with open(package / "plotting.py", "a") as handle:
+        handle.write("\n# an edit\n")
+    assert planned_jobs(finished_run, env) == {f"fig{n}": 1 for n in range(1, 8)} | {"all": 1}
+
+
+def test_one_target_builds_only_what_it_needs(tmp_path):
+    directory = _copy(tmp_path, SMALL)
+    assert planned_jobs(directory, None, "results/figures/fig5.pdf") == {
+        "simulate_shard": 5, "merge_shards": 2, "exact_solution": 2, "fig5": 1
+    }
+    assert planned_jobs(directory, None, "tables") == {
+        "simulate_shard": 5, "merge_shards": 2, "solve": 2, "exact_solution": 2, "moments_table": 1, "tables": 1
+    }
+    result = snakemake(directory, "results/figures/fig1.png")
+    assert result.returncode == 0, result.stderr[-3000:]
+    built = sorted(str(path.relative_to(directory)) for path in (directory / "results").rglob("*") if path.is_file())
+    assert built == ["results/figures/fig1.pdf", "results/figures/fig1.png", "results/theory/exponents.parquet"]
 
 
 def _package_copy(tmp_path):
@@ -192,16 +305,19 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
     assert planned_jobs(finished_run, env) == {}
     with open(package / "histograms.py", "a") as handle:
         handle.write("\n# an edit\n")
-    assert planned_jobs(finished_run, env) == {"merge_shards": 2, "fit": 2, "all": 1}
+    downstream = {"fig4": 1, "fig5": 1, **AGGREGATES}  # everything drawn from the simulation
+    assert planned_jobs(finished_run, env) == {"merge_shards": 2, "fit": 2, **downstream}
     with open(package / "free_flight.py", "a") as handle:
         handle.write("\n# an edit\n")
-    assert planned_jobs(finished_run, env) == {"simulate_shard": 5, "merge_shards": 2, "fit": 2, "all": 1}
+    assert planned_jobs(finished_run, env) == {"simulate_shard": 5, "merge_shards": 2, "fit": 2, **downstream}
+    solved = {"solve": 2, "fit": 2, "solve_grid": 1, "fig4": 1, "fig6": 1, "fig7": 1, "moments_table": 1}
     for module, expected in (
-        ("kernel", {"solve": 2, "fit": 2}),
-        ("solver", {"solve": 2, "fit": 2}),
-        ("exact", {"exact_solution": 2}),
-        ("fits", {"fit": 2}),
-        ("asymptotics", {"solve": 2, "fit": 2, "theory": 1}),
+        ("kernel", solved),
+        ("solver", solved),
+        ("exact", {"exact_solution": 2, "fig3": 1, "fig5": 1, "fig6": 1, "moments_table": 1}),
+        ("fits", {"fit": 2, "fig4": 1, "fig7": 1, "moments_table": 1}),  # comparison uses fits
+        ("asymptotics", {**solved, "theory": 1, "fig1": 1, "fig2": 1}),
+        ("comparison", {"fig7": 1, "moments_table": 1}),
     ):
         shutil.rmtree(package.parent)
         package, env = _package_copy(tmp_path)
@@ -269,6 +385,13 @@ BAD = [
     (_with(["fits", "max_bias"], 2.0), "max_bias"),
     (_with(["simulation", "shards"], 1), "shards"),
     (_with(["fits", "large_speed_window"], {"min": 5, "max": 2}), "fits.large_speed_window: min = 5"),
+    (_with(["solver", "restitution_grid", "min"], 0.01), "solver.restitution_grid: need 0.02 <= min"),
+    (_with(["figures", "fig4"], [0.6, "3/5"]), "figures.fig4[1]: r = '3/5' repeats"),
+    (_with(["figures", "fig4"], [0.3333333]), "figures.fig4[0]: r = 3333333/10000000 and r = 1/3 share the label"),
+    (_with(["figures", "fig5"], [0.5, 0.5]), "figures.fig5[1]: r = 0.5 repeats"),
+    (_with(["figures", "fig5"], [0.25]), "figures.fig5[0]: r = 0.25 has no exact solution"),
+    (_with(["figures", "png_dpi"], 10), "png_dpi"),
+    (_with(["figures", "fig6"], [0.5]), "'fig6' was unexpected"),
 ]
 
 

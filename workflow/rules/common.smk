@@ -13,6 +13,7 @@ from bouncing_ball import (
 from bouncing_ball.config import (
     check_config,
     exact_settings,
+    known_restitutions,
     solver_settings,
     shard_count,
     shard_settings,
@@ -28,6 +29,8 @@ try:
     RESTITUTION = check_config(config)  # {label: exact r}, refused before any job runs
 except ValueError as error:
     raise ValueError(f"invalid config: {error}") from None
+# with the r shown in Figs. 4 and 5, which need not be in `restitution`
+KNOWN_RESTITUTION = known_restitutions(config)
 
 # passed as params: an edit of a stage's library code re-runs that stage only
 SIMULATION_CODE = source_digest(simulation.SOURCES)
@@ -47,8 +50,8 @@ EXACT_LABELS = list(EXACT_BY_LABEL)
 
 def restitution_value(wildcards):
     """Exact r of a label: from the config, or the label itself read as a number."""
-    if wildcards.r in RESTITUTION:
-        return exact_string(RESTITUTION[wildcards.r])
+    if wildcards.r in KNOWN_RESTITUTION:
+        return exact_string(KNOWN_RESTITUTION[wildcards.r])
     exact = parse_restitution(wildcards.r, f"r label '{wildcards.r}'")
     if restitution_label(exact) != wildcards.r:
         raise ValueError(
@@ -110,7 +113,7 @@ def fit_targets():
 
 
 def figure_labels(figure):
-    """The r labels of a figure's panels, config["figures"][figure] (checked to be simulated)."""
+    """The r labels of a figure's panels, config["figures"][figure]."""
     return list(restitution_grid(config["figures"][figure], f"figures.{figure}"))
 
 

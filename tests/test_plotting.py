@@ -1,0 +1,78 @@
+"""The figures: what each one shows, and that they are written whole or not at all."""
+
+from fractions import Fraction
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from bouncing_ball import exact, plotting
+from bouncing_ball.asymptotics import CRITICAL_RESTITUTION, exponents_table
+
+
+@pytest.fixture(scope="module")
+def exponents():
+    return exponents_table(np.linspace(0.005, 0.995, 199))
+
+
+def test_fig1_shows_the_jump_of_m_at_one_half(exponents):
+    figure = plotting.exponents_figure(exponents, CRITICAL_RESTITUTION)
+    axis = figure.axes[0]
+    dashed = [line for line in axis.lines if line.get_linestyle() == "--"]
+    assert len(dashed) == 2  # m below and above r = 1/2, never joined across the jump
+    below, above = (np.asarray(line.get_xdata()) for line in dashed)
+    assert below.max() < 0.5 < above.min()
+    assert np.allclose(dashed[0].get_ydata(), 1.5)
+    dots = {(float(line.get_xdata()[0]), float(line.get_ydata()[0])) for line in axis.lines
+            if line.get_marker() == "o"}
+    assert dots == {(0.5, 1.0), (0.5, 1.5)}
+    vertical = [line for line in axis.lines if np.ptp(line.get_xdata()) == 0 and line.get_marker() != "o"]
+    assert vertical[0].get_xdata()[0] == pytest.approx(CRITICAL_RESTITUTION)
+
+
+def test_fig4_draws_what_it_can_when_a_fit_window_failed():
+    speeds = np.geomspace(1e-4, 50, 101)
+    edges = np.geomspace(1e-3, 10, 41)
+    truth = exact.outgoing_speed_bin_average(edges[:-1], edges[1:], Fraction(1, 2))
+    simulated = pd.DataFrame({"v_lo": edges[:-1], "v_hi": edges[1:], "v": np.sqrt(edges[:-1] * edges[1:]),
+                              "p0v": truth, "p0v_err": 0.01 * truth, "count": 100})
+    rows = []
+    for window, names in (("small_speed", ("prefactor", "beta")), ("large_speed", ("prefactor", "m", "q"))):
+        for name in names:
+            value = np.nan if window == "large_speed" else {"prefactor": 1 / 3, "beta": 1.0}[name]
+            rows.append({"source": "simulation", "window": window, "fit": "fixed_exponents",
+                         "parameter": name, "value": value, "v_min": 1e-3, "v_max": 1e-2})
+    panel = {"restitution": Fraction(1, 2), "simulated": simulated, "fits": pd.DataFrame(rows),
+             "solver": pd.DataFrame({"v": speeds, "p0v": exact.outgoing_speed_density(speeds, Fraction(1, 2))})}
+    axis = plotting.asymptotic_forms_figure([panel]).axes[0]
+    labels = [text.get_text() for text in axis.get_legend().get_texts()]
+    assert labels[0] == "solver, eq. (inteq)" and "simulation" in labels
+    assert any(r"\beta = 1" in label for label in labels) and not any("e^{-qv}" in label for label in labels)
+    assert axis.get_xscale() == axis.get_yscale() == "log"
+
+
+def test_fig7_reports_the_mean_squared_residual():
+    residuals = pd.DataFrame({"v": [0.1, 1.0, 10.0], "residual": [1.0, -2.0, 0.0]})
+    figure = plotting.residuals_figure([(Fraction(1, 4), residuals), (Fraction(3, 5), residuals)])
+    texts = [text.get_text() for axis in figure.axes for text in axis.texts]
+    assert len(figure.axes) == 2 and r"$\chi^2/n = 1.67$, $n = 3$" in texts[0]
+    assert texts[0].startswith("$r = 1/4$") and texts[1].startswith("$r = 3/5$")
+
+
+def test_figures_are_written_reproducibly_and_atomically(exponents, tmp_path):
+    figure = plotting.decay_rate_figure(exponents)
+    pdf, png = tmp_path / "fig2.pdf", tmp_path / "fig2.png"
+    plotting.save_figure(figure, pdf, png, 60, {"figure": "fig2"})
+    first = pdf.read_bytes()
+    plotting.save_figure(figure, pdf, png, 60, {"figure": "fig2"})
+    assert pdf.read_bytes() == first and png.read_bytes().startswith(b"\x89PNG")
+
+    def broken(path, **options):
+        with open(path, "wb") as handle:
+            handle.write(b"%PDF-1.4 half a figure")
+        raise RuntimeError("disk full")
+
+    figure.savefig = broken
+    with pytest.raises(RuntimeError, match="disk full"):
+        plotting.save_figure(figure, tmp_path / "new.pdf", tmp_path / "new.png", 60, {})
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["fig2.pdf", "fig2.png"]
