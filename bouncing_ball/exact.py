@@ -43,7 +43,7 @@ def outgoing_speed_bin_average(lo, hi, restitution):
     hi = np.asarray(hi, dtype=float)
     a = normalization_constant(restitution)
     if _which(restitution) == Fraction(1, 2):
-        rate = a * (np.exp(-lo) - np.exp(-hi))  # int v^0 e^{-v}
+        rate = a * np.exp(-lo) * -np.expm1(lo - hi)  # int v^0 e^{-v}, no cancellation in narrow bins
     else:
         # int v^{-1/2} e^{-3v/2} dv = Gamma(1/2) (3/2)^{-1/2} [P(1/2, 3v/2)]
         # (the upper functions Q in the tail, where P -> 1 would cancel)
