@@ -11,65 +11,9 @@ import pytest
 import yaml
 
 from bouncing_ball.io import read_table
-
-REPOSITORY = Path(__file__).resolve().parents[1]
-SMALL = {
-    "restitution": [0.5, "1/3"],
-    "seed": 5,
-    "simulation": {
-        "shards": 3,
-        "shard_time": 2.0e3,
-        "equilibration_time": 50.0,
-        "criterion_c": 5.0,
-        "min_step_divisor": 500,
-        "max_steps": 1.0e9,
-        "speed_bins": {"lo": 1.0e-4, "hi": 1.0e2, "per_decade": 10},
-        "position_bins": {"lo": 1.0e-3, "hi": 1.0e3, "per_decade": 5},
-        "per_restitution": {"1/3": {"shards": 2}},
-    },
-    "solver": {
-        "quadrature_step": 0.25,
-        "output_speeds": {"min": 1.0e-4, "max": 50, "points": 41},
-        "restitution_grid": {"min": 0.1, "max": 0.9, "points": 5},
-    },
-    "exact": {
-        "positions": [0, 0.1],
-        "speeds": {"min": -2, "max": 3, "points": 6},
-        "position_grid": {"min": 1.0e-3, "max": 100, "points": 6},
-    },
-    "theory": {"restitution_grid": {"min": 0.1, "max": 0.9, "points": 9}},
-    "fits": {"minimum_count": 5, "max_bias": 0.5, "small_speed_window": "auto", "large_speed_window": "auto"},
-    "figures": {"fig4": [0.5], "fig5": ["1/3", "1/2"], "png_dpi": 60},
-}
-FIGURES = [f"results/figures/fig{n}.{ext}" for n in range(1, 8) for ext in ("pdf", "png")]
+from workflow_support import FIGURES, REPOSITORY, SMALL, copy_repository, planned_jobs, snakemake
 
 pytestmark = pytest.mark.workflow
-
-
-def _copy(tmp_path, config):
-    for name in ("Snakefile", "workflow", "scripts", "config"):
-        source = REPOSITORY / name
-        if source.is_dir():
-            shutil.copytree(source, tmp_path / name)
-        else:
-            shutil.copy(source, tmp_path / name)
-    (tmp_path / "config" / "config.yaml").write_text(yaml.safe_dump(config))
-    return tmp_path
-
-
-def snakemake(directory, *arguments):
-    return subprocess.run(
-        [sys.executable, "-m", "snakemake", "--cores", "2", *arguments],
-        cwd=directory, capture_output=True, text=True, timeout=600,
-    )
-
-
-@pytest.fixture(scope="module")
-def finished_run(tmp_path_factory):
-    directory = _copy(tmp_path_factory.mktemp("workflow"), SMALL)
-    result = snakemake(directory)
-    assert result.returncode == 0, result.stderr[-3000:]
-    return directory
 
 
 def test_run_produces_the_documented_tables(finished_run):
@@ -175,7 +119,8 @@ def test_second_run_has_nothing_to_do(finished_run):
     assert "Nothing to be done" in result.stdout + result.stderr
 
 
-def test_an_r_not_in_the_config_is_a_valid_target(finished_run):
+def test_an_r_not_in_the_config_is_a_valid_target(finished_run, tmp_path):
+    finished_run = shutil.copytree(finished_run, tmp_path / "copy")  # the shared run stays as it is
     target = "results/simulation/r0.6/summary.parquet"
     result = snakemake(finished_run, target)
     assert result.returncode == 0, result.stderr[-3000:]
@@ -208,24 +153,6 @@ def test_exact_one_third_does_not_need_one_third_in_the_config(finished_run, tmp
     assert provenance["r"] == "1/3"
     # Fig. 5 still shows r = 1/3 (figures.fig5): its shards keep the exact value, nothing re-runs
     assert planned_jobs(directory, None, "results/figures/fig5.pdf") == {}
-
-
-def planned_jobs(directory, env=None, *targets):
-    """{rule: count} of the jobs a dry run would execute (empty if nothing to do)."""
-    result = subprocess.run(
-        [sys.executable, "-m", "snakemake", "--cores", "2", "--dry-run", *targets, "--quiet", "rules"],
-        cwd=directory, capture_output=True, text=True, timeout=300, env=env,
-    )
-    assert result.returncode == 0, result.stderr[-3000:]
-    jobs = {}
-    lines = (result.stdout + result.stderr).splitlines()
-    if "Job stats:" in lines:
-        for line in lines[lines.index("Job stats:") + 3:]:
-            parts = line.split()
-            if len(parts) != 2 or parts[0] == "total":
-                break
-            jobs[parts[0]] = int(parts[1])
-    return jobs
 
 
 def test_adding_a_shard_runs_only_that_shard(finished_run, tmp_path):
@@ -273,14 +200,14 @@ def test_editing_a_plotting_script_reruns_only_figures(finished_run, tmp_path):
     with open(directory / "scripts/figures/fig4.py", "a") as handle:
         handle.write("\n# an edit\n")
     assert planned_jobs(directory) == {"fig4": 1, "all": 1}
-    package, env = _package_copy(tmp_path)
+    package, env = _packagecopy_repository(tmp_path)
     with open(package / "plotting.py", "a") as handle:
         handle.write("\n# an edit\n")
     assert planned_jobs(finished_run, env) == {f"fig{n}": 1 for n in range(1, 8)} | {"all": 1}
 
 
 def test_one_target_builds_only_what_it_needs(tmp_path):
-    directory = _copy(tmp_path, SMALL)
+    directory = copy_repository(tmp_path, SMALL)
     assert planned_jobs(directory, None, "results/figures/fig5.pdf") == {
         "simulate_shard": 5, "merge_shards": 2, "exact_solution": 2, "fig5": 1
     }
@@ -293,7 +220,7 @@ def test_one_target_builds_only_what_it_needs(tmp_path):
     assert built == ["results/figures/fig1.pdf", "results/figures/fig1.png", "results/theory/exponents.parquet"]
 
 
-def _package_copy(tmp_path):
+def _packagecopy_repository(tmp_path):
     """A copy of the library that PYTHONPATH puts in front of the installed one."""
     shutil.copytree(REPOSITORY / "bouncing_ball", tmp_path / "lib" / "bouncing_ball",
                     ignore=shutil.ignore_patterns("__pycache__"))
@@ -301,7 +228,7 @@ def _package_copy(tmp_path):
 
 
 def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
-    package, env = _package_copy(tmp_path)
+    package, env = _packagecopy_repository(tmp_path)
     assert planned_jobs(finished_run, env) == {}
     with open(package / "histograms.py", "a") as handle:
         handle.write("\n# an edit\n")
@@ -320,7 +247,7 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
         ("comparison", {"fig7": 1, "moments_table": 1}),
     ):
         shutil.rmtree(package.parent)
-        package, env = _package_copy(tmp_path)
+        package, env = _packagecopy_repository(tmp_path)
         with open(package / f"{module}.py", "a") as handle:
             handle.write("\n# an edit\n")
         assert planned_jobs(finished_run, env) == {**expected, "all": 1}, module
@@ -328,7 +255,7 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
 
 def test_results_do_not_depend_on_cores(finished_run, tmp_path):
     """The same config with --cores 1 gives bit-identical tables."""
-    directory = _copy(tmp_path, SMALL)
+    directory = copy_repository(tmp_path, SMALL)
     result = subprocess.run(
         [sys.executable, "-m", "snakemake", "--cores", "1", "results/simulation/r0.5/p0v.parquet",
          "results/simulation/r0.5/summary.parquet", "results/simulation/r0.5/position.parquet"],
@@ -397,7 +324,7 @@ BAD = [
 
 @pytest.mark.parametrize("config, key", BAD, ids=[key.split(":")[0] for _, key in BAD])
 def test_bad_config_is_refused_before_any_job_runs(tmp_path, config, key):
-    directory = _copy(tmp_path, config)
+    directory = copy_repository(tmp_path, config)
     result = snakemake(directory)
     assert result.returncode != 0
     assert key in result.stderr + result.stdout
@@ -465,3 +392,26 @@ def test_scripts_run_by_hand(tmp_path):
     )
     summary, provenance = read_table(solved["summary"])
     assert provenance["r"] == "3/5" and abs(summary.energy_balance_residual.iloc[0]) < 1e-8
+
+
+def test_figure_and_table_scripts_run_by_hand(tmp_path):
+    """Fig. 1 from a theory table, and the moments table from summaries, outside Snakemake."""
+    config = tmp_path / "config.yaml"
+    config.write_text(yaml.safe_dump(SMALL))
+    exponents = tmp_path / "exponents.parquet"
+    for command in (
+        ["scripts/theory.py", str(exponents), "--config", str(config)],
+        ["scripts/figures/fig1.py", str(exponents), "--pdf", str(tmp_path / "fig1.pdf"),
+         "--png", str(tmp_path / "fig1.png"), "--dpi", "50"],
+        ["scripts/solve.py", "--restitution", "1/2", "--p0v", str(tmp_path / "p0v.parquet"),
+         "--summary", str(tmp_path / "solved.parquet"), "--config", str(config)],
+    ):
+        subprocess.run([sys.executable, *command], cwd=REPOSITORY, check=True, capture_output=True, timeout=300)
+    assert (tmp_path / "fig1.pdf").read_bytes().startswith(b"%PDF")
+    # the solver's summary stands in for a simulation's: z needs *_err columns, so it is refused by name
+    result = subprocess.run(
+        [sys.executable, "scripts/moments_table.py", "--simulation", str(tmp_path / "solved.parquet"),
+         "--solver", str(tmp_path / "solved.parquet"), "--csv", str(tmp_path / "m.csv"), "--md", str(tmp_path / "m.md")],
+        cwd=REPOSITORY, capture_output=True, text=True, timeout=300,
+    )
+    assert result.returncode != 0 and not (tmp_path / "m.csv").exists()

@@ -1,0 +1,132 @@
+"""Interrupted runs, corrupt files and reruns: the workflow recovers and the numbers do not change."""
+
+import os
+import signal
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+
+from bouncing_ball.io import read_table
+from workflow_support import SMALL, copy_repository, snakemake
+
+pytestmark = pytest.mark.workflow
+
+# three shards of r = 1/2 that each compute for a few seconds, so a job can be killed mid-run
+LONG = yaml.safe_load(yaml.safe_dump(SMALL)) | {"restitution": [0.5]}
+LONG["simulation"]["per_restitution"] = {"0.5": {"shards": 3, "shard_time": 2.0e6}}
+TABLES = [f"results/simulation/r0.5/{name}.parquet" for name in ("p0v", "position", "summary")]
+
+
+@pytest.fixture(scope="module")
+def uninterrupted(tmp_path_factory):
+    directory = copy_repository(tmp_path_factory.mktemp("uninterrupted"), LONG)
+    result = snakemake(directory, *TABLES)
+    assert result.returncode == 0, result.stderr[-3000:]
+    return directory
+
+
+def _shard_processes(directory):
+    """Pids of the simulate_shard scripts running in ``directory``."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            command = (entry / "cmdline").read_bytes()
+            folder = os.readlink(entry / "cwd")
+        except OSError:
+            continue
+        if b"simulate_shard" in command and b"snakemake" not in command.split(b"\0")[0] and folder == str(directory):
+            found.append(int(entry.name))
+    return found
+
+
+def _start(directory):
+    return subprocess.Popen(
+        [sys.executable, "-m", "snakemake", "--cores", "2", *TABLES], cwd=directory,
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True,
+    )
+
+
+def _wait_for_a_computing_shard(directory, running_for=1.5, timeout=120):
+    """A shard job that has run ``running_for`` seconds (past start-up, inside the loop)."""
+    deadline = time.monotonic() + timeout
+    seen = {}
+    while time.monotonic() < deadline:
+        now = time.monotonic()
+        for pid in _shard_processes(directory):
+            seen.setdefault(pid, now)
+            if now - seen[pid] >= running_for:
+                return pid
+        time.sleep(0.05)
+    raise AssertionError("no simulate_shard job was seen running")
+
+
+def _assert_same_tables(directory, reference):
+    for table in TABLES:
+        got, _ = read_table(directory / table)
+        expected, _ = read_table(reference / table)
+        pd.testing.assert_frame_equal(got, expected, check_exact=True)
+
+
+def _assert_no_half_files(directory):
+    folder = directory / "results/simulation/r0.5"
+    for path in folder.glob("*.parquet"):
+        read_table(path)  # every file there is whole
+    assert not list(folder.glob(".*")), "temporary files left behind"
+
+
+@pytest.mark.parametrize("how", ["kill the shard job", "kill snakemake and its jobs", "interrupt (Ctrl-C)"])
+def test_an_interrupted_run_completes_on_rerun_with_the_same_numbers(uninterrupted, tmp_path, how):
+    directory = copy_repository(tmp_path, LONG)
+    run = _start(directory)
+    victim = _wait_for_a_computing_shard(directory)
+    if how == "kill the shard job":
+        os.kill(victim, signal.SIGKILL)
+    elif how == "kill snakemake and its jobs":
+        os.killpg(run.pid, signal.SIGKILL)
+    else:
+        os.killpg(run.pid, signal.SIGINT)  # what Ctrl-C in a terminal sends
+    output, _ = run.communicate(timeout=300)
+    assert run.returncode != 0, output[-2000:]
+    assert not (directory / TABLES[2]).exists()
+    _assert_no_half_files(directory)
+    # what the README tells a user to type: the same command again
+    result = snakemake(directory, *TABLES)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-3000:]
+    _assert_same_tables(directory, uninterrupted)
+    _assert_no_half_files(directory)
+
+
+def test_a_truncated_shard_is_named_and_forcing_its_rule_recovers(uninterrupted, tmp_path):
+    directory = tmp_path / "copy"
+    shutil.copytree(uninterrupted, directory)
+    shard = directory / "results/simulation/r0.5/shard1.parquet"
+    content = shard.read_bytes()
+    shard.write_bytes(content[: len(content) // 2])
+    result = snakemake(directory, *TABLES)
+    assert result.returncode != 0
+    message = result.stdout + result.stderr
+    assert "results/simulation/r0.5/shard1.parquet: not a readable Parquet file" in message
+    assert "--forcerun results/simulation/r0.5/shard1.parquet" in message  # the way out
+    assert "pyarrow" not in message.split("shard1.parquet: not a readable")[0][-300:]
+    result = snakemake(directory, "--forcerun", "results/simulation/r0.5/shard1.parquet", *TABLES)
+    assert result.returncode == 0, result.stderr[-3000:]
+    _assert_same_tables(directory, uninterrupted)  # a re-run shard is bit-identical
+
+
+def test_a_corrupt_merged_table_is_named_by_the_rule_that_reads_it(finished_run, tmp_path):
+    directory = tmp_path / "copy"
+    shutil.copytree(finished_run, directory)
+    table = directory / "results/simulation/r0.5/p0v.parquet"
+    table.write_bytes(b"not parquet at all")
+    result = snakemake(directory, "results/figures/fig5.pdf")  # newer than fig5: fig5 re-runs, reads it
+    assert result.returncode != 0
+    assert "results/simulation/r0.5/p0v.parquet: not a readable Parquet file" in result.stdout + result.stderr
+    assert (directory / "results/figures/fig4.pdf").exists()  # nothing else was lost
