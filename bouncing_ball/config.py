@@ -113,6 +113,7 @@ SHARD_SETTINGS = (
     "equilibration_time",
     "criterion_c",
     "min_step_divisor",
+    "min_step_floor",
     "max_steps",
     "speed_bins",
     "position_bins",
@@ -122,7 +123,8 @@ SHARD_SETTINGS = (
 def simulation_settings(config: dict, label: str) -> dict:
     """The simulation parameters of one r: the defaults with its overrides applied."""
     simulation = config["simulation"]
-    settings = {k: v for k, v in simulation.items() if k != "per_restitution"}
+    settings = {"min_step_floor": 0.0}  # optional key: the paper's rule alone
+    settings.update({k: v for k, v in simulation.items() if k != "per_restitution"})
     for key, override in simulation.get("per_restitution", {}).items():
         if restitution_label(parse_restitution(key)) == label:
             settings.update(override)

@@ -29,6 +29,8 @@ def atomic_path(path):
     block finishes, removed otherwise, so a reader never sees a half-written file."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    for stale in path.parent.glob(f".{path.stem}.*{path.suffix}"):
+        stale.unlink(missing_ok=True)  # left by a writer that was killed (SIGKILL skips the cleanup below)
     handle, temporary = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
     os.close(handle)
     try:
@@ -63,9 +65,20 @@ def read_table(path) -> tuple[pd.DataFrame, dict]:
     except (pa.ArrowException, OSError) as error:
         raise UnreadableFileError(
             f"{path}: not a readable Parquet file ({error}). It is probably truncated or "
-            "corrupt: delete it, or rerun the rule that makes it (snakemake --forcerun RULE)."
+            f"corrupt: make it again with  snakemake --cores 2 --forcerun {path}  (plus your targets)"
         ) from None
     raw = (table.schema.metadata or {}).get(METADATA_KEY)
     if raw is None:
-        raise UnreadableFileError(f"{path}: no '{METADATA_KEY.decode()}' provenance metadata")
+        raise UnreadableFileError(
+            f"{path}: no '{METADATA_KEY.decode()}' provenance metadata: not written by this workflow; "
+            f"make it again with  snakemake --cores 2 --forcerun {path}"
+        )
     return table.to_pandas(), json.loads(raw)
+
+
+def require_columns(frame: pd.DataFrame, path, columns) -> pd.DataFrame:
+    """``frame`` if it has ``columns``; otherwise an error naming the file and what is missing."""
+    missing = [column for column in columns if column not in frame.columns]
+    if missing:
+        raise UnreadableFileError(f"{path}: not the expected table, it lacks the columns {', '.join(missing)}")
+    return frame

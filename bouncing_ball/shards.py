@@ -1,7 +1,9 @@
 """Reading a set of shard files back, with every check a downstream step needs."""
 
+from .asymptotics import CRITICAL_RESTITUTION
 from .config import SHARD_SETTINGS, log_bins
 from .io import UnreadableFileError, read_table
+from .restitution import parse_restitution
 from .tallies import tallies_from_frame
 
 
@@ -37,10 +39,18 @@ def read_shards(paths, label):
         except (KeyError, ValueError) as error:
             raise UnreadableFileError(f"{path}: malformed shard ({error})") from None
         if not shards[-1].time > 0.0:
+            below = parse_restitution(provenance["r"]) < CRITICAL_RESTITUTION
+            advice = (
+                f"r = {provenance['r']} is below r_c = {CRITICAL_RESTITUTION:.4f}: the particle collapses onto "
+                "the floor (infinitely many collisions in a finite time) and a larger budget cannot help. "
+                "Set simulation.min_step_floor (e.g. 1.0e-10, per r under simulation.per_restitution) "
+                "to regularise the collapse (README, 'Below r_c')."
+                if below and not provenance.get("min_step_floor", 0.0) > 0.0
+                else "Raise the budget or shorten equilibration_time, then rerun this shard."
+            )
             raise UnreadableFileError(
                 f"{path}: recorded no time: its step budget (simulation.max_steps = "
-                f"{provenance['max_steps']}) ran out during equilibration. Raise the budget "
-                "or shorten equilibration_time, then rerun this shard."
+                f"{provenance['max_steps']}) ran out during equilibration. {advice}"
             )
         provenances.append(provenance)
     return shards, provenances

@@ -30,6 +30,22 @@ depends on the state):
 
 A shard's work is bounded: it stops after ``max_steps`` steps (equilibration
 included) even if the simulated time has not been reached, and says so.
+
+Below r_c = exp(-pi / sqrt 3) (inelastic collapse).  The collision rate I
+of eq. (collrate) is infinite there: each collision shrinks the outgoing
+speed by a random factor whose mean logarithm is negative, the speeds go
+to zero geometrically, and infinitely many collisions happen in a finite
+time.  With the paper's rule alone, delta shrinks with v_out and the
+simulation follows the collapse until the step budget runs out or the step falls below
+COLLAPSED_STEP (speeds ~ 1e-37; the shard then stops and says so, as for
+an exhausted budget);
+simulated time stops advancing.  A floor on the minimum step, delta >= min_step_floor,
+is the regularisation: once v_out falls below about
+min_step_divisor * (2 min_step_floor)^(1/2) a single step's noise
+(2 delta)^(1/2) exceeds the speed and lifts the particle off the floor,
+so the collapse is cut off at speeds of order (2 min_step_floor)^(1/2).
+What the regularised process gives above that speed scale, and how I grows
+as the floor goes to zero, is measured, not assumed (README).
 """
 
 import math
@@ -169,12 +185,18 @@ def _tally_step(a, dt, tau, x_tau, slope_tau, k, edges, bin_lower, bin_upper, ti
     return k
 
 
+# a step this short only happens in a collapse (v ~ 1e-37); much shorter ones overflow the bridge's
+# cubic coefficients (~ x / dt^2) before the speed underflows to zero
+COLLAPSED_STEP = 1.0e-80
+
+
 @njit(cache=True)
 def _run(
     rng,
     restitution,
     c,
     min_step_divisor,
+    min_step_floor,
     equilibration_time,
     recorded_time,
     max_steps,
@@ -204,7 +226,7 @@ def _run(
     v = 0.0
     x_bin = _bin_index(x, x_log_lo, x_per_ln, nx, x_edges)  # kept while recording
     min_root_2delta = 1.0 / min_step_divisor
-    delta = 0.5 * min_root_2delta * min_root_2delta
+    delta = max(0.5 * min_root_2delta * min_root_2delta, min_step_floor)
     recording = equilibration_time <= 0.0
     t = 0.0
     t_stop = recorded_time if recording else equilibration_time
@@ -228,6 +250,9 @@ def _run(
             exhausted = 1
             break
         dt = largest_safe_step(x, v, c) + delta  # eq. (criterion) plus delta
+        if not dt > COLLAPSED_STEP:  # below r_c without a floor on delta: the speed is going to 0
+            exhausted = 1
+            break
         if t + dt > t_stop:
             dt = t_stop - t
         normal_r = rng.standard_normal()
@@ -262,7 +287,7 @@ def _run(
             x_bin = 0
             v = v_out
             root_2delta = v_out * min_root_2delta
-            delta = 0.5 * root_2delta * root_2delta
+            delta = max(0.5 * root_2delta * root_2delta, min_step_floor)  # below r_c: regularises
         else:
             x = x1
             v = v1
@@ -285,8 +310,13 @@ def simulate_shard(
     max_steps: int,
     speed_bins: LogBins,
     position_bins: LogBins,
+    min_step_floor: float = 0.0,
 ) -> ShardTallies:
-    """Run one shard and return its tallies (pure: no I/O)."""
+    """Run one shard and return its tallies (pure: no I/O).
+
+    ``min_step_floor`` is a lower bound on delta (0: the paper's rule alone).
+    Below r_c it is what keeps the simulation going: see the module docstring.
+    """
     if not 0.0 < restitution < 1.0:
         raise ValueError(f"restitution must lie in (0, 1), got {restitution}")
     rng = np.random.Generator(np.random.PCG64(seed_sequence))
@@ -299,6 +329,7 @@ def simulate_shard(
         float(restitution),
         float(criterion_c),
         float(min_step_divisor),
+        float(min_step_floor),
         float(equilibration_time),
         float(recorded_time),
         int(max_steps),

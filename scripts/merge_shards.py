@@ -48,8 +48,9 @@ def main(shard_paths, restitution, p0v_path, position_path, summary_path):
     )
     if row.shards_out_of_budget:
         logging.warning(
-            "r=%s: %d of %d shards ran out of their step budget (simulation.max_steps) "
-            "before shard_time; the estimates weight every shard by the time it recorded",
+            "r=%s: %d of %d shards stopped before shard_time (step budget simulation.max_steps exhausted, "
+            "or below/near r_c a speed collapse: see simulation.min_step_floor); the estimates weight "
+            "every shard by the time it recorded",
             label, row.shards_out_of_budget, len(shards),
         )
 

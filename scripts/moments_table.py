@@ -14,8 +14,8 @@ import argparse
 import logging
 from pathlib import Path
 
-from bouncing_ball.comparison import moment_rows, moments_markdown, moments_table
-from bouncing_ball.io import atomic_path, read_table
+from bouncing_ball.comparison import QUANTITIES, moment_rows, moments_markdown, moments_table
+from bouncing_ball.io import atomic_path, read_table, require_columns
 from bouncing_ball.restitution import parse_restitution
 
 
@@ -23,11 +23,14 @@ def main(simulation_paths, solver_paths, exact_paths, csv_path, md_path):
     exact = {}
     for path in exact_paths:
         summary, provenance = read_table(path)
+        require_columns(summary, path, QUANTITIES)
         exact[parse_restitution(provenance["r"])] = summary.iloc[0]
     rows = []
     for simulation, solver in zip(simulation_paths, solver_paths, strict=True):
         simulated, provenance = read_table(simulation)
+        require_columns(simulated, simulation, [*QUANTITIES, *(f"{name}_err" for name in QUANTITIES)])
         solved, solver_provenance = read_table(solver)
+        require_columns(solved, solver, QUANTITIES)
         restitution = parse_restitution(provenance["r"])
         if parse_restitution(solver_provenance["r"]) != restitution:
             raise ValueError(f"{simulation} (r = {provenance['r']}) and {solver} "

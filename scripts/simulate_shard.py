@@ -33,6 +33,7 @@ def main(output, restitution, shard, seed, settings):
         equilibration_time=float(settings["equilibration_time"]),
         criterion_c=float(settings["criterion_c"]),
         min_step_divisor=float(settings["min_step_divisor"]),
+        min_step_floor=float(settings["min_step_floor"]),
         max_steps=int(settings["max_steps"]),
         speed_bins=log_bins(settings["speed_bins"]),
         position_bins=log_bins(settings["position_bins"]),
@@ -51,7 +52,8 @@ def main(output, restitution, shard, seed, settings):
     logging.info(
         "r=%s shard %d: time %.6g, %d collisions, %d steps, %.1f s%s",
         label, shard, tallies.time, tallies.collisions, tallies.steps, elapsed,
-        " -- STEP BUDGET EXHAUSTED (simulation.max_steps)" if tallies.budget_exhausted else "",
+        " -- STOPPED EARLY: STEP BUDGET EXHAUSTED (simulation.max_steps) or the speed collapsed towards 0"
+        " (below or near r_c; see simulation.min_step_floor)" if tallies.budget_exhausted else "",
     )
 
 
@@ -64,13 +66,16 @@ def _command_line():
     parser.add_argument("--shard", type=int, required=True)
     parser.add_argument("--config", default="config/config.yaml", help="settings and seed from here")
     parser.add_argument("--shard-time", type=float, help="override the config's shard_time")
+    parser.add_argument("--max-steps", type=int, help="override the config's max_steps")
+    parser.add_argument("--min-step-floor", type=float, help="override the config's min_step_floor")
     args = parser.parse_args()
     with open(args.config) as handle:
         config = yaml.safe_load(handle)
     check_config(config)
     settings = shard_settings(config, restitution_label(parse_restitution(args.restitution)))
-    if args.shard_time is not None:
-        settings["shard_time"] = args.shard_time
+    for key in ("shard_time", "max_steps", "min_step_floor"):
+        if getattr(args, key) is not None:
+            settings[key] = getattr(args, key)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     main(args.output, args.restitution, args.shard, config["seed"], settings)
 

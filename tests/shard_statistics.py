@@ -14,7 +14,7 @@ POSITION_BINS = LogBins(1e-3, 1e3, 5)
 
 
 def _shard(arguments):
-    r, shard, recorded_time, seed = arguments
+    r, shard, recorded_time, seed, floor = arguments
     return simulate_shard(
         restitution=float(r),
         seed_sequence=shard_seed_sequence(seed, restitution_label(r), shard),
@@ -25,12 +25,14 @@ def _shard(arguments):
         max_steps=10**12,
         speed_bins=SPEED_BINS,
         position_bins=POSITION_BINS,
+        min_step_floor=floor,
     )
 
 
-def simulate_shards(shard_times, shards, seed):
-    """{r: [ShardTallies]} for {r: recorded time per shard}, two processes, the paper's c and delta rule."""
-    jobs = [(r, k, time, seed) for r, time in shard_times.items() for k in range(shards)]
+def simulate_shards(shard_times, shards, seed, min_step_floor=0.0):
+    """{r: [ShardTallies]} for {r: recorded time per shard}, two processes, the paper's c and delta rule
+    (with a floor on delta if ``min_step_floor`` > 0)."""
+    jobs = [(r, k, time, seed, min_step_floor) for r, time in shard_times.items() for k in range(shards)]
     with ProcessPoolExecutor(2) as pool:
         results = list(pool.map(_shard, jobs))
     return {r: [s for (rr, *_), s in zip(jobs, results) if rr == r] for r in shard_times}

@@ -408,10 +408,11 @@ def test_figure_and_table_scripts_run_by_hand(tmp_path):
     ):
         subprocess.run([sys.executable, *command], cwd=REPOSITORY, check=True, capture_output=True, timeout=300)
     assert (tmp_path / "fig1.pdf").read_bytes().startswith(b"%PDF")
-    # the solver's summary stands in for a simulation's: z needs *_err columns, so it is refused by name
+    # the solver's summary stands in for a simulation's: it has no errors, so it is refused by name
     result = subprocess.run(
         [sys.executable, "scripts/moments_table.py", "--simulation", str(tmp_path / "solved.parquet"),
          "--solver", str(tmp_path / "solved.parquet"), "--csv", str(tmp_path / "m.csv"), "--md", str(tmp_path / "m.md")],
         cwd=REPOSITORY, capture_output=True, text=True, timeout=300,
     )
     assert result.returncode != 0 and not (tmp_path / "m.csv").exists()
+    assert f"{tmp_path / 'solved.parquet'}: not the expected table, it lacks the columns mean_x_err" in result.stderr

@@ -33,7 +33,7 @@ KNOWN_RESTITUTION = known_restitutions(config)
 
 # passed as params: an edit of a stage's library code re-runs that stage only
 SIMULATION_CODE = source_digest(simulation.SOURCES)
-MERGE_CODE = source_digest(histograms.SOURCES)
+MERGE_CODE = source_digest(histograms.SOURCES + ("shards",))  # reading shards back
 SOLVER_CODE = source_digest(solver.SOURCES)
 EXACT_CODE = source_digest(("exact",))
 THEORY_CODE = source_digest(asymptotics.SOURCES)
