@@ -8,6 +8,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 import yaml
@@ -135,3 +136,26 @@ def test_a_corrupt_merged_table_is_named_by_the_rule_that_reads_it(finished_run,
     assert result.returncode != 0
     assert "results/simulation/r0.5/p0v.parquet: not a readable Parquet file" in result.stdout + result.stderr
     assert (directory / "results/figures/fig4.pdf").exists()  # nothing else was lost
+
+
+def test_extreme_r_runs_end_to_end_within_its_budget(tmp_path):
+    """r = 0.05 (below r_c, with a floor on delta) and r = 0.98 (slow relaxation, <x> ~ 4000):
+    every stage finishes; the solver meets its accuracy; I is infinite below r_c."""
+    config = yaml.safe_load(yaml.safe_dump(SMALL)) | {"restitution": [0.05, 0.98]}
+    config["simulation"]["per_restitution"] = {"0.05": {"min_step_floor": 1.0e-12}}
+    directory = copy_repository(tmp_path, config)
+    targets = [f"results/{kind}/r{label}/summary.parquet" for kind in ("simulation", "solver")
+               for label in ("0.05", "0.98")]
+    result = snakemake(directory, *targets, "results/fits/r0.05.parquet", "results/fits/r0.98.parquet",
+                       "results/tables/moments.csv")
+    assert result.returncode == 0, result.stderr[-3000:]
+    for label in ("0.05", "0.98"):
+        simulated, _ = read_table(directory / f"results/simulation/r{label}/summary.parquet")
+        assert simulated.shards_out_of_budget.iloc[0] == 0
+        assert simulated.total_time.iloc[0] == pytest.approx(3 * 2.0e3)
+        solved, _ = read_table(directory / f"results/solver/r{label}/summary.parquet")
+        assert solved.accuracy_estimate.iloc[0] < 1e-8
+    below, _ = read_table(directory / "results/solver/r0.05/summary.parquet")
+    assert below.collision_rate.iloc[0] == float("inf")
+    table = pd.read_csv(directory / "results/tables/moments.csv")
+    assert np.isnan(table[(table.r_label == 0.05) & (table.quantity == "collision_rate")].z.iloc[0])

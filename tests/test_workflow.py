@@ -293,6 +293,12 @@ BAD = [
     (_with(["restitution"], []), "instance['restitution']"),
     (_with(["restitution"], [[0.5]]), "instance['restitution'][0]"),
     (_with(["simulation", "shards"], 0), "shards"),
+    (_with(["simulation", "shards"], -3), "-3 is less than the minimum of 2"),
+    (_with(["simulation", "equilibration_time"], -1.0), "equilibration_time"),
+    (_with(["simulation", "max_steps"], 0), "max_steps"),
+    (_with(["simulation", "min_step_floor"], -1.0e-12), "min_step_floor"),
+    (_with(["simulation", "per_restitution"], {"0.5": {"min_step_floor": -1}}), "min_step_floor"),
+    (_with(["simulation", "per_restitution"], {"0.5": {"shard_tme": 5}}), "'shard_tme' was unexpected"),
     (_with(["simulation", "shard_time"], -1.0), "shard_time"),
     (_with(["simulation", "criterion_c"], 0.0), "criterion_c"),
     (_with(["simulation", "shard_time"], "1e5"), "shard_time"),
@@ -329,6 +335,16 @@ def test_bad_config_is_refused_before_any_job_runs(tmp_path, config, key):
     assert result.returncode != 0
     assert key in result.stderr + result.stdout
     assert not (directory / "results").exists()
+
+
+def test_a_bad_config_leaves_existing_results_untouched(finished_run, tmp_path):
+    directory = tmp_path / "copy"
+    shutil.copytree(finished_run, directory)
+    before = {path: path.stat().st_mtime_ns for path in (directory / "results").rglob("*")}
+    (directory / "config" / "config.yaml").write_text(yaml.safe_dump(_with(["restitution"], [0.5, "1/2"])))
+    result = snakemake(directory)
+    assert result.returncode != 0 and "restitution[1]: r = '1/2' repeats" in result.stderr + result.stdout
+    assert {path: path.stat().st_mtime_ns for path in (directory / "results").rglob("*")} == before
 
 
 def test_lint_is_clean_and_rule_files_are_formatted():
