@@ -1,5 +1,6 @@
 """The workflow as a user runs it, in a temporary copy of the repository."""
 
+import copy
 import os
 import shutil
 import subprocess
@@ -10,6 +11,10 @@ import pandas as pd
 import pytest
 import yaml
 
+from snakemake.exceptions import WorkflowError
+from snakemake.utils import validate
+
+from bouncing_ball.config import check_config
 from bouncing_ball.io import read_table
 from workflow_support import FIGURES, REPOSITORY, SMALL, copy_repository, planned_jobs, snakemake
 
@@ -328,7 +333,34 @@ BAD = [
 ]
 
 
+def refusal(config):
+    """The message with which the workflow refuses ``config``: the Snakefile's schema
+    validation, then common.smk's check_config; None if it is accepted."""
+    try:
+        validate(copy.deepcopy(config), str(REPOSITORY / "workflow/schemas/config.schema.yaml"))
+        check_config(config)
+    except (WorkflowError, ValueError) as error:
+        return str(error)
+    return None
+
+
+def test_the_small_config_is_accepted():
+    assert refusal(SMALL) is None  # so that each bad config below fails for its own reason
+
+
 @pytest.mark.parametrize("config, key", BAD, ids=[key.split(":")[0] for _, key in BAD])
+def test_bad_config_is_refused_with_a_message_naming_the_key(config, key):
+    message = refusal(config)
+    assert message is not None and key in message, message
+
+
+# one of each kind, end to end: refused by Snakemake before any job runs, nothing written
+END_TO_END = [BAD[i] for i in (0, 4, 5, 8, 16, 19, 20)] + [
+    (config, key) for config, key in BAD if key.startswith(("figures.fig5", "solver.restitution_grid"))
+]
+
+
+@pytest.mark.parametrize("config, key", END_TO_END, ids=[key.split(":")[0] for _, key in END_TO_END])
 def test_bad_config_is_refused_before_any_job_runs(tmp_path, config, key):
     directory = copy_repository(tmp_path, config)
     result = snakemake(directory)
