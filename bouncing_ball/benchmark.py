@@ -1,10 +1,22 @@
-"""Benchmarks on the machine it runs on: ``python -m bouncing_ball.benchmark [--json]``.
+"""Benchmarks on the machine it runs on: ``python -m bouncing_ball.benchmark [--json] [--scaling]``.
 
-Measured here:
+Measured here (about 1-2 minutes; ``--scaling`` adds about one more):
+  * simulation throughput on one core at r = 0.25, 0.5, 0.75 with the paper's
+    c = 5 and 1/500 rule: collisions and simulated time per CPU second, steps
+    per collision, ns per step;
+  * statistical efficiency at r = 1/2: (relative standard error of I)^2 x CPU
+    seconds, from 16 short shards (lower is better);
+  * numba's compile: the first shard in a fresh cache against a later shard
+    (a new process that loads the cache), and the peak memory of a shard;
   * the solver of eq. (inteq): time per r (median of repeats after a warm-up
     that pays numba's compile or cache load), nodes, and accuracy against the
-    exact r = 1/2 and 1/3 solutions over v in [1e-3, 20];
-    target: 50 ms or less per r at relative error 1e-8.
+    exact r = 1/2 and 1/3 solutions over v in [1e-3, 20]; target: 50 ms or
+    less per r at relative error 1e-8;
+  * the workflow's overhead (from a repository checkout): the dry run of a
+    grid of 20 r values x 16 shards (target < 5 s), and a no-op rerun of the
+    default workflow (target < 3 s; only where its results are complete);
+  * with ``--scaling``: the simulation stage (8 shards) with --cores 1 and
+    --cores 2 (target: at least 1.8 times as fast).
 
 BLAS is pinned to one thread (as Snakemake does in every job), so times are per core.
 """
@@ -12,14 +24,191 @@ BLAS is pinned to one thread (as Snakemake does in every job), so times are per 
 import argparse
 import json
 import os
+import shutil
+import subprocess
 import sys
+import tempfile
 import time
+from pathlib import Path
 
 SINGLE_THREAD = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 SOLVER_RESTITUTIONS = (0.05, 0.1, 0.25, 1.0 / 3.0, 0.5, 0.75, 0.9, 0.95, 0.99)
 SOLVER_TARGET_SECONDS = 0.050
 SOLVER_TARGET_ERROR = 1e-8
+
+
+# the paper's settings and the default config's bins
+SIMULATION_SETTINGS = {"criterion_c": 5.0, "min_step_divisor": 500.0, "equilibration_time": 100.0}
+# simulated time per throughput shard: about 2-4 CPU seconds each
+THROUGHPUT_TIMES = {0.25: 6.0e5, 0.5: 2.0e6, 0.75: 6.0e6}
+REPOSITORY = Path(__file__).resolve().parents[1]
+TARGETS = {"noop_seconds": 3.0, "grid_dry_run_seconds": 5.0, "cores_speedup": 1.8, "compile_later_seconds": 0.5}
+
+
+def _shard(r, recorded_time, shard=0, seed=1, **settings):
+    from .bins import LogBins
+    from .restitution import restitution_label
+    from .simulation import shard_seed_sequence, simulate_shard
+
+    options = {**SIMULATION_SETTINGS, **settings}
+    return simulate_shard(
+        restitution=r, seed_sequence=shard_seed_sequence(seed, restitution_label(r), shard),
+        recorded_time=recorded_time, max_steps=10**13, speed_bins=LogBins(1e-4, 1e2, 10),
+        position_bins=LogBins(1e-3, 1e3, 5), **options,
+    )
+
+
+def simulation_benchmark():
+    """Throughput on one core with the paper's c and delta rule."""
+    _shard(0.5, 10.0)  # warm-up: compile or load the cache
+    rows = []
+    for r, recorded_time in THROUGHPUT_TIMES.items():
+        started = time.process_time()
+        tallies = _shard(r, recorded_time)
+        seconds = time.process_time() - started
+        rows.append({
+            "r": r,
+            "cpu_seconds": seconds,
+            "collisions_per_cpu_second": tallies.collisions / seconds,
+            "simulated_time_per_cpu_second": tallies.time / seconds,
+            "steps_per_collision": tallies.steps / tallies.collisions,
+            "ns_per_step": 1e9 * seconds / tallies.steps,
+        })
+    return {"rows": rows}
+
+
+def _efficiency_shard(arguments):
+    r, recorded_time, shard, settings = arguments
+    started = time.process_time()
+    tallies = _shard(r, recorded_time, shard=shard, seed=7, **settings)
+    return tallies.collisions / tallies.time, time.process_time() - started, tallies.steps, tallies.collisions
+
+
+def efficiency_benchmark(settings=None, shards=16, recorded_time=1.0e5, r=0.5):
+    """(relative standard error of I)^2 x CPU seconds at r = 1/2 from ``shards`` shards in two processes."""
+    import numpy as np
+    from concurrent.futures import ProcessPoolExecutor
+
+    settings = settings or {}
+    with ProcessPoolExecutor(2) as pool:
+        results = list(pool.map(_efficiency_shard, [(r, recorded_time, k, settings) for k in range(shards)]))
+    rates = np.array([rate for rate, *_ in results])
+    cpu = sum(seconds for _, seconds, *_ in results)
+    relative_error = rates.std(ddof=1) / np.sqrt(shards) / rates.mean()
+    return {
+        "r": r, **{**SIMULATION_SETTINGS, **settings}, "shards": shards, "shard_time": recorded_time,
+        "collision_rate": float(rates.mean()), "relative_error": float(relative_error), "cpu_seconds": cpu,
+        "variance_times_cpu": float(relative_error**2 * cpu),
+        "steps_per_collision": sum(s for *_, s, _ in results) / sum(c for *_, c in results),
+    }
+
+
+_PROBE = """
+import json, resource, sys, time
+started = time.perf_counter()
+from bouncing_ball.bins import LogBins
+from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
+imported = time.perf_counter()
+before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+def run(t):
+    return simulate_shard(0.5, shard_seed_sequence(1, "0.5", 0), t, 100.0, 5.0, 500.0, 10**13,
+                          LogBins(1e-4, 1e2, 10), LogBins(1e-3, 1e3, 5))
+run(10.0)
+first = time.perf_counter()
+run(10.0)
+second = time.perf_counter()
+run(float(sys.argv[1]))
+print(json.dumps({"import_s": imported - started, "first_call_s": first - imported,
+                  "second_call_s": second - first, "rss_before_mib": before / 1024,
+                  "peak_rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+"""
+
+
+def compile_benchmark(memory_shard_time=2.0e5):
+    """A shard in a new process with an empty numba cache, then another new process with the
+    cache it left: the first pays the compile, the later one only loads it. Peak memory of a shard."""
+    with tempfile.TemporaryDirectory() as cache:
+        env = {**os.environ, "NUMBA_CACHE_DIR": cache}
+        runs = []
+        for _ in range(2):
+            output = subprocess.run([sys.executable, "-c", _PROBE, str(memory_shard_time)], env=env,
+                                    capture_output=True, text=True, check=True, timeout=300).stdout
+            runs.append(json.loads(output))
+    first, later = runs
+    return {
+        "first_shard_compile_seconds": first["first_call_s"],
+        "later_shard_load_seconds": later["first_call_s"],
+        "import_seconds": later["import_s"],
+        "peak_memory_mib": later["peak_rss_mib"],
+        "memory_before_shard_mib": later["rss_before_mib"],
+        "memory_shard_time": memory_shard_time,
+    }
+
+
+def _workflow_copy(directory, config):
+    import yaml
+
+    for name in ("Snakefile", "workflow", "scripts", "config", "profiles"):
+        source = REPOSITORY / name
+        if source.is_dir():
+            shutil.copytree(source, directory / name)
+        elif source.exists():
+            shutil.copy(source, directory / name)
+    (directory / "config" / "config.yaml").write_text(yaml.safe_dump(config))
+
+
+def _timed_snakemake(directory, *arguments):
+    started = time.perf_counter()
+    result = subprocess.run([sys.executable, "-m", "snakemake", *arguments], cwd=directory,
+                            capture_output=True, text=True, timeout=600)
+    return time.perf_counter() - started, result
+
+
+def workflow_benchmark():
+    """Dry run of 20 r x 16 shards in a copy of the workflow; a no-op rerun of the default workflow."""
+    import yaml
+
+    if not (REPOSITORY / "Snakefile").exists():
+        return {"skipped": f"no Snakefile next to the package ({REPOSITORY}): run from a repository checkout"}
+    config = yaml.safe_load((REPOSITORY / "config" / "config.yaml").read_text())
+    config["restitution"] = [round(0.2 + 0.0375 * k, 4) for k in range(20)]
+    config["simulation"]["shards"] = 16
+    config["simulation"]["per_restitution"] = {}
+    config["figures"].update({"fig4": [0.5], "fig5": [0.5]})  # panels from the grid: 320 shard jobs
+    with tempfile.TemporaryDirectory() as folder:
+        _workflow_copy(Path(folder), config)
+        dry_run, result = _timed_snakemake(folder, "--cores", "2", "--dry-run", "--quiet", "rules")
+        jobs = next((int(line.split()[1]) for line in result.stdout.splitlines() if line.startswith("simulate_shard")), 0)
+    planned, result = _timed_snakemake(REPOSITORY, "--cores", "2", "--dry-run", "--quiet", "rules")
+    complete = "Nothing to be done" in result.stdout + result.stderr
+    noop = _timed_snakemake(REPOSITORY, "--cores", "2")[0] if complete else None
+    return {
+        "grid_shard_jobs": jobs,
+        "grid_dry_run_seconds": dry_run,
+        "default_results_complete": complete,
+        "noop_seconds": noop,
+        "default_dry_run_seconds": planned,
+    }
+
+
+def scaling_benchmark(shards=8, shard_time=1.2e6):
+    """The simulation stage of ``shards`` shards of r = 1/2 with --cores 1 and with --cores 2."""
+    import yaml
+
+    config = yaml.safe_load((REPOSITORY / "config" / "config.yaml").read_text())
+    config["restitution"] = [0.5]
+    config["simulation"].update({"shards": shards, "shard_time": shard_time, "per_restitution": {}})
+    times = {}
+    for cores in (1, 2):
+        with tempfile.TemporaryDirectory() as folder:
+            _workflow_copy(Path(folder), config)
+            seconds, result = _timed_snakemake(folder, "--cores", str(cores), "simulation")
+            if result.returncode != 0:
+                raise RuntimeError(result.stderr[-2000:])
+            times[cores] = seconds
+    return {"shards": shards, "shard_time": shard_time, "cores_1_seconds": times[1],
+            "cores_2_seconds": times[2], "speedup": times[1] / times[2]}
 
 
 def _median_seconds(function, repeats):
@@ -83,16 +272,75 @@ def _print_solver(result):
     )
 
 
+def _verdict(value, target, larger_is_better=False):
+    if value is None:
+        return "not measured"
+    return "met" if (value >= target if larger_is_better else value <= target) else "MISSED"
+
+
+def _print_all(results):
+    print("Simulation, one core, c = 5 and the 1/500 rule")
+    print(f"{'r':>6} {'CPU s':>6} {'collisions/CPU s':>17} {'time/CPU s':>11} {'steps/collision':>16} {'ns/step':>8}")
+    for row in results["simulation"]["rows"]:
+        print(f"{row['r']:6.3g} {row['cpu_seconds']:6.2f} {row['collisions_per_cpu_second']:17.3g}"
+              f" {row['simulated_time_per_cpu_second']:11.3g} {row['steps_per_collision']:16.1f}"
+              f" {row['ns_per_step']:8.0f}")
+    e = results["efficiency"]
+    print(f"\nStatistical efficiency at r = 1/2 ({e['shards']} shards x {e['shard_time']:.0e}, c = "
+          f"{e['criterion_c']:g}, divisor {e['min_step_divisor']:g}): I = {e['collision_rate']:.5f} "
+          f"+- {100 * e['relative_error']:.2f}%, CPU {e['cpu_seconds']:.1f} s, "
+          f"(rel. error)^2 x CPU s = {e['variance_times_cpu']:.2e} (lower is better)")
+    c = results["compile"]
+    print(f"\nnumba: first shard in an empty cache {c['first_shard_compile_seconds']:.1f} s (compile), a later shard "
+          f"in a new process {c['later_shard_load_seconds']:.2f} s (cache load; target <= "
+          f"{TARGETS['compile_later_seconds']} s: {_verdict(c['later_shard_load_seconds'], TARGETS['compile_later_seconds'])}); "
+          f"imports {c['import_seconds']:.1f} s")
+    print(f"peak memory of a shard (r = 1/2, {c['memory_shard_time']:.0e} time units): {c['peak_memory_mib']:.0f} MiB "
+          f"({c['memory_before_shard_mib']:.0f} MiB before it)")
+    print()
+    _print_solver(results["solver"])
+    w = results["workflow"]
+    print()
+    if "skipped" in w:
+        print(f"Workflow overhead: skipped ({w['skipped']})")
+    else:
+        print(f"Workflow: dry run of 20 r x 16 shards ({w['grid_shard_jobs']} shard jobs): {w['grid_dry_run_seconds']:.1f} s"
+              f" (target < {TARGETS['grid_dry_run_seconds']:.0f} s: {_verdict(w['grid_dry_run_seconds'], TARGETS['grid_dry_run_seconds'])})")
+        if w["noop_seconds"] is None:
+            print(f"no-op rerun of the default workflow: not measured (its results are not complete; "
+                  f"its dry run took {w['default_dry_run_seconds']:.1f} s)")
+        else:
+            print(f"no-op rerun of the default workflow: {w['noop_seconds']:.1f} s (target < "
+                  f"{TARGETS['noop_seconds']:.0f} s: {_verdict(w['noop_seconds'], TARGETS['noop_seconds'])})")
+    if "scaling" in results:
+        s = results["scaling"]
+        print(f"simulation stage, {s['shards']} shards: --cores 1 {s['cores_1_seconds']:.1f} s, --cores 2 "
+              f"{s['cores_2_seconds']:.1f} s, speed-up {s['speedup']:.2f} (target >= {TARGETS['cores_speedup']}: "
+              f"{_verdict(s['speedup'], TARGETS['cores_speedup'], larger_is_better=True)})")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m bouncing_ball.benchmark", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--json", action="store_true", help="print machine-readable JSON instead of tables")
+    parser.add_argument("--scaling", action="store_true", help="also time the simulation stage with 1 and 2 cores")
     args = parser.parse_args(argv)
-    results = {"solver": solver_benchmark()}
+    started = time.perf_counter()
+    results = {
+        "simulation": simulation_benchmark(),
+        "efficiency": efficiency_benchmark(),
+        "compile": compile_benchmark(),
+        "solver": solver_benchmark(),
+        "workflow": workflow_benchmark(),
+    }
+    if args.scaling:
+        results["scaling"] = scaling_benchmark()
+    results["seconds"] = time.perf_counter() - started
     if args.json:
         print(json.dumps(results, indent=2))
     else:
-        _print_solver(results["solver"])
+        _print_all(results)
+        print(f"\n(benchmark took {results['seconds']:.0f} s)")
     return 0
 
 
