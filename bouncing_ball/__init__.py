@@ -20,20 +20,3 @@ def source_digest(modules=None) -> str:
         digest.update(name.encode())
         digest.update((PACKAGE / f"{name}.py").read_bytes())
     return digest.hexdigest()[:16]
-
-
-def _use_source_keyed_numba_cache():
-    """Keep numba's compiled code in a folder named after the package's source.
-
-    ``cache=True`` checks only the file that holds a compiled function, not
-    the files it calls into: after an edit of free_flight.py a cached
-    simulation loop would silently keep the old code.  A user's
-    NUMBA_CACHE_DIR is respected.
-    """
-    import numba
-
-    if not numba.config.CACHE_DIR:
-        numba.config.CACHE_DIR = str(PACKAGE / "__pycache__" / f"numba-{source_digest()}")
-
-
-_use_source_keyed_numba_cache()

@@ -10,8 +10,9 @@ import numpy as np
 import pandas as pd
 
 from .fits import bin_averages_of_curve
+from . import stages
 
-SOURCES = ("comparison", "fits")
+SOURCES = stages.COMPARISON
 
 # the time averages of eq. (xandDeltax)
 QUANTITIES = ("mean_x", "delta_x", "collision_rate")

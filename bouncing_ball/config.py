@@ -13,8 +13,7 @@ import numpy as np
 import yaml
 
 from .bins import LogBins
-from .exact import EXACT_RESTITUTIONS
-from .restitution import parse_restitution, restitution_grid, restitution_label
+from .restitution import EXACT_RESTITUTIONS, parse_restitution, restitution_grid, restitution_label
 
 
 def read_config(path) -> dict:

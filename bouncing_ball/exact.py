@@ -11,7 +11,8 @@ from fractions import Fraction
 import numpy as np
 from scipy import integrate, special
 
-EXACT_RESTITUTIONS = (Fraction(1, 2), Fraction(1, 3))
+from .restitution import EXACT_RESTITUTIONS  # noqa: F401 (re-exported: exact.EXACT_RESTITUTIONS)
+
 
 
 def _which(restitution) -> Fraction:

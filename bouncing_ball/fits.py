@@ -43,9 +43,10 @@ from scipy.interpolate import CubicSpline
 from .histograms import outgoing_speed_density
 
 from .asymptotics import large_speed_decay_rate, large_speed_exponent, small_speed_exponent
+from . import stages
 
 # the modules whose code decides a fit table (see ``source_digest``)
-SOURCES = ("asymptotics", "bins", "fits", "histograms", "io", "shards", "tallies")
+SOURCES = stages.FITS
 
 SMALL_SPEED = "small_speed"
 LARGE_SPEED = "large_speed"

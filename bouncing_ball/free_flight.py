@@ -23,7 +23,7 @@ its four monomial coefficients ``a0 + a1 t + a2 t^2 + a3 t^3``.
 import math
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 SQRT3 = math.sqrt(3.0)
 SQRT1_12 = math.sqrt(1.0 / 12.0)

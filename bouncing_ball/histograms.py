@@ -10,9 +10,10 @@ import numpy as np
 import pandas as pd
 
 from .tallies import ShardTallies, merge_shards
+from . import stages
 
 # the modules whose code decides the merged tables (see ``source_digest``)
-SOURCES = ("bins", "histograms", "tallies")
+SOURCES = stages.MERGE
 
 
 def jackknife(estimator, *per_shard):

@@ -38,7 +38,7 @@ z0^2 as (v - u)^2 + v u.
 import math
 
 import numpy as np
-from numba import njit, prange
+from .jit import njit, prange
 
 # Gauss-Legendre order of the tau integral; see ``tests/test_kernel.py``
 TAU_NODES = 24

@@ -15,11 +15,11 @@ matplotlib.use("Agg")
 import numpy as np  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
-from . import __version__  # noqa: E402
+from . import __version__, stages  # noqa: E402
 from .io import atomic_path  # noqa: E402
 from .restitution import exact_string  # noqa: E402
 
-SOURCES = ("plotting",)
+SOURCES = stages.PLOTTING
 
 STYLE = {
     "font.family": "serif",

@@ -8,6 +8,9 @@ significant digits, trailing zeros dropped ("0.25", "0.333333").
 
 from fractions import Fraction
 
+# the r with an exact solution, eq. (P(0,v)) (bouncing_ball.exact)
+EXACT_RESTITUTIONS = (Fraction(1, 2), Fraction(1, 3))
+
 
 def parse_restitution(value, where: str = "restitution") -> Fraction:
     """The exact value of r from a config entry or a label; ``where`` names it in errors."""

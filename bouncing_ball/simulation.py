@@ -51,7 +51,7 @@ as the floor goes to zero, is measured, not assumed (README).
 import math
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 from .bins import LogBins
 from .free_flight import (
@@ -69,9 +69,10 @@ from .free_flight import (
     speed_squared_coefficients,
 )
 from .tallies import ShardTallies
+from . import stages
 
 # the modules whose code decides a shard's numbers (see ``source_digest``)
-SOURCES = ("bins", "free_flight", "simulation", "tallies")
+SOURCES = stages.SIMULATION
 
 # indices into the scalar tally array of the compiled loop
 _TIME, _COLLISIONS, _STEPS, _INT_X, _INT_X2, _EXHAUSTED = range(6)

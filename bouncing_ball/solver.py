@@ -57,9 +57,10 @@ from scipy import linalg, special
 
 from .asymptotics import large_speed_decay_rate, small_speed_exponent
 from .kernel import kernel_small_u_limit, return_speed_kernel_matrix
+from . import stages
 
 # the modules whose code decides the solver's numbers
-SOURCES = ("asymptotics", "kernel", "solver")
+SOURCES = stages.SOLVER
 
 HIGHEST_RESTITUTION = 0.9999  # above, the grid (~ (1 - r)^(-1/2) nodes, dense) outgrows a job
 DEFAULT_STEP = 0.25  # trapezoidal step in s; ~1e-11 relative error at r = 1/2, 1/3

@@ -1,14 +1,5 @@
 # Helpers for every stage: r labels and exact values, per-r settings, shard lists, targets.
-from bouncing_ball import (
-    asymptotics,
-    comparison,
-    exact,
-    fits,
-    histograms,
-    simulation,
-    solver,
-    source_digest,
-)
+from bouncing_ball import source_digest, stages
 from bouncing_ball.config import (
     check_config,
     exact_settings,
@@ -18,6 +9,7 @@ from bouncing_ball.config import (
     shard_settings,
 )
 from bouncing_ball.restitution import (
+    EXACT_RESTITUTIONS,
     exact_string,
     parse_restitution,
     restitution_grid,
@@ -32,20 +24,19 @@ except ValueError as error:
 KNOWN_RESTITUTION = known_restitutions(config)
 
 # passed as params: an edit of a stage's library code re-runs that stage only
-SIMULATION_CODE = source_digest(simulation.SOURCES)
-MERGE_CODE = source_digest(histograms.SOURCES + ("shards",))  # reading shards back
-SOLVER_CODE = source_digest(solver.SOURCES)
-EXACT_CODE = source_digest(("exact",))
-THEORY_CODE = source_digest(asymptotics.SOURCES)
-FIT_CODE = source_digest(fits.SOURCES)
-# plotting.SOURCES, named here so that planning a run does not import matplotlib
-PLOTTING_SOURCES = ("plotting",)
-FIGURE_CODE = source_digest(PLOTTING_SOURCES)
-RESIDUALS_CODE = source_digest(PLOTTING_SOURCES + comparison.SOURCES)
-TABLE_CODE = source_digest(comparison.SOURCES)
+# (bouncing_ball.stages names the modules without importing them)
+SIMULATION_CODE = source_digest(stages.SIMULATION)
+MERGE_CODE = source_digest(stages.MERGE)
+SOLVER_CODE = source_digest(stages.SOLVER)
+EXACT_CODE = source_digest(stages.EXACT)
+THEORY_CODE = source_digest(stages.THEORY)
+FIT_CODE = source_digest(stages.FITS)
+FIGURE_CODE = source_digest(stages.PLOTTING)
+RESIDUALS_CODE = source_digest(stages.PLOTTING + stages.COMPARISON)
+TABLE_CODE = source_digest(stages.COMPARISON)
 
 # the r values with an exact solution, eq. (P(0,v)): always computed (Figs. 3 and 5)
-EXACT_BY_LABEL = {restitution_label(value): value for value in exact.EXACT_RESTITUTIONS}
+EXACT_BY_LABEL = {restitution_label(value): value for value in EXACT_RESTITUTIONS}
 EXACT_LABELS = list(EXACT_BY_LABEL)
 
 
