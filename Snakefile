@@ -19,6 +19,8 @@ wildcard_constraints:
     shard=r"[0-9]+",
 
 
+# run by Snakemake itself, never submitted to a cluster (profiles/slurm): the stage
+# targets, and jobs of a few seconds whose queue wait would exceed their run time
 localrules:
     all,
     simulation,
@@ -27,6 +29,17 @@ localrules:
     fits,
     figures,
     tables,
+    theory,
+    solve,
+    solve_grid,
+    moments_table,
+    fig1,
+    fig2,
+    fig3,
+    fig4,
+    fig5,
+    fig6,
+    fig7,
 
 
 include: "workflow/rules/common.smk"

@@ -14,6 +14,7 @@ rule exact_solution:
     resources:
         runtime=10,
         mem_mb=500,
+        cpus_per_task=1,
     params:
         restitution=exact_value,
         settings=exact_settings(config),

@@ -20,6 +20,7 @@ rule fig1:
     resources:
         runtime=5,
         mem_mb=1000,
+        cpus_per_task=1,
     params:
         dpi=config["figures"]["png_dpi"],
         code=FIGURE_CODE,
@@ -45,6 +46,7 @@ rule fig2:
     resources:
         runtime=5,
         mem_mb=1000,
+        cpus_per_task=1,
     params:
         dpi=config["figures"]["png_dpi"],
         code=FIGURE_CODE,
@@ -70,6 +72,7 @@ rule fig3:
     resources:
         runtime=5,
         mem_mb=1000,
+        cpus_per_task=1,
     params:
         dpi=config["figures"]["png_dpi"],
         code=FIGURE_CODE,
@@ -99,6 +102,7 @@ rule fig4:
     resources:
         runtime=5,
         mem_mb=1000,
+        cpus_per_task=1,
     params:
         dpi=config["figures"]["png_dpi"],
         code=FIGURE_CODE,
@@ -127,6 +131,7 @@ rule fig5:
     resources:
         runtime=5,
         mem_mb=1000,
+        cpus_per_task=1,
     params:
         dpi=config["figures"]["png_dpi"],
         code=FIGURE_CODE,
@@ -154,6 +159,7 @@ rule fig6:
     resources:
         runtime=5,
         mem_mb=1000,
+        cpus_per_task=1,
     params:
         dpi=config["figures"]["png_dpi"],
         code=FIGURE_CODE,
@@ -180,6 +186,7 @@ rule fig7:
     resources:
         runtime=5,
         mem_mb=1000,
+        cpus_per_task=1,
     params:
         dpi=config["figures"]["png_dpi"],
         code=RESIDUALS_CODE,

@@ -6,11 +6,18 @@ rule simulate_shard:
         "results/simulation/r{r}/shard{shard}.parquet",
     log:
         "logs/simulation/r{r}/shard{shard}.log",
+    # one SLURM job runs several shards (profiles/slurm: group-components);
+    # local runs are unaffected
+    group:
+        "shards"
     conda:
         "../envs/bouncing-ball.yaml"
+    # minutes: the step budget (simulation.max_steps, 10^9 steps) stops a shard after
+    # about 2-4 CPU minutes; raise runtime with max_steps
     resources:
-        runtime=60,
+        runtime=20,
         mem_mb=500,
+        cpus_per_task=1,
     params:
         restitution=restitution_value,
         seed=config["seed"],
@@ -34,6 +41,7 @@ rule merge_shards:
     resources:
         runtime=10,
         mem_mb=1000,
+        cpus_per_task=1,
     params:
         restitution=restitution_value,
         code=MERGE_CODE,

@@ -12,6 +12,7 @@ rule solve:
     resources:
         runtime=5,
         mem_mb=1000,
+        cpus_per_task=1,
     params:
         restitution=restitution_value,
         settings=solver_settings(config),
@@ -30,6 +31,7 @@ rule solve_grid:
     resources:
         runtime=10,
         mem_mb=1000,
+        cpus_per_task=1,
     params:
         grid=config["solver"]["restitution_grid"],
         step=config["solver"]["quadrature_step"],

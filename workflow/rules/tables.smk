@@ -24,6 +24,7 @@ rule moments_table:
     resources:
         runtime=5,
         mem_mb=500,
+        cpus_per_task=1,
     params:
         code=TABLE_CODE,
     script:

@@ -11,6 +11,7 @@ rule theory:
     resources:
         runtime=5,
         mem_mb=500,
+        cpus_per_task=1,
     params:
         grid=config["theory"]["restitution_grid"],
         code=THEORY_CODE,
@@ -31,6 +32,7 @@ rule fit:
     resources:
         runtime=10,
         mem_mb=1000,
+        cpus_per_task=1,
     params:
         restitution=restitution_value,
         settings=config["fits"],
