@@ -1,0 +1,64 @@
+"""Static checks of the cluster profile (profiles/slurm); .ci/slurm.sh runs it on a real SLURM."""
+
+import re
+
+import yaml
+
+from snakemake.cli import get_argument_parser
+
+from workflow_support import REPOSITORY
+
+PROFILE = REPOSITORY / "profiles" / "slurm" / "config.yaml"
+
+
+def rule_blocks():
+    """{rule name: its text} over the Snakefile and workflow/rules/*.smk."""
+    blocks = {}
+    for path in [REPOSITORY / "Snakefile", *sorted((REPOSITORY / "workflow" / "rules").glob("*.smk"))]:
+        parts = re.split(r"^rule (\w+):\n", path.read_text(), flags=re.MULTILINE)
+        for name, body in zip(parts[1::2], parts[2::2]):
+            blocks[name] = re.split(r"^\S", body, maxsplit=1, flags=re.MULTILINE)[0]
+    return blocks
+
+
+def local_rules():
+    text = (REPOSITORY / "Snakefile").read_text()
+    listed = re.search(r"^localrules:\n((?:    \w+,\n)+)", text, flags=re.MULTILINE).group(1)
+    return set(re.findall(r"\w+", listed))
+
+
+def test_the_profile_names_only_options_snakemake_and_the_slurm_plugin_know():
+    profile = yaml.safe_load(PROFILE.read_text())
+    known = get_argument_parser()._option_string_actions
+    unknown = [key for key in profile if f"--{key}" not in known]
+    assert not unknown, f"unknown options in {PROFILE}: {unknown} (is the SLURM plugin installed?)"
+    assert profile["executor"] == "slurm"
+    assert profile["slurm-status-command"] in ("sacct", "squeue")
+    assert isinstance(profile["slurm-init-seconds-before-status-checks"], int)
+    assert profile["slurm-init-seconds-before-status-checks"] > 0
+
+
+def test_shards_are_grouped_and_a_group_asks_for_one_core():
+    profile = yaml.safe_load(PROFILE.read_text())
+    groups = dict(item.split("=") for item in profile["group-components"])
+    assert int(groups["shards"]) >= 2
+    blocks = rule_blocks()
+    grouped = [name for name, body in blocks.items() if re.search(r'group:\n\s+"shards"', body)]
+    assert grouped == ["simulate_shard"]
+    # the plugin runs a group's jobs one after the other: one core per SLURM job
+    assert profile["cores"] == 1
+
+
+def test_every_submitted_rule_sets_its_resources_and_local_rules_exist():
+    blocks = rule_blocks()
+    local = local_rules()
+    assert local <= set(blocks), f"localrules names no rule: {sorted(local - set(blocks))}"
+    submitted = set(blocks) - local
+    assert {"simulate_shard", "merge_shards", "fit", "exact_solution"} <= submitted
+    for name in submitted:
+        resources = re.search(r"resources:\n((?:\s+\w+=.+\n)+)", blocks[name])
+        assert resources, f"rule {name} sets no resources"
+        keys = set(re.findall(r"(\w+)=", resources.group(1)))
+        assert {"runtime", "mem_mb", "cpus_per_task"} <= keys, f"rule {name}: {sorted(keys)}"
+        threads = re.search(r"threads:\n\s+(\S+)", blocks[name])
+        assert threads is None or threads.group(1) == "1", f"rule {name}: threads > 1 meets cores: 1"
