@@ -164,6 +164,22 @@ def exact_distribution_figure(panels):
     return figure
 
 
+def _simulated_points(axis, bins, index):
+    return _error_bars(axis, bins.v, bins.p0v, bins.p0v_err, color="k",
+                       marker=SIMULATION_MARKERS[index % len(SIMULATION_MARKERS)], label="simulation", zorder=3)
+
+
+def _finish_outgoing_speed_panel(axis, bins, restitution):
+    """Log-log axes of a P(0, v) panel (Figs. 4, 5), scaled to the simulated points."""
+    axis.set_xscale("log")
+    axis.set_yscale("log")
+    positive = bins.p0v[bins.p0v > 0]
+    axis.set_ylim(positive.min() / 5, positive.max() * 5)
+    axis.set_xlabel(r"$v$")
+    axis.set_title(restitution_text(restitution), fontsize=10)
+    axis.legend(loc="lower left")
+
+
 def _fitted(fits, window, parameter):
     row = fits[(fits.source == "simulation") & (fits.window == window) & (fits.fit == "fixed_exponents")
                & (fits.parameter == parameter)]
@@ -182,8 +198,7 @@ def asymptotic_forms_figure(panels):
     figure, axes = new_figure(1, len(panels), width=3.6 * len(panels), height=3.8)
     for index, (axis, panel) in enumerate(zip(axes[0], panels)):
         bins = simulated_bins(panel["simulated"])
-        _error_bars(axis, bins.v, bins.p0v, bins.p0v_err, color="k",
-                    marker=SIMULATION_MARKERS[index % len(SIMULATION_MARKERS)], label="simulation", zorder=3)
+        _simulated_points(axis, bins, index)
         low, high = bins.v_lo.min(), bins.v_hi.max()
         solver = panel["solver"][(panel["solver"].v >= low) & (panel["solver"].v <= high)]
         axis.plot(solver.v, solver.p0v, color="0.4", linestyle=":", zorder=5, label="solver, eq. (inteq)")
@@ -205,13 +220,7 @@ def asymptotic_forms_figure(panels):
             axis.plot(v, form, color="C3", zorder=4, label=rf"$A v^{{-m}} e^{{-qv}}$, $m = {m:.4g}$, $q = {q:.4g}$")
             inside = (v >= v_min) & (v <= v_max)
             axis.plot(v[inside], form[inside], color="C3", linewidth=3, alpha=0.35)
-        axis.set_xscale("log")
-        axis.set_yscale("log")
-        positive = bins.p0v[bins.p0v > 0]
-        axis.set_ylim(positive.min() / 5, positive.max() * 5)
-        axis.set_xlabel(r"$v$")
-        axis.set_title(restitution_text(panel["restitution"]), fontsize=10)
-        axis.legend(loc="lower left")
+        _finish_outgoing_speed_panel(axis, bins, panel["restitution"])
     axes[0, 0].set_ylabel(r"$P(0, v)$")
     return figure
 
@@ -229,15 +238,8 @@ def exact_comparison_figure(panels):
         low, high = bins.v_lo.min(), bins.v_hi.max()
         exact = panel["exact"][(panel["exact"].v >= low) & (panel["exact"].v <= high)]
         axis.plot(exact.v, exact.p0v, color="C0", label="exact, eqs. (P(0,v)), (constants)")
-        _error_bars(axis, bins.v, bins.p0v, bins.p0v_err, color="k",
-                    marker=SIMULATION_MARKERS[index % len(SIMULATION_MARKERS)], label="simulation", zorder=3)
-        axis.set_xscale("log")
-        axis.set_yscale("log")
-        positive = bins.p0v[bins.p0v > 0]
-        axis.set_ylim(positive.min() / 5, positive.max() * 5)
-        axis.set_xlabel(r"$v$")
-        axis.set_title(restitution_text(panel["restitution"]), fontsize=10)
-        axis.legend(loc="lower left")
+        _simulated_points(axis, bins, index)
+        _finish_outgoing_speed_panel(axis, bins, panel["restitution"])
     axes[0, 0].set_ylabel(r"$P(0, v)$")
     return figure
 
