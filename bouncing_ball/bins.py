@@ -41,3 +41,16 @@ class LogBins:
     def upper(self) -> np.ndarray:
         """Upper edge of each of the n + 2 bins (inf for the overflow bin)."""
         return np.concatenate([self.edges, [np.inf]])
+
+
+# the config's specifications of bins and grids, e.g. {lo, hi, per_decade} and {min, max, points}
+def log_bins(spec: dict) -> LogBins:
+    return LogBins(float(spec["lo"]), float(spec["hi"]), int(spec["per_decade"]))
+
+
+def log_grid(spec: dict):
+    return np.geomspace(float(spec["min"]), float(spec["max"]), int(spec["points"]))
+
+
+def linear_grid(spec: dict):
+    return np.linspace(float(spec["min"]), float(spec["max"]), int(spec["points"]))

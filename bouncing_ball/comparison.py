@@ -9,7 +9,7 @@ from fractions import Fraction
 import numpy as np
 import pandas as pd
 
-from .fits import bin_averages_of_curve
+from .fits import bin_averages_of_curve, usable_curve
 from . import stages
 
 SOURCES = stages.COMPARISON
@@ -99,9 +99,9 @@ def outgoing_speed_residuals(simulated: pd.DataFrame, solver_curve: pd.DataFrame
     the solver's ``v, p0v`` grid; the solver enters as its average over each
     bin (eq. (collrate)), like the data.  Bins without an error (no
     collisions, the under- and overflow bins) and bins beyond the solver's
-    grid are left out.
+    grid (or beyond where its P(0, v) underflows) are left out.
     """
-    speeds, density = solver_curve.v.to_numpy(), solver_curve.p0v.to_numpy()
+    speeds, density = usable_curve(solver_curve.v.to_numpy(), solver_curve.p0v.to_numpy())
     inside = (
         (simulated.v_lo >= speeds[0]) & (simulated.v_hi <= speeds[-1])
         & np.isfinite(simulated.p0v_err) & (simulated.p0v_err > 0)

@@ -12,7 +12,7 @@ from fractions import Fraction
 import numpy as np
 import yaml
 
-from .bins import LogBins
+from .bins import linear_grid, log_bins, log_grid  # noqa: F401 (the config's grids and bins)
 from .restitution import EXACT_RESTITUTIONS, parse_restitution, restitution_grid, restitution_label
 
 
@@ -152,15 +152,3 @@ def solver_settings(config: dict) -> dict:
 def exact_settings(config: dict) -> dict:
     """What the exact-solution stage is run with: its section plus the solver's output speeds."""
     return {"output_speeds": config["solver"]["output_speeds"], **config["exact"]}
-
-
-def log_grid(spec: dict):
-    return np.geomspace(float(spec["min"]), float(spec["max"]), int(spec["points"]))
-
-
-def linear_grid(spec: dict):
-    return np.linspace(float(spec["min"]), float(spec["max"]), int(spec["points"]))
-
-
-def log_bins(spec: dict) -> LogBins:
-    return LogBins(float(spec["lo"]), float(spec["hi"]), int(spec["per_decade"]))

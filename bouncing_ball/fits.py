@@ -317,11 +317,23 @@ def asymptotic_fits(lower, upper, counts, times, errors, reference, restitution,
     return pd.DataFrame(rows), problems
 
 
+def usable_curve(speeds, density):
+    """The part of a tabulated P(0, v) that can be interpolated in logs: up to the last
+    positive value (for r below ~0.035 the solver's P(0, v) ~ exp(-v / (2r)) underflows
+    to 0 before the grid ends)."""
+    speeds, density = np.asarray(speeds, dtype=float), np.asarray(density, dtype=float)
+    bad = np.flatnonzero(~(np.isfinite(density) & (density > 0.0)))
+    end = bad[0] if len(bad) else len(density)
+    return speeds[:end], density[:end]
+
+
 def bin_averages_of_curve(speeds, density, lower, upper):
     """Bin averages of P(0, v) given on a dense log grid (the solver's output): a cubic spline
     of ln P in ln v, averaged like the data (relative error ~1e-7 at 50 points per decade)."""
-    spline = CubicSpline(np.log(speeds), np.log(density))
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    if len(lower) == 0:
+        return np.empty(0)
+    spline = CubicSpline(np.log(speeds), np.log(density))
     if lower.min() < speeds[0] or upper.max() > speeds[-1]:
         raise ValueError(f"bins reach beyond the curve's speeds [{speeds[0]}, {speeds[-1]}]")
     return bin_average(lambda v: np.exp(spline(np.log(v))), lower, upper)

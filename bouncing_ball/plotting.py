@@ -108,7 +108,9 @@ def exponents_figure(exponents, critical_restitution):
     below, above = r < 0.5, (r > 0.5) & ~half
     axis.plot(r[below], exponents.m[below], color="C3", linestyle="--",
               label=r"$m(r)$, eqs. (asym3)-(asym6)")
-    axis.plot(r[above], exponents.m[above], color="C3", linestyle="--")
+    # m -> 1 only logarithmically as r -> 1/2 from above (m(0.505) = 0.81): the branch
+    # is drawn on to m(1/2) = 1, so that the one jump shown is the one at r = 1/2 from below
+    axis.plot(np.r_[0.5, r[above]], np.r_[1.0, exponents.m[above]], color="C3", linestyle="--")
     axis.plot([0.5], [1.0], "o", color="C3", markersize=4)  # m(1/2) = 1
     axis.plot([0.5], [1.5], "o", color="C3", markersize=4, markerfacecolor="white")
     axis.axvline(critical_restitution, color="0.5", linestyle=":", linewidth=0.9)

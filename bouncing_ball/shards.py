@@ -1,7 +1,8 @@
 """Reading a set of shard files back, with every check a downstream step needs."""
 
 from .asymptotics import CRITICAL_RESTITUTION
-from .config import SHARD_SETTINGS, log_bins
+from .bins import log_bins
+from .config import SHARD_SETTINGS
 from .io import UnreadableFileError, read_table
 from .restitution import parse_restitution
 from .tallies import tallies_from_frame

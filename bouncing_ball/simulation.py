@@ -40,10 +40,11 @@ simulation follows the collapse until the step budget runs out or the step falls
 COLLAPSED_STEP (speeds ~ 1e-37; the shard then stops and says so, as for
 an exhausted budget);
 simulated time stops advancing.  A floor on the minimum step, delta >= min_step_floor,
-is the regularisation: once v_out falls below about
-min_step_divisor * (2 min_step_floor)^(1/2) a single step's noise
-(2 delta)^(1/2) exceeds the speed and lifts the particle off the floor,
-so the collapse is cut off at speeds of order (2 min_step_floor)^(1/2).
+is the regularisation: it takes over from the 1/500 rule once v_out
+falls below about min_step_divisor * (2 min_step_floor)^(1/2), and once
+v_out falls below about (2 min_step_floor)^(1/2) a single step's noise
+exceeds the speed and lifts the particle off the floor: the collapse is
+cut off at speeds of order (2 min_step_floor)^(1/2).
 What the regularised process gives above that speed scale, and how I grows
 as the floor goes to zero, is measured, not assumed (README).
 """

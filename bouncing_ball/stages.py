@@ -6,11 +6,13 @@ Kept apart from the modules so that the workflow can plan a run without
 importing numba, scipy or matplotlib.
 """
 
-SIMULATION = ("bins", "free_flight", "simulation", "tallies")
-MERGE = ("bins", "histograms", "shards", "tallies")
-SOLVER = ("asymptotics", "kernel", "solver")
-EXACT = ("exact",)
-THEORY = ("asymptotics",)
-FITS = ("asymptotics", "bins", "fits", "histograms", "io", "shards", "tallies")
-PLOTTING = ("plotting",)
-COMPARISON = ("comparison", "fits")
+# "bins" also builds the config's grids; "restitution" parses r and makes the labels
+# that key the random streams; "jit" is how the compiled modules are compiled
+SIMULATION = ("bins", "free_flight", "jit", "restitution", "simulation", "tallies")
+MERGE = ("bins", "histograms", "io", "restitution", "shards", "tallies")
+SOLVER = ("asymptotics", "bins", "jit", "kernel", "solver")
+EXACT = ("bins", "exact")
+THEORY = ("asymptotics", "bins")
+FITS = ("asymptotics", "bins", "fits", "histograms", "io", "restitution", "shards", "tallies")
+PLOTTING = ("io", "plotting", "restitution")
+COMPARISON = ("comparison", "fits", "io")

@@ -28,8 +28,8 @@ def main(shard_paths, solver_path, restitution, settings, output):
     curve, solver_provenance = read_table(solver_path)
     if solver_provenance.get("r_label") != label:
         raise ValueError(f"{solver_path}: solved for r = {solver_provenance.get('r_label')}, not r = {label}")
-    speeds, density = curve.v.to_numpy(), curve.p0v.to_numpy()
-    # finite bins inside the solver's output speeds (solver.output_speeds)
+    # the solver's output speeds (solver.output_speeds) up to where P(0, v) underflows
+    speeds, density = fits.usable_curve(curve.v.to_numpy(), curve.p0v.to_numpy())
     inside = (np.isfinite(table.v_hi) & (table.v_lo >= speeds[0]) & (table.v_hi <= speeds[-1])).to_numpy()
     beyond = int(np.sum(np.isfinite(table.v_hi) & (table.v_hi > speeds[-1]) & (table["count"] > 0)))
     if beyond:

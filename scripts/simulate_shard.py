@@ -14,7 +14,8 @@ import time
 import yaml
 
 from bouncing_ball import source_digest
-from bouncing_ball.config import check_config, log_bins, shard_settings
+from bouncing_ball.bins import log_bins
+from bouncing_ball.config import check_config, shard_settings
 from bouncing_ball.io import write_table
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 from bouncing_ball.simulation import SOURCES, shard_seed_sequence, simulate_shard

@@ -21,7 +21,8 @@ def test_fig1_shows_the_jump_of_m_at_one_half(exponents):
     dashed = [line for line in axis.lines if line.get_linestyle() == "--"]
     assert len(dashed) == 2  # m below and above r = 1/2, never joined across the jump
     below, above = (np.asarray(line.get_xdata()) for line in dashed)
-    assert below.max() < 0.5 < above.min()
+    assert below.max() < 0.5 and above.min() == 0.5 and above[1] > 0.5  # joined only to m(1/2) = 1
+    assert dashed[1].get_ydata()[0] == 1.0
     assert np.allclose(dashed[0].get_ydata(), 1.5)
     dots = {(float(line.get_xdata()[0]), float(line.get_ydata()[0])) for line in axis.lines
             if line.get_marker() == "o"}

