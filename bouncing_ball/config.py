@@ -9,10 +9,8 @@ is asked for as a target.
 
 from fractions import Fraction
 
-import numpy as np
 import yaml
 
-from .bins import linear_grid, log_bins, log_grid  # noqa: F401 (the config's grids and bins)
 from .restitution import EXACT_RESTITUTIONS, parse_restitution, restitution_grid, restitution_label
 
 

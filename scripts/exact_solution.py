@@ -13,7 +13,8 @@ import numpy as np
 import pandas as pd
 
 from bouncing_ball import exact, source_digest
-from bouncing_ball.config import exact_settings, linear_grid, log_grid, read_config
+from bouncing_ball.bins import linear_grid, log_grid
+from bouncing_ball.config import exact_settings, read_config
 from bouncing_ball.io import write_table
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 

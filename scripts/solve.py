@@ -14,7 +14,8 @@ import numpy as np
 import pandas as pd
 
 from bouncing_ball import source_digest, solver
-from bouncing_ball.config import log_grid, read_config, solver_settings
+from bouncing_ball.bins import log_grid
+from bouncing_ball.config import read_config, solver_settings
 from bouncing_ball.io import write_table
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 

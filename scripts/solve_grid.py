@@ -13,7 +13,8 @@ import time
 import pandas as pd
 
 from bouncing_ball import solver, source_digest
-from bouncing_ball.config import linear_grid, read_config
+from bouncing_ball.bins import linear_grid
+from bouncing_ball.config import read_config
 from bouncing_ball.io import write_table
 
 

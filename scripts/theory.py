@@ -11,7 +11,8 @@ import logging
 
 from bouncing_ball import source_digest
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION, SOURCES, exponents_table
-from bouncing_ball.config import linear_grid, read_config
+from bouncing_ball.bins import linear_grid
+from bouncing_ball.config import read_config
 from bouncing_ball.io import write_table
 
 
