@@ -7,16 +7,55 @@ package's source, inside numba's own cache folder or, where the user set
 NUMBA_CACHE_DIR, inside that one.  Only the compiled
 modules import this, so importing the package (as the workflow does to plan a
 run) does not load numba.
+
+Every edit of the library makes a new folder; the old ones are pruned here,
+keeping the ``KEEP_CACHES`` most recently used besides the current one (so
+switching between two versions does not recompile) and never one used in the
+last ``PRUNE_AFTER_SECONDS`` (a job of another version may still be running).
 """
 
+import shutil
+import time
 from pathlib import Path
 
 import numba
 
 from . import PACKAGE, source_digest
 
+KEEP_CACHES = 3
+PRUNE_AFTER_SECONDS = 3600.0
+
+
+def prune_caches(base: Path, current: Path, keep: int = KEEP_CACHES, older_than: float = PRUNE_AFTER_SECONDS):
+    """Remove ``numba-*`` folders under ``base`` other than ``current``, keeping the ``keep`` newest.
+
+    Returns the folders removed.  Failures (a folder removed by another
+    process at the same time, no permission) are ignored: pruning is tidying.
+    """
+    try:
+        others = [path for path in base.glob("numba-*") if path.is_dir() and path != current]
+        others.sort(key=lambda path: path.stat().st_mtime, reverse=True)
+    except OSError:
+        return []
+    now = time.time()
+    removed = []
+    for path in others[keep:]:
+        try:
+            if now - path.stat().st_mtime < older_than:
+                continue
+            shutil.rmtree(path)
+            removed.append(path)
+        except OSError:
+            continue
+    return removed
+
+
 _base = Path(numba.config.CACHE_DIR) if numba.config.CACHE_DIR else PACKAGE / "__pycache__"
-numba.config.CACHE_DIR = str(_base / f"numba-{source_digest()}")
+CACHE = _base / f"numba-{source_digest()}"
+numba.config.CACHE_DIR = str(CACHE)
+if CACHE.is_dir():
+    CACHE.touch()  # in use: the newest to keep
+prune_caches(_base, CACHE)
 
 njit = numba.njit
 prange = numba.prange
