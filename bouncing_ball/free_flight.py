@@ -189,10 +189,11 @@ def cubic_level_time(a0, a1, a2, a3, level, t_lo, t_hi, f_lo, f_hi):
     ``f_lo`` and ``f_hi`` are m - level at the two ends (opposite signs, or
     f_lo = 0).  Safeguarded Halley iteration from the linear interpolation of
     the ends: a step that leaves the bracket is replaced by bisection, so it
-    always converges.  It stops when t is known to 1e-10 of the bracket: after
-    a Halley step below 1e-10 of it, or below 1e-6 of it and 1e-3 of the step
-    before (cubic convergence under way, so the error left is below ~1e-15
-    of the bracket), or when bisection has shrunk the bracket to 1e-10.
+    always converges.  It stops after a Halley step below 1e-5 of the bracket
+    (the root is simple and the convergence cubic, so the error left is of
+    order (1e-5)^3 of it, at the level of rounding; most crossings need one or
+    two steps from the linear start), or when bisection has shrunk the bracket
+    to 1e-10 of it.
     """
     if f_lo == 0.0:
         return t_lo
@@ -200,7 +201,6 @@ def cubic_level_time(a0, a1, a2, a3, level, t_lo, t_hi, f_lo, f_hi):
     width = t_hi - t_lo
     lo, hi = t_lo, t_hi
     t = t_lo + width * f_lo / (f_lo - f_hi)
-    last_step = width
     for _ in range(200):
         f = cubic_value(a0, a1, a2, a3, t) - level
         if f == 0.0:
@@ -213,14 +213,11 @@ def cubic_level_time(a0, a1, a2, a3, level, t_lo, t_hi, f_lo, f_hi):
         d2 = 2.0 * a2 + 6.0 * a3 * t
         t_new = t - 2.0 * f * d1 / (2.0 * d1 * d1 - f * d2)
         if lo < t_new < hi:  # false also for a zero or NaN denominator
-            step = abs(t_new - t)
-            if step <= 1e-10 * width or (step <= 1e-6 * width and step <= 1e-3 * last_step):
+            if abs(t_new - t) <= 1e-5 * width:
                 return t_new
-            last_step = step
         else:
             t_new = 0.5 * (lo + hi)
-            last_step = hi - lo
-            if last_step <= 1e-10 * width:
+            if hi - lo <= 1e-10 * width:
                 return t_new
         t = t_new
     return t

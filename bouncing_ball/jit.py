@@ -14,6 +14,7 @@ switching between two versions does not recompile) and never one used in the
 last ``PRUNE_AFTER_SECONDS`` (a job of another version may still be running).
 """
 
+import functools
 import shutil
 import time
 from pathlib import Path
@@ -57,5 +58,7 @@ if CACHE.is_dir():
     CACHE.touch()  # in use: the newest to keep
 prune_caches(_base, CACHE)
 
-njit = numba.njit
+# IEEE division (inf or NaN) instead of a Python ZeroDivisionError check on every division:
+# the compiled code tests its own denominators, and the C reference of the loop does the same
+njit = functools.partial(numba.njit, error_model="numpy")
 prange = numba.prange

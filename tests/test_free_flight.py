@@ -99,3 +99,38 @@ def test_bridge_speed_squared_integral_is_unbiased():
     samples = _speed_squared_integrals(x0, v0, dt, 200_000, 5)
     expected = (v0**3 - (v0 - dt) ** 3) / 3 + dt**2
     assert abs(_z(samples, expected)) < 4
+
+
+def test_level_crossing_time_is_the_root_to_rounding():
+    """cubic_level_time against scipy's brentq on monotone pieces of random bridge paths,
+    including nearly linear ones (one Halley step) and pieces ending at a slope zero: to 1e-12
+    of the piece, or to what rounding of x allows where the piece spans few digits of x."""
+    from scipy.optimize import brentq
+
+    from bouncing_ball.free_flight import cubic_level_time, cubic_value, monotone_piece_end, slope_zeros
+
+    rng = np.random.default_rng(3)
+    worst = 0.0
+    checked = 0
+    for _ in range(3000):
+        dt = 10 ** rng.uniform(-6, 0.5)
+        x0 = 10 ** rng.uniform(-4, 1)
+        v0 = rng.normal(0, 2)
+        x1, v1 = free_flight_step(x0, v0, dt, rng.normal(), rng.normal())
+        a = hermite_cubic(x0, v0, x1, v1, dt)
+        n, t1, t2 = slope_zeros(a[1], a[2], a[3], dt)
+        start = 0.0
+        for piece in range(n + 1):
+            stop = monotone_piece_end(piece, n, t1, t2, dt)
+            m_lo, m_hi = cubic_value(*a, start), cubic_value(*a, stop)
+            level = m_lo + rng.uniform(0.01, 0.99) * (m_hi - m_lo)
+            if m_hi != m_lo:
+                t = cubic_level_time(*a, level, start, stop, m_lo - level, m_hi - level)
+                exact = brentq(lambda s: cubic_value(*a, s) - level, start, stop, xtol=1e-300, rtol=1e-15)
+                # the level is known only to rounding of x: that sets how well t can be known
+                conditioning = 4e-16 * max(abs(m_lo), abs(m_hi)) / abs(m_hi - m_lo)
+                worst = max(worst, abs(t - exact) / (stop - start) / (1e-12 + conditioning))
+                checked += 1
+            start = stop
+    assert checked > 3000
+    assert worst < 1.0

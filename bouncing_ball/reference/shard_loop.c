@@ -1,0 +1,519 @@
+/*
+ * shard_loop.c -- a plain C99 reference implementation of one simulation shard.
+ *
+ * What it is: a line-by-line translation of the numba-compiled shard loop
+ * ``bouncing_ball.simulation._run`` and of every numba function it calls:
+ *
+ *   bouncing_ball/free_flight.py: free_flight_step, largest_safe_step,
+ *       hermite_cubic, cubic_value, cubic_slope, mean_path_integrals,
+ *       speed_squared_coefficients, quintic_antiderivative_value,
+ *       cubic_level_time, slope_zeros, monotone_piece_end, first_crossing_time
+ *   bouncing_ball/simulation.py: _bin_index, _tally_position, _tally_step, _run
+ *
+ * (translated from the committed versions of those files).  Every floating-point
+ * operation is the same as in the Python source and in the same order (same
+ * parenthesisation, same constants, ``np.cbrt`` -> cbrt, ``math.log`` -> log,
+ * Python's min/max -> py_min/py_max, which keep Python's choice between equal
+ * arguments), so with the FMA contraction switched off (numba does not fuse
+ * multiply-adds) it gives bit-identical tallies.  The normals come from numpy's
+ * own C generator, ``random_standard_normal`` of libnpyrandom.a, called on the
+ * bit generator that Python passes in (``np.random.PCG64(seed).ctypes.bit_generator``),
+ * i.e. the same ziggurat that numba's ``Generator.standard_normal`` ports, on
+ * the same stream.
+ *
+ * What it is for: the yardstick of the performance target "the numba simulation
+ * runs at >= 90 % of the speed of a plain C implementation of the same loop
+ * (gcc -O3, a fast generator)", and a cross-check of the compiled loop.  It is
+ * not used by the workflow.
+ *
+ * How it is built and run: ``bouncing_ball.reference_loop.build()`` compiles it with
+ *
+ *   gcc -O3 -march=native -ffp-contract=off -fPIC -shared -std=c99
+ *       -I<numpy.get_include()> -I<Python include> shard_loop.c
+ *       <numpy>/random/lib/libnpyrandom.a -lm -o shard_loop.so
+ *
+ * into a cache folder keyed on this file's hash and the flags, and
+ * ``reference_loop.reference_shard`` (same arguments as
+ * ``simulation.simulate_shard``) calls ``bouncing_ball_shard_loop`` via ctypes.
+ * No allocation happens inside the loop (the two bin-bound arrays are
+ * allocated once before it, as np.empty is in ``_run``).
+ */
+
+#include "numpy/random/distributions.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+/* free_flight.py constants */
+#define SQRT3 0x1.bb67ae8584caap+0    /* math.sqrt(3.0) */
+#define SQRT1_12 0x1.279a74590331cp-2 /* math.sqrt(1.0 / 12.0) */
+#define FIT_P 0.44356066
+#define FIT_Q 0.56163652
+#define FIT_N1 0.40104058
+#define FIT_N2 0.00211799
+#define FIT_N3 0.06071102
+#define SMALLEST_NORMAL DBL_MIN /* np.finfo(np.float64).tiny */
+
+/* simulation.py */
+#define COLLAPSED_STEP 1.0e-80
+enum { TIME, COLLISIONS, STEPS, INT_X, INT_X2, EXHAUSTED };
+
+/* Python's min(a, b) and max(a, b) on floats, as numba compiles them */
+static inline double py_min(double a, double b) { return b < a ? b : a; }
+static inline double py_max(double a, double b) { return b > a ? b : a; }
+
+/* ---------------------------------------------------------------- free_flight.py */
+
+static inline void free_flight_step(double x, double v, double dt, double normal_r, double normal_s,
+                                    double *x_new, double *v_new)
+{
+    double root_2dt = sqrt(2.0 * dt);
+    *x_new = x + v * dt - 0.5 * dt * dt + dt * root_2dt * SQRT1_12 * (normal_s + SQRT3 * normal_r);
+    *v_new = v - dt + root_2dt * normal_r;
+}
+
+static inline double largest_safe_step(double x, double v, double c)
+{
+    double s;
+    if (x < SMALLEST_NORMAL) {
+        if (v <= 0.0)
+            return 0.0;
+        s = 2.0 * v / (c + sqrt(c * c + 2.0 * v));
+        return s * s;
+    }
+    double a3 = x / c;
+    double a = cbrt(a3);
+    double b = v / c;
+    if (b >= 0.0) {
+        double a2 = a * a;
+        s = b + a * ((a3 + FIT_P * a2 * b)
+                     / (a3 + b * (a2 * (FIT_P + 2.0 / 3.0) + b * (FIT_Q * a + FIT_P * b))));
+    } else {
+        double a2 = a * a;
+        s = sqrt(a3 / (-b + a2 * (a - FIT_N3 * b) / (a2 - b * (FIT_N1 * a - FIT_N2 * b))));
+    }
+    for (int i = 0; i < 100; i++) {
+        double f = x + s * s * (v - s * (c + 0.5 * s));
+        double fp = s * (2.0 * v - s * (3.0 * c + 2.0 * s));
+        if (!(fp < 0.0))
+            break;
+        double fpp = 2.0 * v - s * (6.0 * c + 6.0 * s);
+        double denominator = 2.0 * fp * fp - f * fpp;
+        double step = denominator > 0.0 ? 2.0 * f * fp / denominator : f / fp;
+        s -= step;
+        if (fabs(step) <= 1e-5 * s)
+            break;
+    }
+    return s * s;
+}
+
+static inline void hermite_cubic(double x0, double v0, double x1, double v1, double dt,
+                                 double *a0, double *a1, double *a2, double *a3)
+{
+    double inv_dt = 1.0 / dt;
+    double slope = (x1 - x0) * inv_dt;
+    *a0 = x0;
+    *a1 = v0;
+    *a2 = (3.0 * slope - 2.0 * v0 - v1) * inv_dt;
+    *a3 = (v0 + v1 - 2.0 * slope) * (inv_dt * inv_dt);
+}
+
+static inline double cubic_value(double a0, double a1, double a2, double a3, double t)
+{
+    return a0 + t * (a1 + t * (a2 + t * a3));
+}
+
+static inline double cubic_slope(double a1, double a2, double a3, double t)
+{
+    return a1 + t * (2.0 * a2 + t * 3.0 * a3);
+}
+
+static inline void mean_path_integrals(double a0, double a1, double a2, double a3, double dt,
+                                       double tau, double *int_x_out, double *int_x2_out)
+{
+    double int_x = tau * (a0 + tau * (0.5 * a1 + tau * ((1.0 / 3.0) * a2 + tau * 0.25 * a3)));
+    double c0 = a0 * a0;
+    double c1 = 2.0 * a0 * a1;
+    double c2 = a1 * a1 + 2.0 * a0 * a2;
+    double c3 = 2.0 * (a0 * a3 + a1 * a2);
+    double c4 = a2 * a2 + 2.0 * a1 * a3;
+    double c5 = 2.0 * a2 * a3;
+    double c6 = a3 * a3;
+    double int_m2 = tau * (
+        c0
+        + tau
+        * (
+            0.5 * c1
+            + tau
+            * (
+                (1.0 / 3.0) * c2
+                + tau
+                * (
+                    0.25 * c3
+                    + tau * ((1.0 / 5.0) * c4 + tau * ((1.0 / 6.0) * c5 + tau * (1.0 / 7.0) * c6))
+                )
+            )
+        )
+    );
+    /* int_0^tau 2 t^3 (dt - t)^3 / (3 dt^3) dt */
+    double u = tau / dt;
+    double tau2 = tau * tau;
+    double int_var = (2.0 / 3.0) * tau2 * tau2 * (0.25 - u * (3.0 / 5.0 - u * (0.5 - u * (1.0 / 7.0))));
+    *int_x_out = int_x;
+    *int_x2_out = int_m2 + int_var;
+}
+
+typedef struct {
+    double s1, s2, s3, s4, s5;
+} quintic;
+
+static inline quintic speed_squared_coefficients(double a1, double a2, double a3, double dt)
+{
+    double inv_dt = 1.0 / dt;
+    quintic q;
+    q.s1 = a1 * a1;
+    q.s2 = 2.0 * a1 * a2 + 1.0;
+    q.s3 = (4.0 / 3.0) * a2 * a2 + 2.0 * a1 * a3 - (8.0 / 3.0) * inv_dt;
+    q.s4 = 3.0 * a2 * a3 + 3.0 * inv_dt * inv_dt;
+    q.s5 = (9.0 / 5.0) * a3 * a3 - (6.0 / 5.0) * inv_dt * inv_dt * inv_dt;
+    return q;
+}
+
+static inline double quintic_antiderivative_value(double s1, double s2, double s3, double s4,
+                                                  double s5, double t)
+{
+    return t * (s1 + t * (s2 + t * (s3 + t * (s4 + t * s5))));
+}
+
+static inline double cubic_level_time(double a0, double a1, double a2, double a3, double level,
+                                      double t_lo, double t_hi, double f_lo, double f_hi)
+{
+    if (f_lo == 0.0)
+        return t_lo;
+    int rising = f_lo < 0.0;
+    double width = t_hi - t_lo;
+    double lo = t_lo, hi = t_hi;
+    double t = t_lo + width * f_lo / (f_lo - f_hi);
+    for (int i = 0; i < 200; i++) {
+        double f = cubic_value(a0, a1, a2, a3, t) - level;
+        if (f == 0.0)
+            return t;
+        if ((f < 0.0) == rising)
+            lo = t;
+        else
+            hi = t;
+        double d1 = cubic_slope(a1, a2, a3, t);
+        double d2 = 2.0 * a2 + 6.0 * a3 * t;
+        double t_new = t - 2.0 * f * d1 / (2.0 * d1 * d1 - f * d2);
+        if (lo < t_new && t_new < hi) { /* false also for a zero or NaN denominator */
+            if (fabs(t_new - t) <= 1e-5 * width)
+                return t_new;
+        } else {
+            t_new = 0.5 * (lo + hi);
+            if (hi - lo <= 1e-10 * width)
+                return t_new;
+        }
+        t = t_new;
+    }
+    return t;
+}
+
+/* the zeros of m'(t) strictly inside (0, t_end): returns their count, sets t1 < t2 */
+static inline int slope_zeros(double a1, double a2, double a3, double t_end, double *t1_out,
+                              double *t2_out)
+{
+    double a = 3.0 * a3, b = 2.0 * a2, c = a1;
+    double t1 = t_end;
+    double t2 = t_end;
+    int n = 0;
+    *t1_out = t1;
+    *t2_out = t2;
+    if (a == 0.0) {
+        if (b != 0.0) {
+            double r = -c / b;
+            if (0.0 < r && r < t_end) {
+                t1 = r;
+                n = 1;
+            }
+        }
+        *t1_out = t1;
+        *t2_out = t2;
+        return n;
+    }
+    double disc = b * b - 4.0 * a * c;
+    if (disc <= 0.0)
+        return 0;
+    double sq = sqrt(disc);
+    double qq = b >= 0.0 ? -0.5 * (b + sq) : -0.5 * (b - sq);
+    double r1 = qq / a;
+    double r2 = qq != 0.0 ? c / qq : r1;
+    if (r1 > r2) {
+        double swap = r1;
+        r1 = r2;
+        r2 = swap;
+    }
+    if (0.0 < r1 && r1 < t_end) {
+        t1 = r1;
+        n = 1;
+    }
+    if (0.0 < r2 && r2 < t_end && r2 > r1) {
+        if (n == 0)
+            t1 = r2;
+        else
+            t2 = r2;
+        n += 1;
+    }
+    *t1_out = t1;
+    *t2_out = t2;
+    return n;
+}
+
+static inline double monotone_piece_end(int piece, int n_zero, double t1, double t2, double t_end)
+{
+    if (piece == 0 && n_zero >= 1)
+        return t1;
+    if (piece == 1 && n_zero == 2)
+        return t2;
+    return t_end;
+}
+
+static inline double first_crossing_time(double a0, double a1, double a2, double a3, double t_end,
+                                         double x_end)
+{
+    double t1, t2;
+    int n = slope_zeros(a1, a2, a3, t_end, &t1, &t2);
+    double start = 0.0;
+    double m_start = a0;
+    for (int k = 0; k < n + 1; k++) {
+        double stop = monotone_piece_end(k, n, t1, t2, t_end);
+        double m_stop = stop == t_end ? x_end : cubic_value(a0, a1, a2, a3, stop);
+        if (m_stop <= 0.0)
+            return cubic_level_time(a0, a1, a2, a3, 0.0, start, stop, m_start, m_stop);
+        start = stop;
+        m_start = m_stop;
+    }
+    return t_end;
+}
+
+/* ---------------------------------------------------------------- simulation.py */
+
+static inline int64_t bin_index(double value, double log_lo, double per_ln, int64_t n,
+                                const double *edges)
+{
+    if (value < edges[0])
+        return 0;
+    if (value >= edges[n])
+        return n + 1;
+    int64_t k = (int64_t)((log(value) - log_lo) * per_ln);
+    if (k < 0)
+        k = 0;
+    if (k > n - 1)
+        k = n - 1;
+    /* correct a last-digit disagreement between log and the stored edges */
+    while (k > 0 && value < edges[k])
+        k -= 1;
+    while (k < n - 1 && value >= edges[k + 1])
+        k += 1;
+    return k + 1;
+}
+
+/* edges has n + 1 entries */
+static inline int64_t tally_position(double a0, double a1, double a2, double a3, quintic sq,
+                                     double t_a, double t_b, double x_a, double x_b, int64_t k,
+                                     const double *edges, int64_t n, double *time_in,
+                                     double *v2_in)
+{
+    double t_prev = t_a;
+    double x_prev = x_a;
+    double s_prev = quintic_antiderivative_value(sq.s1, sq.s2, sq.s3, sq.s4, sq.s5, t_a);
+    for (;;) {
+        double level;
+        int64_t k_next;
+        if (k <= n && x_b >= edges[k]) { /* leaves bin k through its upper edge */
+            level = edges[k];
+            k_next = k + 1;
+        } else if (k >= 1 && x_b < edges[k - 1]) { /* through its lower edge */
+            level = edges[k - 1];
+            k_next = k - 1;
+        } else {
+            break;
+        }
+        double t_e = cubic_level_time(a0, a1, a2, a3, level, t_prev, t_b, x_prev - level, x_b - level);
+        double s_e = quintic_antiderivative_value(sq.s1, sq.s2, sq.s3, sq.s4, sq.s5, t_e);
+        time_in[k] += t_e - t_prev;
+        v2_in[k] += s_e - s_prev;
+        t_prev = t_e;
+        x_prev = level;
+        s_prev = s_e;
+        k = k_next;
+    }
+    double s_b = quintic_antiderivative_value(sq.s1, sq.s2, sq.s3, sq.s4, sq.s5, t_b);
+    time_in[k] += t_b - t_prev;
+    v2_in[k] += s_b - s_prev;
+    return k;
+}
+
+static inline int64_t tally_step(double a0, double a1, double a2, double a3, double dt, double tau,
+                                 double x_tau, double slope_tau, int64_t k, const double *edges,
+                                 int64_t n, const double *bin_lower, const double *bin_upper,
+                                 double *time_in, double *v2_in)
+{
+    quintic sq = speed_squared_coefficients(a1, a2, a3, dt);
+    double c1 = a0 + a1 * tau * (1.0 / 3.0);
+    double c2 = x_tau - slope_tau * tau * (1.0 / 3.0);
+    double lowest = py_min(py_min(a0, x_tau), py_min(c1, c2));
+    double highest = py_max(py_max(a0, x_tau), py_max(c1, c2));
+    if (bin_lower[k] <= lowest && highest < bin_upper[k]) {
+        time_in[k] += tau;
+        v2_in[k] += quintic_antiderivative_value(sq.s1, sq.s2, sq.s3, sq.s4, sq.s5, tau);
+        return k;
+    }
+    /* m' is a quadratic with Bernstein control points m'(0), m'(0) + a2 tau, m'(tau):
+       when they share a sign, m is monotone and needs no split */
+    double slope_mid = a1 + a2 * tau;
+    int n_zero;
+    double t1, t2;
+    if ((a1 > 0.0 && slope_mid > 0.0 && slope_tau > 0.0)
+        || (a1 < 0.0 && slope_mid < 0.0 && slope_tau < 0.0)) {
+        n_zero = 0;
+        t1 = tau;
+        t2 = tau;
+    } else {
+        n_zero = slope_zeros(a1, a2, a3, tau, &t1, &t2);
+    }
+    double t_a = 0.0;
+    double x_a = a0;
+    for (int piece = 0; piece < n_zero + 1; piece++) {
+        double t_b = monotone_piece_end(piece, n_zero, t1, t2, tau);
+        double x_b = t_b == tau ? x_tau : cubic_value(a0, a1, a2, a3, t_b);
+        k = tally_position(a0, a1, a2, a3, sq, t_a, t_b, x_a, x_b, k, edges, n, time_in, v2_in);
+        t_a = t_b;
+        x_a = x_b;
+    }
+    return k;
+}
+
+/*
+ * _run.  v_edges has nv + 1 entries, x_edges nx + 1; speed_counts, position_time and
+ * position_v2_time have nv + 2, nx + 2 and nx + 2 entries (zeroed by the caller);
+ * scalars has 6.  Returns 0, or -1 if the two small bin-bound arrays cannot be allocated.
+ */
+int bouncing_ball_shard_loop(bitgen_t *rng, double restitution, double c, double min_step_divisor,
+                             double min_step_floor, double equilibration_time,
+                             double recorded_time, int64_t max_steps, const double *v_edges,
+                             int64_t nv, const double *x_edges, int64_t nx, int64_t *speed_counts,
+                             double *position_time, double *position_v2_time, double *scalars)
+{
+    double v_log_lo = log(v_edges[0]);
+    double v_per_ln = (double)nv / (log(v_edges[nv]) - v_log_lo);
+    double x_log_lo = log(x_edges[0]);
+    double x_per_ln = (double)nx / (log(x_edges[nx]) - x_log_lo);
+    /* the two ends of every x bin, the under- and overflow bins unbounded */
+    double *x_bin_lower = malloc((size_t)(nx + 2) * sizeof(double));
+    double *x_bin_upper = malloc((size_t)(nx + 2) * sizeof(double));
+    if (x_bin_lower == NULL || x_bin_upper == NULL) {
+        free(x_bin_lower);
+        free(x_bin_upper);
+        return -1;
+    }
+    x_bin_lower[0] = -INFINITY;
+    for (int64_t j = 0; j < nx + 1; j++) {
+        x_bin_lower[j + 1] = x_edges[j];
+        x_bin_upper[j] = x_edges[j];
+    }
+    x_bin_upper[nx + 1] = INFINITY;
+
+    /* start at rest one unit above the floor; equilibration forgets this */
+    double x = 1.0;
+    double v = 0.0;
+    int64_t x_bin = bin_index(x, x_log_lo, x_per_ln, nx, x_edges); /* kept while recording */
+    double min_root_2delta = 1.0 / min_step_divisor;
+    double delta = py_max(0.5 * min_root_2delta * min_root_2delta, min_step_floor);
+    int recording = equilibration_time <= 0.0;
+    double t = 0.0;
+    double t_stop = recording ? recorded_time : equilibration_time;
+    int64_t steps = 0; /* all steps, against the budget */
+    int64_t recorded_steps = 0;
+    int64_t collisions = 0;
+    double int_x = 0.0;
+    double int_x2 = 0.0;
+    int64_t exhausted = 0;
+
+    for (;;) {
+        if (t >= t_stop) {
+            if (recording)
+                break;
+            recording = 1;
+            x_bin = bin_index(x, x_log_lo, x_per_ln, nx, x_edges);
+            t = 0.0;
+            t_stop = recorded_time;
+            continue;
+        }
+        if (steps >= max_steps) {
+            exhausted = 1;
+            break;
+        }
+        double dt = largest_safe_step(x, v, c) + delta; /* eq. (criterion) plus delta */
+        if (!(dt > COLLAPSED_STEP)) { /* below r_c without a floor on delta */
+            exhausted = 1;
+            break;
+        }
+        if (t + dt > t_stop)
+            dt = t_stop - t;
+        double normal_r = random_standard_normal(rng);
+        double normal_s = random_standard_normal(rng);
+        double x1, v1;
+        free_flight_step(x, v, dt, normal_r, normal_s, &x1, &v1);
+        double a0, a1, a2, a3;
+        hermite_cubic(x, v, x1, v1, dt, &a0, &a1, &a2, &a3);
+        int collided = x1 < 0.0;
+        double tau, x_tau, v_tau;
+        if (collided) { /* the step ends where the mean path first reaches 0 */
+            tau = first_crossing_time(a0, a1, a2, a3, dt, x1);
+            x_tau = 0.0;
+            v_tau = cubic_slope(a1, a2, a3, tau);
+        } else {
+            tau = dt;
+            x_tau = x1;
+            v_tau = v1;
+        }
+        steps += 1;
+        if (recording) {
+            recorded_steps += 1;
+            double ix, ix2;
+            mean_path_integrals(a0, a1, a2, a3, dt, tau, &ix, &ix2);
+            int_x += ix;
+            int_x2 += ix2;
+            x_bin = tally_step(a0, a1, a2, a3, dt, tau, x_tau, v_tau, x_bin, x_edges, nx,
+                               x_bin_lower, x_bin_upper, position_time, position_v2_time);
+        }
+        t += tau;
+        if (collided) {
+            double v_out = restitution * fabs(v_tau); /* eq. (restitution) */
+            if (recording) {
+                collisions += 1;
+                speed_counts[bin_index(v_out, v_log_lo, v_per_ln, nv, v_edges)] += 1;
+            }
+            x = 0.0;
+            x_bin = 0;
+            v = v_out;
+            double root_2delta = v_out * min_root_2delta;
+            delta = py_max(0.5 * root_2delta * root_2delta, min_step_floor); /* below r_c: regularises */
+        } else {
+            x = x1;
+            v = v1;
+        }
+    }
+
+    scalars[TIME] = recording ? t : 0.0;
+    scalars[COLLISIONS] = (double)collisions;
+    scalars[STEPS] = (double)recorded_steps;
+    scalars[INT_X] = int_x;
+    scalars[INT_X2] = int_x2;
+    scalars[EXHAUSTED] = (double)exhausted;
+    free(x_bin_lower);
+    free(x_bin_upper);
+    return 0;
+}

@@ -1,0 +1,198 @@
+"""A plain C reference of the shard loop: build it, run one shard with it.
+
+``reference/shard_loop.c`` translates the compiled loop ``simulation._run``
+and the free-flight functions it calls, operation for operation, and draws its
+normals with numpy's own C ziggurat (``random_standard_normal`` of
+libnpyrandom.a) from the same PCG64 stream as ``simulate_shard``; so on the
+same seed sequence ``reference_shard`` returns the same tallies.  It is the
+yardstick of the performance target (numba at >= 90 % of a plain C loop) and a
+cross-check of the compiled code; the workflow does not use it.
+
+``build`` compiles it with gcc (-O3 -march=native, and -ffp-contract=off:
+numba does not fuse multiply-adds, so the C must not either) into a folder
+keyed on the hash of the C source and the whole compiler command, compiling
+only when that folder lacks the library and writing it atomically.  This
+module imports numpy and the package's light modules only, never numba.
+"""
+
+import ctypes
+import functools
+import hashlib
+import os
+import shutil
+import subprocess
+import sysconfig
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from . import PACKAGE
+from .bins import LogBins
+from .tallies import ShardTallies
+
+SOURCE = PACKAGE / "reference" / "shard_loop.c"
+COMPILER = "gcc"
+FLAGS = ("-O3", "-march=native", "-ffp-contract=off", "-fPIC", "-shared", "-std=c99")
+LIBRARY_NAME = "shard_loop.so"
+FUNCTION = "bouncing_ball_shard_loop"
+
+# indices into the scalar tally array (as in simulation.py)
+_TIME, _COLLISIONS, _STEPS, _INT_X, _INT_X2, _EXHAUSTED = range(6)
+
+
+def npyrandom_library() -> Path:
+    """numpy's static library of C distributions (random_standard_normal and co.)."""
+    path = Path(os.path.dirname(np.__file__)) / "random" / "lib" / "libnpyrandom.a"
+    if not path.is_file():
+        raise RuntimeError(f"numpy's C random library is missing: {path}")
+    return path
+
+
+def compile_command(source: Path, output: Path) -> list[str]:
+    """The gcc command that builds ``source`` into the shared library ``output``."""
+    return [
+        COMPILER,
+        *FLAGS,
+        f"-I{np.get_include()}",
+        f"-I{sysconfig.get_paths()['include']}",  # numpy's headers include Python.h
+        str(source),
+        str(npyrandom_library()),
+        "-lm",
+        "-o",
+        str(output),
+    ]
+
+
+def cache_key(source_text: bytes, command: list[str]) -> str:
+    """Hash of the C source and of the compiler command (flags, include and library paths)."""
+    digest = hashlib.sha256()
+    digest.update(source_text)
+    digest.update(b"\0")
+    digest.update("\0".join(command).encode())
+    return digest.hexdigest()[:16]
+
+
+def build(directory=None, source=None) -> Path:
+    """Compile the C reference (if not cached yet) and return the shared library's path.
+
+    The library goes to ``<directory>/reference-<key>/shard_loop.so``, ``directory``
+    defaulting to the package's __pycache__ and ``<key>`` hashing the source and
+    the compiler command, so an edit of the C file builds into a new folder.
+    ``source`` defaults to the package's reference/shard_loop.c.
+    """
+    source = Path(source) if source is not None else SOURCE
+    base = Path(directory) if directory is not None else PACKAGE / "__pycache__"
+    if shutil.which(COMPILER) is None:
+        raise RuntimeError(
+            f"the C compiler '{COMPILER}' was not found on PATH; it is needed to build {source.name}"
+        )
+    text = source.read_bytes()
+    # the key is computed on a placeholder output name, so that it does not depend on itself
+    key = cache_key(text, compile_command(Path(source.name), Path(LIBRARY_NAME)))
+    folder = base / f"reference-{key}"
+    library = folder / LIBRARY_NAME
+    if library.is_file():
+        return library
+    folder.mkdir(parents=True, exist_ok=True)
+    # compile a snapshot of the text that was hashed, to a temporary name, then rename
+    with tempfile.TemporaryDirectory(dir=folder, prefix=".build-") as scratch:
+        snapshot = Path(scratch) / source.name
+        snapshot.write_bytes(text)
+        temporary = Path(scratch) / LIBRARY_NAME
+        result = subprocess.run(
+            compile_command(snapshot, temporary), capture_output=True, text=True
+        )
+        if result.returncode != 0:
+            raise RuntimeError(f"compiling {source} failed:\n{result.stderr}")
+        os.replace(temporary, library)
+    return library
+
+
+_double_array = np.ctypeslib.ndpointer(dtype=np.float64, ndim=1, flags="C_CONTIGUOUS")
+_int64_array = np.ctypeslib.ndpointer(dtype=np.int64, ndim=1, flags="C_CONTIGUOUS")
+
+
+@functools.lru_cache(maxsize=None)
+def _load(library: str):
+    function = getattr(ctypes.CDLL(library), FUNCTION)
+    function.restype = ctypes.c_int
+    function.argtypes = [
+        ctypes.c_void_p,  # bitgen_t *
+        ctypes.c_double,  # restitution
+        ctypes.c_double,  # c
+        ctypes.c_double,  # min_step_divisor
+        ctypes.c_double,  # min_step_floor
+        ctypes.c_double,  # equilibration_time
+        ctypes.c_double,  # recorded_time
+        ctypes.c_int64,  # max_steps
+        _double_array,  # v_edges
+        ctypes.c_int64,  # nv
+        _double_array,  # x_edges
+        ctypes.c_int64,  # nx
+        _int64_array,  # speed_counts
+        _double_array,  # position_time
+        _double_array,  # position_v2_time
+        _double_array,  # scalars
+    ]
+    return function
+
+
+def reference_shard(
+    restitution: float,
+    seed_sequence: np.random.SeedSequence,
+    recorded_time: float,
+    equilibration_time: float,
+    criterion_c: float,
+    min_step_divisor: float,
+    max_steps: int,
+    speed_bins: LogBins,
+    position_bins: LogBins,
+    min_step_floor: float = 0.0,
+    library=None,
+) -> ShardTallies:
+    """``simulation.simulate_shard``, run by the C reference (``library``: a built
+    shared library, by default ``build()``)."""
+    if not 0.0 < restitution < 1.0:
+        raise ValueError(f"restitution must lie in (0, 1), got {restitution}")
+    function = _load(str(library if library is not None else build()))
+    bit_generator = np.random.PCG64(seed_sequence)  # kept alive across the call
+    v_edges = np.ascontiguousarray(speed_bins.edges, dtype=np.float64)
+    x_edges = np.ascontiguousarray(position_bins.edges, dtype=np.float64)
+    speed_counts = np.zeros(speed_bins.n + 2, dtype=np.int64)
+    position_time = np.zeros(position_bins.n + 2)
+    position_v2_time = np.zeros(position_bins.n + 2)
+    scalars = np.zeros(6)
+    status = function(
+        bit_generator.ctypes.bit_generator,
+        float(restitution),
+        float(criterion_c),
+        float(min_step_divisor),
+        float(min_step_floor),
+        float(equilibration_time),
+        float(recorded_time),
+        int(max_steps),
+        v_edges,
+        speed_bins.n,
+        x_edges,
+        position_bins.n,
+        speed_counts,
+        position_time,
+        position_v2_time,
+        scalars,
+    )
+    if status != 0:
+        raise MemoryError("the C reference could not allocate its bin bounds")
+    return ShardTallies(
+        speed_bins=speed_bins,
+        position_bins=position_bins,
+        speed_counts=speed_counts,
+        position_time=position_time,
+        position_v2_time=position_v2_time,
+        time=scalars[_TIME],
+        collisions=int(scalars[_COLLISIONS]),
+        steps=int(scalars[_STEPS]),
+        int_x=scalars[_INT_X],
+        int_x2=scalars[_INT_X2],
+        budget_exhausted=int(scalars[_EXHAUSTED]),
+    )
