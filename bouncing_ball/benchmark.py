@@ -1,11 +1,16 @@
 """Benchmarks on the machine it runs on: ``python -m bouncing_ball.benchmark [--json] [--scaling]``.
 
 Measured here (about 1-2 minutes; ``--scaling`` adds about one more):
-  * simulation throughput on one core at r = 0.25, 0.5, 0.75 with the paper's
-    c = 5 and 1/500 rule: collisions and simulated time per CPU second, steps
-    per collision, ns per step;
+  * simulation throughput on one core at r = 0.25, 0.5, 0.75 with the default
+    config's c and delta rule (c = 3, 1/500): collisions and simulated time
+    per CPU second, steps per collision, ns per step;
+  * the same loop in plain C (``reference/shard_loop.c``, gcc -O3, numpy's
+    own ziggurat on the same PCG64 stream, so the tallies must be identical):
+    numba's speed over C's at r = 1/2, with the tallies and stepping only
+    (target: at least 90%);
   * statistical efficiency at r = 1/2: (relative standard error of I)^2 x CPU
-    seconds, from 16 short shards (lower is better);
+    seconds, from 32 short shards (lower is better), for the default c and
+    the paper's c = 5;
   * numba's compile: the first shard in a fresh cache against a later shard
     (a new process that loads the cache), and the peak memory of a shard;
   * the solver of eq. (inteq): time per r (median of repeats after a warm-up
@@ -38,11 +43,27 @@ SOLVER_TARGET_SECONDS = 0.050
 SOLVER_TARGET_ERROR = 1e-8
 
 
-# the paper's settings and the default config's bins
-SIMULATION_SETTINGS = {"criterion_c": 5.0, "min_step_divisor": 500.0, "equilibration_time": 100.0}
+REPOSITORY = Path(__file__).resolve().parents[1]
+PAPER_CRITERION_C = 5.0
+
+
+def _default_simulation_settings():
+    """c and the delta divisor of the repository's default config (3 and 500 without one)."""
+    settings = {"criterion_c": 3.0, "min_step_divisor": 500.0}
+    config = REPOSITORY / "config" / "config.yaml"
+    if config.is_file():
+        import yaml
+
+        simulation = yaml.safe_load(config.read_text())["simulation"]
+        settings = {key: float(simulation[key]) for key in settings}
+    return {**settings, "equilibration_time": 100.0}
+
+
+# the default config's c and delta rule, and its bins
+SIMULATION_SETTINGS = _default_simulation_settings()
+REFERENCE_TARGET = 0.9  # numba's speed at least 90% of the C reference's
 # simulated time per throughput shard: about 2-4 CPU seconds each
 THROUGHPUT_TIMES = {0.25: 6.0e5, 0.5: 2.0e6, 0.75: 6.0e6}
-REPOSITORY = Path(__file__).resolve().parents[1]
 TARGETS = {"noop_seconds": 3.0, "grid_dry_run_seconds": 5.0, "cores_speedup": 1.8, "compile_later_seconds": 0.5}
 
 
@@ -78,6 +99,53 @@ def simulation_benchmark():
     return {"rows": rows}
 
 
+def reference_benchmark(r=0.5, recorded_time=2.0e6, repeats=3):
+    """The numba loop against the C reference of the same loop (``reference_loop``), same stream:
+    best of ``repeats`` CPU times each, with the tallies and without (all steps as equilibration)."""
+    import numpy as np
+
+    from . import reference_loop
+
+    try:
+        reference_loop.build()
+    except RuntimeError as error:
+        return {"skipped": str(error).splitlines()[0]}
+    from .bins import LogBins
+    from .restitution import restitution_label
+    from .simulation import shard_seed_sequence, simulate_shard
+
+    def arguments(recorded, equilibration):
+        return dict(
+            restitution=r, seed_sequence=shard_seed_sequence(1, restitution_label(r), 0), recorded_time=recorded,
+            equilibration_time=equilibration, criterion_c=SIMULATION_SETTINGS["criterion_c"],
+            min_step_divisor=SIMULATION_SETTINGS["min_step_divisor"], max_steps=10**13,
+            speed_bins=LogBins(1e-4, 1e2, 10), position_bins=LogBins(1e-3, 1e3, 5),
+        )
+
+    loops = {"numba": simulate_shard, "c": reference_loop.reference_shard}
+    for loop in loops.values():
+        loop(**arguments(10.0, 0.0))  # compile, build or load
+    rows = []
+    for case, recorded, equilibration in (("with tallies", recorded_time, 100.0), ("stepping only", 1e-9, recorded_time)):
+        best = {name: float("inf") for name in loops}
+        results = {}
+        for _ in range(repeats):  # interleaved, so a change of machine load hits both
+            for name, loop in loops.items():
+                started = time.process_time()
+                results[name] = loop(**arguments(recorded, equilibration))
+                best[name] = min(best[name], time.process_time() - started)
+        same = all(
+            np.array_equal(getattr(results["numba"], field), getattr(results["c"], field))
+            for field in ("speed_counts", "position_time", "position_v2_time", "time", "collisions", "steps")
+        )
+        rows.append({"case": case, "numba_cpu_seconds": best["numba"], "c_cpu_seconds": best["c"],
+                     "speed_ratio": best["c"] / best["numba"], "identical_tallies": bool(same)})
+    ratio = min(row["speed_ratio"] for row in rows)
+    return {"r": r, "simulated_time": recorded_time, **{k: SIMULATION_SETTINGS[k] for k in ("criterion_c", "min_step_divisor")},
+            "compiler": " ".join(reference_loop.FLAGS), "rows": rows, "worst_speed_ratio": ratio,
+            "target_met": ratio >= REFERENCE_TARGET}
+
+
 def _efficiency_shard(arguments):
     r, recorded_time, shard, settings = arguments
     started = time.process_time()
@@ -85,7 +153,7 @@ def _efficiency_shard(arguments):
     return tallies.collisions / tallies.time, time.process_time() - started, tallies.steps, tallies.collisions
 
 
-def efficiency_benchmark(settings=None, shards=16, recorded_time=1.0e5, r=0.5):
+def efficiency_benchmark(settings=None, shards=32, recorded_time=1.0e5, r=0.5):
     """(relative standard error of I)^2 x CPU seconds at r = 1/2 from ``shards`` shards in two processes."""
     import numpy as np
     from concurrent.futures import ProcessPoolExecutor
@@ -279,17 +347,32 @@ def _verdict(value, target, larger_is_better=False):
 
 
 def _print_all(results):
-    print("Simulation, one core, c = 5 and the 1/500 rule")
+    print(f"Simulation, one core, the default c = {SIMULATION_SETTINGS['criterion_c']:g} and the "
+          f"1/{SIMULATION_SETTINGS['min_step_divisor']:g} rule")
     print(f"{'r':>6} {'CPU s':>6} {'collisions/CPU s':>17} {'time/CPU s':>11} {'steps/collision':>16} {'ns/step':>8}")
     for row in results["simulation"]["rows"]:
         print(f"{row['r']:6.3g} {row['cpu_seconds']:6.2f} {row['collisions_per_cpu_second']:17.3g}"
               f" {row['simulated_time_per_cpu_second']:11.3g} {row['steps_per_collision']:16.1f}"
               f" {row['ns_per_step']:8.0f}")
-    e = results["efficiency"]
-    print(f"\nStatistical efficiency at r = 1/2 ({e['shards']} shards x {e['shard_time']:.0e}, c = "
-          f"{e['criterion_c']:g}, divisor {e['min_step_divisor']:g}): I = {e['collision_rate']:.5f} "
-          f"+- {100 * e['relative_error']:.2f}%, CPU {e['cpu_seconds']:.1f} s, "
-          f"(rel. error)^2 x CPU s = {e['variance_times_cpu']:.2e} (lower is better)")
+    ref = results["reference"]
+    print()
+    if "skipped" in ref:
+        print(f"C reference of the same loop: not measured ({ref['skipped']})")
+    else:
+        print(f"numba against the C reference of the same loop (gcc {ref['compiler']}; same stream), r = {ref['r']:g},"
+              f" c = {ref['criterion_c']:g}, best CPU s")
+        for row in ref["rows"]:
+            print(f"  {row['case']:>14}: numba {row['numba_cpu_seconds']:.2f} s, C {row['c_cpu_seconds']:.2f} s,"
+                  f" numba speed / C speed {row['speed_ratio']:.2f}, tallies identical: {row['identical_tallies']}")
+        print(f"  target: numba >= {REFERENCE_TARGET:.0%} of C: {'met' if ref['target_met'] else 'MISSED'}")
+    print()
+    for key in ("efficiency", "efficiency_paper_c"):
+        e = results[key]
+        print(f"Statistical efficiency at r = 1/2 ({e['shards']} shards x {e['shard_time']:.0e}, c = "
+              f"{e['criterion_c']:g}, divisor {e['min_step_divisor']:g}): I = {e['collision_rate']:.5f} "
+              f"+- {100 * e['relative_error']:.2f}%, {e['steps_per_collision']:.1f} steps/collision, CPU "
+              f"{e['cpu_seconds']:.1f} s, (rel. error)^2 x CPU s = {e['variance_times_cpu']:.2e} "
+              f"(+- {100 * (2 / (e['shards'] - 1)) ** 0.5:.0f}%; lower is better)")
     c = results["compile"]
     print(f"\nnumba: first shard in an empty cache {c['first_shard_compile_seconds']:.1f} s (compile), a later shard "
           f"in a new process {c['later_shard_load_seconds']:.2f} s (cache load; target <= "
@@ -329,7 +412,9 @@ def main(argv=None):
     solver_result = solver_benchmark()  # first: timed in a process that has run nothing else
     results = {
         "simulation": simulation_benchmark(),
+        "reference": reference_benchmark(),
         "efficiency": efficiency_benchmark(),
+        "efficiency_paper_c": efficiency_benchmark({"criterion_c": PAPER_CRITERION_C}),
         "compile": compile_benchmark(),
         "solver": solver_result,
         "workflow": workflow_benchmark(),

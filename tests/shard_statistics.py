@@ -1,27 +1,35 @@
 """CI-sized simulations and the statistics that hold them against predictions (shared by tests)."""
 
 from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
 
 import numpy as np
+import yaml
 
 from bouncing_ball.bins import LogBins
 from bouncing_ball.histograms import outgoing_speed_density, outgoing_speed_histogram
 from bouncing_ball.restitution import restitution_label
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 
+# the exact-result tests hold the simulation to the settings users run: the default config's
+DEFAULT_SIMULATION = yaml.safe_load((Path(__file__).resolve().parents[1] / "config" / "config.yaml").read_text())[
+    "simulation"
+]
+CRITERION_C = float(DEFAULT_SIMULATION["criterion_c"])
+MIN_STEP_DIVISOR = float(DEFAULT_SIMULATION["min_step_divisor"])
 SPEED_BINS = LogBins(1e-4, 1e2, 10)
 POSITION_BINS = LogBins(1e-3, 1e3, 5)
 
 
 def _shard(arguments):
-    r, shard, recorded_time, seed, floor = arguments
+    r, shard, recorded_time, seed, floor, criterion_c = arguments
     return simulate_shard(
         restitution=float(r),
         seed_sequence=shard_seed_sequence(seed, restitution_label(r), shard),
         recorded_time=recorded_time,
         equilibration_time=200.0,
-        criterion_c=5.0,
-        min_step_divisor=500.0,
+        criterion_c=criterion_c,
+        min_step_divisor=MIN_STEP_DIVISOR,
         max_steps=10**12,
         speed_bins=SPEED_BINS,
         position_bins=POSITION_BINS,
@@ -29,10 +37,10 @@ def _shard(arguments):
     )
 
 
-def simulate_shards(shard_times, shards, seed, min_step_floor=0.0):
-    """{r: [ShardTallies]} for {r: recorded time per shard}, two processes, the paper's c and delta rule
-    (with a floor on delta if ``min_step_floor`` > 0)."""
-    jobs = [(r, k, time, seed, min_step_floor) for r, time in shard_times.items() for k in range(shards)]
+def simulate_shards(shard_times, shards, seed, min_step_floor=0.0, criterion_c=CRITERION_C):
+    """{r: [ShardTallies]} for {r: recorded time per shard}, two processes, the default config's c
+    (or ``criterion_c``) and delta rule (with a floor on delta if ``min_step_floor`` > 0)."""
+    jobs = [(r, k, time, seed, min_step_floor, criterion_c) for r, time in shard_times.items() for k in range(shards)]
     with ProcessPoolExecutor(2) as pool:
         results = list(pool.map(_shard, jobs))
     return {r: [s for (rr, *_), s in zip(jobs, results) if rr == r] for r in shard_times}

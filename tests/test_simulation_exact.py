@@ -3,6 +3,7 @@
 CI-sized runs (a few core-seconds per r) that are still sharp: the relative
 standard error of <x>, Delta x and I is asserted to be 1% or less before the
 3-sigma comparison is made.  Seeds are fixed, so the outcome is deterministic.
+Run with the default config's criterion constant c and with the paper's c = 5.
 """
 
 from fractions import Fraction
@@ -10,7 +11,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from shard_statistics import outgoing_speed_bins, sign_flip_p_values, simulate_shards
+from shard_statistics import CRITERION_C, outgoing_speed_bins, sign_flip_p_values, simulate_shards
 
 from bouncing_ball import exact
 from bouncing_ball.histograms import position_histogram, position_moments_summary
@@ -26,9 +27,13 @@ PAPER = {
 }
 
 
-@pytest.fixture(scope="module")
-def shards():
-    return simulate_shards(SHARD_TIME, SHARDS, SEED)
+# the default config's c, and the paper's c = 5 where that differs
+CRITERIA = sorted({CRITERION_C, 5.0})
+
+
+@pytest.fixture(scope="module", params=CRITERIA, ids=lambda c: f"c={c:g}")
+def shards(request):
+    return simulate_shards(SHARD_TIME, SHARDS, SEED, criterion_c=request.param)
 
 
 @pytest.mark.parametrize("r", list(PAPER), ids=str)

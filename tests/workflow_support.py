@@ -15,7 +15,7 @@ SMALL = {
         "shards": 3,
         "shard_time": 2.0e3,
         "equilibration_time": 50.0,
-        "criterion_c": 5.0,
+        "criterion_c": 3.0,
         "min_step_divisor": 500,
         "max_steps": 1.0e9,
         "speed_bins": {"lo": 1.0e-4, "hi": 1.0e2, "per_decade": 10},
