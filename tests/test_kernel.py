@@ -87,3 +87,16 @@ def test_small_u_limit():
     v = np.array([1e-3, 0.5, 3.0, 20.0])
     u = 1e-9 * v
     np.testing.assert_allclose(return_speed_kernel(v, u), kernel_small_u_limit(v, u), rtol=1e-8)
+
+
+def test_tau_rule_is_converged():
+    """The fixed Gauss-Legendre rule of the tau integral against a 64-node rule, over
+    v in [1e-5, 200] and u in [1e-12, 200]: far below the solver's 1e-11."""
+    from bouncing_ball.kernel import _kernel_matrix, return_speed_kernel_matrix
+
+    v, u = np.geomspace(1e-5, 200.0, 150), np.geomspace(1e-12, 200.0, 160)
+    nodes, weights = np.polynomial.legendre.leggauss(64)
+    reference = _kernel_matrix(v, u, 0.5 * (nodes + 1.0), 0.5 * weights)
+    rule = return_speed_kernel_matrix(v, u)
+    resolved = reference > 1e-300
+    assert np.max(np.abs(rule[resolved] / reference[resolved] - 1.0)) < 1e-12
