@@ -339,6 +339,21 @@ def bin_averages_of_curve(speeds, density, lower, upper):
     return bin_average(lambda v: np.exp(spline(np.log(v))), lower, upper)
 
 
+def fit_errors(errors, reference, expected):
+    """The per-bin standard errors that weight a fit: the jackknife's, except where it has
+    none to give.
+
+    With few shards a bin's jackknife error can be exactly 0 (every shard put the same
+    number of collisions there) or undefined; such a bin is weighted by its Poisson error
+    from the collisions it should hold, ``reference / sqrt(expected)``, so that it stays in
+    the fit (dropping it because of what its counts happened to be would select on the data).
+    """
+    errors = np.array(errors, dtype=float)
+    missing = ~(np.isfinite(errors) & (errors > 0.0))
+    errors[missing] = np.asarray(reference, dtype=float)[missing] / np.sqrt(np.asarray(expected, dtype=float)[missing])
+    return errors
+
+
 def expected_collisions(reference, lower, upper, total_time):
     """Collisions a run of ``total_time`` should put in each bin, from noise-free bin averages
     (eq. (collrate): rate = P-bar int_bin v dv)."""

@@ -110,3 +110,11 @@ def test_one_shard_is_refused():
     counts, times = synthetic_shards(np.random.default_rng(2), fits.SMALL_SPEED, truth, edges, time)
     with pytest.raises(ValueError, match="at least 2"):
         fits.fit_shards(fits.SMALL_SPEED, lower, upper, counts[:1], times[:1], np.ones(len(lower)), r, True)
+
+
+def test_bins_without_a_jackknife_error_are_weighted_by_their_poisson_error():
+    reference = np.array([2.0, 1.0, 0.5, 0.25])
+    expected = np.array([400.0, 100.0, 25.0, 16.0])
+    errors = fits.fit_errors([0.1, 0.0, np.nan, 0.07], reference, expected)
+    np.testing.assert_allclose(errors, [0.1, 0.1, 0.1, 0.07])
+    assert np.all(errors > 0)
