@@ -190,10 +190,13 @@ def cubic_level_time(a0, a1, a2, a3, level, t_lo, t_hi, f_lo, f_hi):
     f_lo = 0).  Safeguarded Halley iteration from the linear interpolation of
     the ends: a step that leaves the bracket is replaced by bisection, so it
     always converges.  It stops after a Halley step below 1e-5 of the bracket
-    (the root is simple and the convergence cubic, so the error left is of
-    order (1e-5)^3 of it, at the level of rounding; most crossings need one or
-    two steps from the linear start), or when bisection has shrunk the bracket
-    to 1e-10 of it.
+    where the slope there is at least 0.1 of the bracket's mean slope: then m'
+    changes by < 1e-3 over the step, the step measures the distance to the
+    root and the error left is at rounding (most crossings need one or two
+    steps from the linear start).  Next to a zero of m' (a piece ends where
+    the path turns) a Halley step is short because m' is small, not because
+    the root is near; such a step is replaced by bisection, which stops when
+    the bracket is 1e-10 of its start.
     """
     if f_lo == 0.0:
         return t_lo
@@ -212,13 +215,14 @@ def cubic_level_time(a0, a1, a2, a3, level, t_lo, t_hi, f_lo, f_hi):
         d1 = cubic_slope(a1, a2, a3, t)
         d2 = 2.0 * a2 + 6.0 * a3 * t
         t_new = t - 2.0 * f * d1 / (2.0 * d1 * d1 - f * d2)
-        if lo < t_new < hi:  # false also for a zero or NaN denominator
-            if abs(t_new - t) <= 1e-5 * width:
-                return t_new
-        else:
-            t_new = 0.5 * (lo + hi)
+        short = abs(t_new - t) <= 1e-5 * width
+        # not lo < t_new < hi: outside the bracket, or a zero or NaN denominator
+        if not lo < t_new < hi or (short and abs(d1) * width < 0.1 * abs(f_hi - f_lo)):
+            t_new = 0.5 * (lo + hi)  # bisect (also where a step is short only because m' is small)
             if hi - lo <= 1e-10 * width:
                 return t_new
+        elif short:
+            return t_new
         t = t_new
     return t
 

@@ -15,6 +15,7 @@ last ``PRUNE_AFTER_SECONDS`` (a job of another version may still be running).
 """
 
 import functools
+import os
 import shutil
 import time
 from pathlib import Path
@@ -54,8 +55,10 @@ def prune_caches(base: Path, current: Path, keep: int = KEEP_CACHES, older_than:
 _base = Path(numba.config.CACHE_DIR) if numba.config.CACHE_DIR else PACKAGE / "__pycache__"
 CACHE = _base / f"numba-{source_digest()}"
 numba.config.CACHE_DIR = str(CACHE)
-if CACHE.is_dir():
-    CACHE.touch()  # in use: the newest to keep
+try:
+    os.utime(CACHE)  # in use: the newest to keep
+except OSError:
+    pass  # not there yet, or not ours to touch (a shared or read-only cache)
 prune_caches(_base, CACHE)
 
 # IEEE division (inf or NaN) instead of a Python ZeroDivisionError check on every division:

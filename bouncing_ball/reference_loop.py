@@ -196,3 +196,12 @@ def reference_shard(
         int_x2=scalars[_INT_X2],
         budget_exhausted=int(scalars[_EXHAUSTED]),
     )
+
+
+TALLY_FIELDS = ("speed_counts", "position_time", "position_v2_time", "time", "collisions", "steps",
+                "int_x", "int_x2", "budget_exhausted")
+
+
+def differing_tallies(first: ShardTallies, second: ShardTallies) -> list[str]:
+    """The tally fields in which two shards' results differ (bit for bit); [] if none."""
+    return [name for name in TALLY_FIELDS if not np.array_equal(getattr(first, name), getattr(second, name))]

@@ -42,10 +42,12 @@ def main(shard_paths, solver_path, restitution, settings, output):
     keep = expected >= settings["minimum_count"]
     lower, upper, reference = lower_all[keep], upper_all[keep], reference_all[keep]
     rows = np.flatnonzero(inside)[keep]
-    errors = fits.fit_errors(table.p0v_err.to_numpy()[rows], reference, expected[keep])
-    if np.any(errors != table.p0v_err.to_numpy()[rows]):
+    jackknife_errors = table.p0v_err.to_numpy()[rows]
+    errors = fits.fit_errors(jackknife_errors, reference, expected[keep])
+    replaced = int(np.sum(errors != jackknife_errors))
+    if replaced:
         logging.warning("r=%s: %d bins without a jackknife error (too few shards?) are weighted by their "
-                        "Poisson error", label, int(np.sum(errors != table.p0v_err.to_numpy()[rows])))
+                        "Poisson error", label, replaced)
     counts = np.stack([s.speed_counts[rows] for s in shards])
     windows = {fits.SMALL_SPEED: settings["small_speed_window"], fits.LARGE_SPEED: settings["large_speed_window"]}
     result, problems = fits.asymptotic_fits(

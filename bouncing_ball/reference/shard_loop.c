@@ -207,13 +207,14 @@ static inline double cubic_level_time(double a0, double a1, double a2, double a3
         double d1 = cubic_slope(a1, a2, a3, t);
         double d2 = 2.0 * a2 + 6.0 * a3 * t;
         double t_new = t - 2.0 * f * d1 / (2.0 * d1 * d1 - f * d2);
-        if (lo < t_new && t_new < hi) { /* false also for a zero or NaN denominator */
-            if (fabs(t_new - t) <= 1e-5 * width)
-                return t_new;
-        } else {
-            t_new = 0.5 * (lo + hi);
+        int is_short = fabs(t_new - t) <= 1e-5 * width;
+        /* !(lo < t_new < hi): outside the bracket, or a zero or NaN denominator */
+        if (!(lo < t_new && t_new < hi) || (is_short && fabs(d1) * width < 0.1 * fabs(f_hi - f_lo))) {
+            t_new = 0.5 * (lo + hi); /* bisect (also where a step is short only because m' is small) */
             if (hi - lo <= 1e-10 * width)
                 return t_new;
+        } else if (is_short) {
+            return t_new;
         }
         t = t_new;
     }
