@@ -37,8 +37,6 @@ FLAGS = ("-O3", "-march=native", "-ffp-contract=off", "-fPIC", "-shared", "-std=
 LIBRARY_NAME = "shard_loop.so"
 FUNCTION = "bouncing_ball_shard_loop"
 
-# indices into the scalar tally array (as in simulation.py)
-_TIME, _COLLISIONS, _STEPS, _INT_X, _INT_X2, _EXHAUSTED = range(6)
 
 
 def npyrandom_library() -> Path:
@@ -183,19 +181,7 @@ def reference_shard(
     )
     if status != 0:
         raise MemoryError("the C reference could not allocate its bin bounds")
-    return ShardTallies(
-        speed_bins=speed_bins,
-        position_bins=position_bins,
-        speed_counts=speed_counts,
-        position_time=position_time,
-        position_v2_time=position_v2_time,
-        time=scalars[_TIME],
-        collisions=int(scalars[_COLLISIONS]),
-        steps=int(scalars[_STEPS]),
-        int_x=scalars[_INT_X],
-        int_x2=scalars[_INT_X2],
-        budget_exhausted=int(scalars[_EXHAUSTED]),
-    )
+    return ShardTallies.from_loop(speed_bins, position_bins, speed_counts, position_time, position_v2_time, scalars)
 
 
 TALLY_FIELDS = ("speed_counts", "position_time", "position_v2_time", "time", "collisions", "steps",

@@ -75,7 +75,7 @@ from . import stages
 # the modules whose code decides a shard's numbers (see ``source_digest``)
 SOURCES = stages.SIMULATION
 
-# indices into the scalar tally array of the compiled loop
+# indices into the scalar tally array of the compiled loop, in the order of tallies.SCALARS
 _TIME, _COLLISIONS, _STEPS, _INT_X, _INT_X2, _EXHAUSTED = range(6)
 
 
@@ -342,16 +342,4 @@ def simulate_shard(
         position_v2_time,
         scalars,
     )
-    return ShardTallies(
-        speed_bins=speed_bins,
-        position_bins=position_bins,
-        speed_counts=speed_counts,
-        position_time=position_time,
-        position_v2_time=position_v2_time,
-        time=scalars[_TIME],
-        collisions=int(scalars[_COLLISIONS]),
-        steps=int(scalars[_STEPS]),
-        int_x=scalars[_INT_X],
-        int_x2=scalars[_INT_X2],
-        budget_exhausted=int(scalars[_EXHAUSTED]),
-    )
+    return ShardTallies.from_loop(speed_bins, position_bins, speed_counts, position_time, position_v2_time, scalars)

@@ -42,6 +42,16 @@ class ShardTallies:
     int_x2: float
     budget_exhausted: int  # number of shards that ran out of their step budget
 
+    @classmethod
+    def from_loop(cls, speed_bins, position_bins, speed_counts, position_time, position_v2_time, scalars):
+        """The tallies of a compiled shard loop: its three histograms and its scalar array,
+        ordered as ``SCALARS`` (the numba loop and its C reference both fill them so)."""
+        values = dict(zip(SCALARS, scalars))
+        for name in _INTEGER:
+            values[name] = int(values[name])
+        return cls(speed_bins=speed_bins, position_bins=position_bins, speed_counts=speed_counts,
+                   position_time=position_time, position_v2_time=position_v2_time, **values)
+
     def __add__(self, other: "ShardTallies") -> "ShardTallies":
         if (self.speed_bins, self.position_bins) != (other.speed_bins, other.position_bins):
             raise ValueError("cannot merge shards recorded on different bins")

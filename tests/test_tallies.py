@@ -122,3 +122,12 @@ def test_truncated_file_gives_an_error_that_names_it(tmp_path):
     path.write_bytes(path.read_bytes()[:200])
     with pytest.raises(UnreadableFileError, match="shard3.parquet"):
         read_table(path)
+
+
+def test_the_compiled_loop_fills_its_scalars_in_the_order_of_SCALARS():
+    from bouncing_ball import simulation
+    from bouncing_ball.tallies import SCALARS
+
+    indices = (simulation._TIME, simulation._COLLISIONS, simulation._STEPS, simulation._INT_X,
+               simulation._INT_X2, simulation._EXHAUSTED)
+    assert [SCALARS[k] for k in indices] == ["time", "collisions", "steps", "int_x", "int_x2", "budget_exhausted"]
