@@ -157,10 +157,7 @@ def reference_shard(
     bit_generator = np.random.PCG64(seed_sequence)  # kept alive across the call
     v_edges = np.ascontiguousarray(speed_bins.edges, dtype=np.float64)
     x_edges = np.ascontiguousarray(position_bins.edges, dtype=np.float64)
-    speed_counts = np.zeros(speed_bins.n + 2, dtype=np.int64)
-    position_time = np.zeros(position_bins.n + 2)
-    position_v2_time = np.zeros(position_bins.n + 2)
-    scalars = np.zeros(6)
+    speed_counts, position_time, position_v2_time, scalars = ShardTallies.loop_arrays(speed_bins, position_bins)
     status = function(
         bit_generator.ctypes.bit_generator,
         float(restitution),

@@ -322,10 +322,7 @@ def simulate_shard(
     if not 0.0 < restitution < 1.0:
         raise ValueError(f"restitution must lie in (0, 1), got {restitution}")
     rng = np.random.Generator(np.random.PCG64(seed_sequence))
-    speed_counts = np.zeros(speed_bins.n + 2, dtype=np.int64)
-    position_time = np.zeros(position_bins.n + 2)
-    position_v2_time = np.zeros(position_bins.n + 2)
-    scalars = np.zeros(6)
+    speed_counts, position_time, position_v2_time, scalars = ShardTallies.loop_arrays(speed_bins, position_bins)
     _run(
         rng,
         float(restitution),

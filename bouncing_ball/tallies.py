@@ -42,6 +42,13 @@ class ShardTallies:
     int_x2: float
     budget_exhausted: int  # number of shards that ran out of their step budget
 
+    @staticmethod
+    def loop_arrays(speed_bins, position_bins):
+        """Zeroed arrays a compiled shard loop fills: speed counts, time and int v^2 dt per x bin
+        (each with under- and overflow), and the scalars in the order of ``SCALARS``."""
+        return (np.zeros(speed_bins.n + 2, dtype=np.int64), np.zeros(position_bins.n + 2),
+                np.zeros(position_bins.n + 2), np.zeros(len(SCALARS)))
+
     @classmethod
     def from_loop(cls, speed_bins, position_bins, speed_counts, position_time, position_v2_time, scalars):
         """The tallies of a compiled shard loop: its three histograms and its scalar array,
