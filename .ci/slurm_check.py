@@ -13,7 +13,12 @@ import pandas as pd
 from bouncing_ball.io import read_table
 
 # what the tiny config (.ci/slurm-tiny.yaml, one r, 4 shards, 2 per SLURM job) submits
-SUBMITTED = {"group_shards_simulate_shard": 2, "rule_merge_shards": 1, "rule_fit": 1, "rule_exact_solution": 1}
+SUBMITTED = {
+    "group_shards_simulate_shard": 2,
+    "rule_merge_shards": 1,
+    "rule_fit": 1,
+    "rule_exact_solution": 1,
+}
 # what each asks SLURM for: the resources of workflow/rules/*.smk (CPUs, minutes, MB); a
 # group of 2 shards runs them one after the other on one core (profiles/slurm: cores 1)
 REQUESTED = {
@@ -42,15 +47,25 @@ def check_jobs(run_dir, log_text):
         kinds[kind] = kinds.get(kind, 0) + 1
         if not log_path.is_file():
             fail(f"SLURM job {slurm_id}: no log file {log_path}")
-        state = subprocess.run(["scontrol", "show", "job", slurm_id], capture_output=True, text=True)
+        state = subprocess.run(
+            ["scontrol", "show", "job", slurm_id], capture_output=True, text=True
+        )
         fields = dict(re.findall(r"(\w+)=(\S*)", state.stdout))
         if fields.get("JobState") != "COMPLETED":
-            fail(f"SLURM job {slurm_id} is not COMPLETED for slurmctld:\n{state.stdout}{state.stderr}")
+            fail(
+                f"SLURM job {slurm_id} is not COMPLETED for slurmctld:\n{state.stdout}{state.stderr}"
+            )
         hours, minutes, _ = map(int, fields["TimeLimit"].split(":"))
-        requested = (int(fields["NumCPUs"]), 60 * hours + minutes, int(fields["MinMemoryNode"].rstrip("M")))
+        requested = (
+            int(fields["NumCPUs"]),
+            60 * hours + minutes,
+            int(fields["MinMemoryNode"].rstrip("M")),
+        )
         if requested != REQUESTED.get(kind):
-            fail(f"SLURM job {slurm_id} ({kind}) asked for (CPUs, minutes, MB) {requested}, "
-                 f"expected {REQUESTED.get(kind)}")
+            fail(
+                f"SLURM job {slurm_id} ({kind}) asked for (CPUs, minutes, MB) {requested}, "
+                f"expected {REQUESTED.get(kind)}"
+            )
     if kinds != SUBMITTED:
         fail(f"submitted to SLURM {kinds}, expected {SUBMITTED}")
     if "Falling back to 'sacct'" in log_text:
@@ -59,16 +74,24 @@ def check_jobs(run_dir, log_text):
         if f"localrule {rule}:" not in log_text:
             fail(f"rule {rule} did not run locally")
     ids = sorted(int(match.group(2)) for match in submissions)
-    print(f"{len(ids)} SLURM jobs, all COMPLETED for slurmctld, each with its log under "
-          f".snakemake/slurm_logs: job ids {ids}; by kind {kinds}; local rules {', '.join(LOCAL)}")
+    print(
+        f"{len(ids)} SLURM jobs, all COMPLETED for slurmctld, each with its log under "
+        f".snakemake/slurm_logs: job ids {ids}; by kind {kinds}; local rules {', '.join(LOCAL)}"
+    )
 
 
 def check_results(local_dir, slurm_dir):
-    local = sorted(p.relative_to(local_dir) for p in (local_dir / "results").rglob("*") if p.is_file())
-    cluster = sorted(p.relative_to(slurm_dir) for p in (slurm_dir / "results").rglob("*") if p.is_file())
+    local = sorted(
+        p.relative_to(local_dir) for p in (local_dir / "results").rglob("*") if p.is_file()
+    )
+    cluster = sorted(
+        p.relative_to(slurm_dir) for p in (slurm_dir / "results").rglob("*") if p.is_file()
+    )
     if local != cluster:
-        fail(f"different files: local only {sorted(set(local) - set(cluster))}, "
-             f"SLURM only {sorted(set(cluster) - set(local))}")
+        fail(
+            f"different files: local only {sorted(set(local) - set(cluster))}, "
+            f"SLURM only {sorted(set(cluster) - set(local))}"
+        )
     tables = 0
     for name in local:
         if name.suffix == ".parquet":
@@ -83,7 +106,9 @@ def check_results(local_dir, slurm_dir):
             tables += 1
         elif (local_dir / name).read_bytes() != (slurm_dir / name).read_bytes():
             fail(f"{name} differs between the local and the SLURM run")
-    print(f"{len(local)} result files ({tables} tables, exactly, with provenance) equal a local run's")
+    print(
+        f"{len(local)} result files ({tables} tables, exactly, with provenance) equal a local run's"
+    )
 
 
 def main():

@@ -14,7 +14,9 @@ def source_digest(modules=None) -> str:
     The workflow passes it to its rules as a parameter, so that editing the
     code behind a stage re-runs that stage and nothing else.
     """
-    names = sorted(path.stem for path in PACKAGE.glob("*.py")) if modules is None else sorted(modules)
+    names = (
+        sorted(path.stem for path in PACKAGE.glob("*.py")) if modules is None else sorted(modules)
+    )
     digest = hashlib.sha256()
     for name in names:
         digest.update(name.encode())

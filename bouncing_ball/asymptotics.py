@@ -7,6 +7,7 @@ for v -> infinity, eqs. (asym3)-(asym6).
 import numpy as np
 import pandas as pd
 from scipy import optimize
+
 from . import stages
 
 SOURCES = stages.THEORY  # what decides the theory table
@@ -24,7 +25,7 @@ def _log_restitution_of_beta(beta):
     derivative, (pi / 3) cot(5 pi / 6) = -pi / sqrt(3) = ln r_c.
     """
     if abs(beta - 2.0) < 1e-7:
-        return -np.pi / np.sqrt(3.0) + (beta - 2.0) * (-np.pi**2 / 9.0) * 2.0  # + O((beta-2)^2)
+        return -np.pi / np.sqrt(3.0) + (beta - 2.0) * (-(np.pi**2) / 9.0) * 2.0  # + O((beta-2)^2)
     return np.log(2.0 * np.sin((2.0 * beta + 1.0) * np.pi / 6.0)) / (beta - 2.0)
 
 

@@ -66,7 +66,12 @@ SIMULATION_SETTINGS = _default_simulation_settings()
 REFERENCE_TARGET = 0.9  # numba's speed at least 90% of the C reference's
 # simulated time per throughput shard: about 2-4 CPU seconds each
 THROUGHPUT_TIMES = {0.25: 6.0e5, 0.5: 2.0e6, 0.75: 6.0e6}
-TARGETS = {"noop_seconds": 3.0, "grid_dry_run_seconds": 5.0, "cores_speedup": 1.8, "compile_later_seconds": 0.5}
+TARGETS = {
+    "noop_seconds": 3.0,
+    "grid_dry_run_seconds": 5.0,
+    "cores_speedup": 1.8,
+    "compile_later_seconds": 0.5,
+}
 
 
 def _shard(r, recorded_time, shard=0, seed=1, **settings):
@@ -76,9 +81,13 @@ def _shard(r, recorded_time, shard=0, seed=1, **settings):
 
     options = {**SIMULATION_SETTINGS, **settings}
     return simulate_shard(
-        restitution=r, seed_sequence=shard_seed_sequence(seed, restitution_label(r), shard),
-        recorded_time=recorded_time, max_steps=10**13, speed_bins=LogBins(1e-4, 1e2, 10),
-        position_bins=LogBins(1e-3, 1e3, 5), **options,
+        restitution=r,
+        seed_sequence=shard_seed_sequence(seed, restitution_label(r), shard),
+        recorded_time=recorded_time,
+        max_steps=10**13,
+        speed_bins=LogBins(1e-4, 1e2, 10),
+        position_bins=LogBins(1e-3, 1e3, 5),
+        **options,
     )
 
 
@@ -94,15 +103,17 @@ def simulation_benchmark():
                 started = time.process_time()
                 tallies = _shard(r, recorded_time, criterion_c=criterion_c)
                 seconds = min(seconds, time.process_time() - started)
-            rows.append({
-                "r": r,
-                "criterion_c": criterion_c,
-                "cpu_seconds": seconds,
-                "collisions_per_cpu_second": tallies.collisions / seconds,
-                "simulated_time_per_cpu_second": tallies.time / seconds,
-                "steps_per_collision": tallies.steps / tallies.collisions,
-                "ns_per_step": 1e9 * seconds / tallies.steps,
-            })
+            rows.append(
+                {
+                    "r": r,
+                    "criterion_c": criterion_c,
+                    "cpu_seconds": seconds,
+                    "collisions_per_cpu_second": tallies.collisions / seconds,
+                    "simulated_time_per_cpu_second": tallies.time / seconds,
+                    "steps_per_collision": tallies.steps / tallies.collisions,
+                    "ns_per_step": 1e9 * seconds / tallies.steps,
+                }
+            )
     return {"rows": rows}
 
 
@@ -121,17 +132,25 @@ def reference_benchmark(r=0.5, recorded_time=2.0e6, repeats=3):
 
     def arguments(recorded, equilibration):
         return dict(
-            restitution=r, seed_sequence=shard_seed_sequence(1, restitution_label(r), 0), recorded_time=recorded,
-            equilibration_time=equilibration, criterion_c=SIMULATION_SETTINGS["criterion_c"],
-            min_step_divisor=SIMULATION_SETTINGS["min_step_divisor"], max_steps=10**13,
-            speed_bins=LogBins(1e-4, 1e2, 10), position_bins=LogBins(1e-3, 1e3, 5),
+            restitution=r,
+            seed_sequence=shard_seed_sequence(1, restitution_label(r), 0),
+            recorded_time=recorded,
+            equilibration_time=equilibration,
+            criterion_c=SIMULATION_SETTINGS["criterion_c"],
+            min_step_divisor=SIMULATION_SETTINGS["min_step_divisor"],
+            max_steps=10**13,
+            speed_bins=LogBins(1e-4, 1e2, 10),
+            position_bins=LogBins(1e-3, 1e3, 5),
         )
 
     loops = {"numba": simulate_shard, "c": reference_loop.reference_shard}
     for loop in loops.values():
         loop(**arguments(10.0, 0.0))  # compile, build or load
     rows = []
-    for case, recorded, equilibration in (("with tallies", recorded_time, 100.0), ("stepping only", 1e-9, recorded_time)):
+    for case, recorded, equilibration in (
+        ("with tallies", recorded_time, 100.0),
+        ("stepping only", 1e-9, recorded_time),
+    ):
         best = {name: float("inf") for name in loops}
         results = {}
         for _ in range(repeats):  # interleaved, so a change of machine load hits both
@@ -140,35 +159,62 @@ def reference_benchmark(r=0.5, recorded_time=2.0e6, repeats=3):
                 results[name] = loop(**arguments(recorded, equilibration))
                 best[name] = min(best[name], time.process_time() - started)
         same = not reference_loop.differing_tallies(results["numba"], results["c"])
-        rows.append({"case": case, "numba_cpu_seconds": best["numba"], "c_cpu_seconds": best["c"],
-                     "speed_ratio": best["c"] / best["numba"], "identical_tallies": bool(same)})
+        rows.append(
+            {
+                "case": case,
+                "numba_cpu_seconds": best["numba"],
+                "c_cpu_seconds": best["c"],
+                "speed_ratio": best["c"] / best["numba"],
+                "identical_tallies": bool(same),
+            }
+        )
     ratio = min(row["speed_ratio"] for row in rows)
-    return {"r": r, "simulated_time": recorded_time, **{k: SIMULATION_SETTINGS[k] for k in ("criterion_c", "min_step_divisor")},
-            "compiler": " ".join(reference_loop.FLAGS), "rows": rows, "worst_speed_ratio": ratio,
-            "target_met": ratio >= REFERENCE_TARGET}
+    return {
+        "r": r,
+        "simulated_time": recorded_time,
+        **{k: SIMULATION_SETTINGS[k] for k in ("criterion_c", "min_step_divisor")},
+        "compiler": " ".join(reference_loop.FLAGS),
+        "rows": rows,
+        "worst_speed_ratio": ratio,
+        "target_met": ratio >= REFERENCE_TARGET,
+    }
 
 
 def _efficiency_shard(arguments):
     r, recorded_time, shard, settings = arguments
     started = time.process_time()
     tallies = _shard(r, recorded_time, shard=shard, seed=7, **settings)
-    return tallies.collisions / tallies.time, time.process_time() - started, tallies.steps, tallies.collisions
+    return (
+        tallies.collisions / tallies.time,
+        time.process_time() - started,
+        tallies.steps,
+        tallies.collisions,
+    )
 
 
 def efficiency_benchmark(settings=None, shards=32, recorded_time=1.0e5, r=0.5):
     """(relative standard error of I)^2 x CPU seconds at r = 1/2 from ``shards`` shards in two processes."""
-    import numpy as np
     from concurrent.futures import ProcessPoolExecutor
+
+    import numpy as np
 
     settings = settings or {}
     with ProcessPoolExecutor(2) as pool:
-        results = list(pool.map(_efficiency_shard, [(r, recorded_time, k, settings) for k in range(shards)]))
+        results = list(
+            pool.map(_efficiency_shard, [(r, recorded_time, k, settings) for k in range(shards)])
+        )
     rates = np.array([rate for rate, *_ in results])
     cpu = sum(seconds for _, seconds, *_ in results)
     relative_error = rates.std(ddof=1) / np.sqrt(shards) / rates.mean()
     return {
-        "r": r, **{**SIMULATION_SETTINGS, **settings}, "shards": shards, "shard_time": recorded_time,
-        "collision_rate": float(rates.mean()), "relative_error": float(relative_error), "cpu_seconds": cpu,
+        "r": r,
+        **SIMULATION_SETTINGS,
+        **settings,
+        "shards": shards,
+        "shard_time": recorded_time,
+        "collision_rate": float(rates.mean()),
+        "relative_error": float(relative_error),
+        "cpu_seconds": cpu,
         "variance_times_cpu": float(relative_error**2 * cpu),
         "steps_per_collision": sum(s for *_, s, _ in results) / sum(c for *_, c in results),
     }
@@ -202,8 +248,14 @@ def compile_benchmark(memory_shard_time=2.0e5):
         env = {**os.environ, "NUMBA_CACHE_DIR": cache}
         runs = []
         for _ in range(2):
-            output = subprocess.run([sys.executable, "-c", _PROBE, str(memory_shard_time)], env=env,
-                                    capture_output=True, text=True, check=True, timeout=300).stdout
+            output = subprocess.run(
+                [sys.executable, "-c", _PROBE, str(memory_shard_time)],
+                env=env,
+                capture_output=True,
+                text=True,
+                check=True,
+                timeout=300,
+            ).stdout
             runs.append(json.loads(output))
     first, later = runs
     return {
@@ -230,8 +282,13 @@ def _workflow_copy(directory, config):
 
 def _timed_snakemake(directory, *arguments):
     started = time.perf_counter()
-    result = subprocess.run([sys.executable, "-m", "snakemake", *arguments], cwd=directory,
-                            capture_output=True, text=True, timeout=600)
+    result = subprocess.run(
+        [sys.executable, "-m", "snakemake", *arguments],
+        cwd=directory,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     return time.perf_counter() - started, result
 
 
@@ -240,7 +297,9 @@ def workflow_benchmark():
     import yaml
 
     if not (REPOSITORY / "Snakefile").exists():
-        return {"skipped": f"no Snakefile next to the package ({REPOSITORY}): run from a repository checkout"}
+        return {
+            "skipped": f"no Snakefile next to the package ({REPOSITORY}): run from a repository checkout"
+        }
     config = yaml.safe_load((REPOSITORY / "config" / "config.yaml").read_text())
     config["restitution"] = [round(0.2 + 0.0375 * k, 4) for k in range(20)]
     config["simulation"]["shards"] = 16
@@ -249,7 +308,14 @@ def workflow_benchmark():
     with tempfile.TemporaryDirectory() as folder:
         _workflow_copy(Path(folder), config)
         dry_run, result = _timed_snakemake(folder, "--cores", "2", "--dry-run", "--quiet", "rules")
-        jobs = next((int(line.split()[1]) for line in result.stdout.splitlines() if line.startswith("simulate_shard")), 0)
+        jobs = next(
+            (
+                int(line.split()[1])
+                for line in result.stdout.splitlines()
+                if line.startswith("simulate_shard")
+            ),
+            0,
+        )
     planned, result = _timed_snakemake(REPOSITORY, "--cores", "2", "--dry-run", "--quiet", "rules")
     complete = "Nothing to be done" in result.stdout + result.stderr
     noop = _timed_snakemake(REPOSITORY, "--cores", "2")[0] if complete else None
@@ -277,8 +343,13 @@ def scaling_benchmark(shards=16, shard_time=5.0e6):
             if result.returncode != 0:
                 raise RuntimeError(result.stderr[-2000:])
             times[cores] = seconds
-    return {"shards": shards, "shard_time": shard_time, "cores_1_seconds": times[1],
-            "cores_2_seconds": times[2], "speedup": times[1] / times[2]}
+    return {
+        "shards": shards,
+        "shard_time": shard_time,
+        "cores_1_seconds": times[1],
+        "cores_2_seconds": times[2],
+        "speedup": times[1] / times[2],
+    }
 
 
 def _median_seconds(function, repeats):
@@ -303,7 +374,8 @@ def solver_benchmark(repeats=7):
         solution = solver.solve_outgoing_speed_density(r)
         seconds = _median_seconds(lambda: solver.solve_outgoing_speed_density(r), repeats)
         with_output = _median_seconds(
-            lambda: solver.solve_outgoing_speed_density(r).outgoing_speed_density(output_speeds), repeats
+            lambda: solver.solve_outgoing_speed_density(r).outgoing_speed_density(output_speeds),
+            repeats,
         )
         row = {
             "r": r,
@@ -313,7 +385,10 @@ def solver_benchmark(repeats=7):
             "energy_balance_residual": solver.energy_balance_residual(solution),
         }
         if any(abs(r - float(e)) < 1e-12 for e in exact.EXACT_RESTITUTIONS):
-            relative = solution.outgoing_speed_density(checked) / exact.outgoing_speed_density(checked, r) - 1.0
+            relative = (
+                solution.outgoing_speed_density(checked) / exact.outgoing_speed_density(checked, r)
+                - 1.0
+            )
             row["error_vs_exact"] = float(np.max(np.abs(relative)))
         rows.append(row)
     worst_time = max(row["solve_ms"] for row in rows)
@@ -322,13 +397,16 @@ def solver_benchmark(repeats=7):
         "rows": rows,
         "worst_solve_ms": worst_time,
         "worst_error_vs_exact": worst_error,
-        "target_met": worst_time <= 1e3 * SOLVER_TARGET_SECONDS and worst_error <= SOLVER_TARGET_ERROR,
+        "target_met": worst_time <= 1e3 * SOLVER_TARGET_SECONDS
+        and worst_error <= SOLVER_TARGET_ERROR,
     }
 
 
 def _print_solver(result):
     print("Solver of eq. (inteq), one core (median of repeats, after warm-up)")
-    print(f"{'r':>8} {'nodes':>6} {'solve ms':>9} {'+401 outputs ms':>16} {'energy resid':>13} {'err vs exact':>13}")
+    print(
+        f"{'r':>8} {'nodes':>6} {'solve ms':>9} {'+401 outputs ms':>16} {'energy resid':>13} {'err vs exact':>13}"
+    )
     for row in result["rows"]:
         error = f"{row['error_vs_exact']:.1e}" if "error_vs_exact" in row else "-"
         print(
@@ -349,45 +427,68 @@ def _verdict(value, target, larger_is_better=False):
 
 
 def _print_all(results):
-    print(f"Simulation, one core, the default c = {SIMULATION_SETTINGS['criterion_c']:g} and the paper's "
-          f"c = {PAPER_CRITERION_C:g}, the 1/{SIMULATION_SETTINGS['min_step_divisor']:g} rule")
-    print(f"{'r':>6} {'c':>3} {'CPU s':>6} {'collisions/CPU s':>17} {'time/CPU s':>11} {'steps/collision':>16} {'ns/step':>8}")
+    print(
+        f"Simulation, one core, the default c = {SIMULATION_SETTINGS['criterion_c']:g} and the paper's "
+        f"c = {PAPER_CRITERION_C:g}, the 1/{SIMULATION_SETTINGS['min_step_divisor']:g} rule"
+    )
+    print(
+        f"{'r':>6} {'c':>3} {'CPU s':>6} {'collisions/CPU s':>17} {'time/CPU s':>11} {'steps/collision':>16} {'ns/step':>8}"
+    )
     rows = results["simulation"]["rows"]
     for row in rows:
-        print(f"{row['r']:6.3g} {row['criterion_c']:3g} {row['cpu_seconds']:6.2f} {row['collisions_per_cpu_second']:17.3g}"
-              f" {row['simulated_time_per_cpu_second']:11.3g} {row['steps_per_collision']:16.1f}"
-              f" {row['ns_per_step']:8.0f}")
+        print(
+            f"{row['r']:6.3g} {row['criterion_c']:3g} {row['cpu_seconds']:6.2f} {row['collisions_per_cpu_second']:17.3g}"
+            f" {row['simulated_time_per_cpu_second']:11.3g} {row['steps_per_collision']:16.1f}"
+            f" {row['ns_per_step']:8.0f}"
+        )
     default, paper = SIMULATION_SETTINGS["criterion_c"], PAPER_CRITERION_C
     if default != paper:
-        rate = {(row["r"], row["criterion_c"]): row["simulated_time_per_cpu_second"] for row in rows}
-        saving = ", ".join(f"{100 * (1 - rate[r, paper] / rate[r, default]):.0f}% at r = {r:g}" for r in THROUGHPUT_TIMES)
+        rate = {
+            (row["r"], row["criterion_c"]): row["simulated_time_per_cpu_second"] for row in rows
+        }
+        saving = ", ".join(
+            f"{100 * (1 - rate[r, paper] / rate[r, default]):.0f}% at r = {r:g}"
+            for r in THROUGHPUT_TIMES
+        )
         print(f"CPU per simulated time, c = {default:g} against c = {paper:g}: {saving} less")
     ref = results["reference"]
     print()
     if "skipped" in ref:
         print(f"C reference of the same loop: not measured ({ref['skipped']})")
     else:
-        print(f"numba against the C reference of the same loop (gcc {ref['compiler']}; same stream), r = {ref['r']:g},"
-              f" c = {ref['criterion_c']:g}, best CPU s")
+        print(
+            f"numba against the C reference of the same loop (gcc {ref['compiler']}; same stream), r = {ref['r']:g},"
+            f" c = {ref['criterion_c']:g}, best CPU s"
+        )
         for row in ref["rows"]:
-            print(f"  {row['case']:>14}: numba {row['numba_cpu_seconds']:.2f} s, C {row['c_cpu_seconds']:.2f} s,"
-                  f" numba speed / C speed {row['speed_ratio']:.2f}, tallies identical: {row['identical_tallies']}")
-        print(f"  target: numba >= {REFERENCE_TARGET:.0%} of C: {'met' if ref['target_met'] else 'MISSED'}")
+            print(
+                f"  {row['case']:>14}: numba {row['numba_cpu_seconds']:.2f} s, C {row['c_cpu_seconds']:.2f} s,"
+                f" numba speed / C speed {row['speed_ratio']:.2f}, tallies identical: {row['identical_tallies']}"
+            )
+        print(
+            f"  target: numba >= {REFERENCE_TARGET:.0%} of C: {'met' if ref['target_met'] else 'MISSED'}"
+        )
     print()
     for key in ("efficiency", "efficiency_paper_c"):
         e = results[key]
-        print(f"Statistical efficiency at r = 1/2 ({e['shards']} shards x {e['shard_time']:.0e}, c = "
-              f"{e['criterion_c']:g}, divisor {e['min_step_divisor']:g}): I = {e['collision_rate']:.5f} "
-              f"+- {100 * e['relative_error']:.2f}%, {e['steps_per_collision']:.1f} steps/collision, CPU "
-              f"{e['cpu_seconds']:.1f} s, (rel. error)^2 x CPU s = {e['variance_times_cpu']:.2e} "
-              f"(+- {100 * (2 / (e['shards'] - 1)) ** 0.5:.0f}%; lower is better)")
+        print(
+            f"Statistical efficiency at r = 1/2 ({e['shards']} shards x {e['shard_time']:.0e}, c = "
+            f"{e['criterion_c']:g}, divisor {e['min_step_divisor']:g}): I = {e['collision_rate']:.5f} "
+            f"+- {100 * e['relative_error']:.2f}%, {e['steps_per_collision']:.1f} steps/collision, CPU "
+            f"{e['cpu_seconds']:.1f} s, (rel. error)^2 x CPU s = {e['variance_times_cpu']:.2e} "
+            f"(+- {100 * (2 / (e['shards'] - 1)) ** 0.5:.0f}%; lower is better)"
+        )
     c = results["compile"]
-    print(f"\nnumba: first shard in an empty cache {c['first_shard_compile_seconds']:.1f} s (compile), a later shard "
-          f"in a new process {c['later_shard_load_seconds']:.2f} s (cache load; target <= "
-          f"{TARGETS['compile_later_seconds']} s: {_verdict(c['later_shard_load_seconds'], TARGETS['compile_later_seconds'])}); "
-          f"imports {c['import_seconds']:.1f} s")
-    print(f"peak memory of a shard (r = 1/2, {c['memory_shard_time']:.0e} time units): {c['peak_memory_mib']:.0f} MiB "
-          f"({c['memory_before_shard_mib']:.0f} MiB before it)")
+    print(
+        f"\nnumba: first shard in an empty cache {c['first_shard_compile_seconds']:.1f} s (compile), a later shard "
+        f"in a new process {c['later_shard_load_seconds']:.2f} s (cache load; target <= "
+        f"{TARGETS['compile_later_seconds']} s: {_verdict(c['later_shard_load_seconds'], TARGETS['compile_later_seconds'])}); "
+        f"imports {c['import_seconds']:.1f} s"
+    )
+    print(
+        f"peak memory of a shard (r = 1/2, {c['memory_shard_time']:.0e} time units): {c['peak_memory_mib']:.0f} MiB "
+        f"({c['memory_before_shard_mib']:.0f} MiB before it)"
+    )
     print()
     _print_solver(results["solver"])
     w = results["workflow"]
@@ -395,26 +496,41 @@ def _print_all(results):
     if "skipped" in w:
         print(f"Workflow overhead: skipped ({w['skipped']})")
     else:
-        print(f"Workflow: dry run of 20 r x 16 shards ({w['grid_shard_jobs']} shard jobs): {w['grid_dry_run_seconds']:.1f} s"
-              f" (target < {TARGETS['grid_dry_run_seconds']:.0f} s: {_verdict(w['grid_dry_run_seconds'], TARGETS['grid_dry_run_seconds'])})")
+        print(
+            f"Workflow: dry run of 20 r x 16 shards ({w['grid_shard_jobs']} shard jobs): {w['grid_dry_run_seconds']:.1f} s"
+            f" (target < {TARGETS['grid_dry_run_seconds']:.0f} s: {_verdict(w['grid_dry_run_seconds'], TARGETS['grid_dry_run_seconds'])})"
+        )
         if w["noop_seconds"] is None:
-            print(f"no-op rerun of the default workflow: not measured (its results are not complete; "
-                  f"its dry run took {w['default_dry_run_seconds']:.1f} s)")
+            print(
+                f"no-op rerun of the default workflow: not measured (its results are not complete; "
+                f"its dry run took {w['default_dry_run_seconds']:.1f} s)"
+            )
         else:
-            print(f"no-op rerun of the default workflow: {w['noop_seconds']:.1f} s (target < "
-                  f"{TARGETS['noop_seconds']:.0f} s: {_verdict(w['noop_seconds'], TARGETS['noop_seconds'])})")
+            print(
+                f"no-op rerun of the default workflow: {w['noop_seconds']:.1f} s (target < "
+                f"{TARGETS['noop_seconds']:.0f} s: {_verdict(w['noop_seconds'], TARGETS['noop_seconds'])})"
+            )
     if "scaling" in results:
         s = results["scaling"]
-        print(f"simulation stage, {s['shards']} shards: --cores 1 {s['cores_1_seconds']:.1f} s, --cores 2 "
-              f"{s['cores_2_seconds']:.1f} s, speed-up {s['speedup']:.2f} (target >= {TARGETS['cores_speedup']}: "
-              f"{_verdict(s['speedup'], TARGETS['cores_speedup'], larger_is_better=True)})")
+        print(
+            f"simulation stage, {s['shards']} shards: --cores 1 {s['cores_1_seconds']:.1f} s, --cores 2 "
+            f"{s['cores_2_seconds']:.1f} s, speed-up {s['speedup']:.2f} (target >= {TARGETS['cores_speedup']}: "
+            f"{_verdict(s['speedup'], TARGETS['cores_speedup'], larger_is_better=True)})"
+        )
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m bouncing_ball.benchmark", description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--json", action="store_true", help="print machine-readable JSON instead of tables")
-    parser.add_argument("--scaling", action="store_true", help="also time the simulation stage with 1 and 2 cores")
+    parser = argparse.ArgumentParser(
+        prog="python -m bouncing_ball.benchmark",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "--json", action="store_true", help="print machine-readable JSON instead of tables"
+    )
+    parser.add_argument(
+        "--scaling", action="store_true", help="also time the simulation stage with 1 and 2 cores"
+    )
     args = parser.parse_args(argv)
     started = time.perf_counter()
     solver_result = solver_benchmark()  # first: timed in a process that has run nothing else
@@ -441,6 +557,6 @@ def main(argv=None):
 if __name__ == "__main__":
     if any(os.environ.get(name) != "1" for name in SINGLE_THREAD):
         # BLAS reads these when numpy is first imported: start again with them set
-        os.environ.update({name: "1" for name in SINGLE_THREAD})
+        os.environ.update(dict.fromkeys(SINGLE_THREAD, "1"))
         os.execv(sys.executable, [sys.executable, "-m", "bouncing_ball.benchmark", *sys.argv[1:]])
     sys.exit(main())

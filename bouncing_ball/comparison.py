@@ -9,8 +9,8 @@ from fractions import Fraction
 import numpy as np
 import pandas as pd
 
-from .fits import bin_averages_of_curve, usable_curve
 from . import stages
+from .fits import bin_averages_of_curve, usable_curve
 
 SOURCES = stages.COMPARISON
 
@@ -25,8 +25,18 @@ PAPER_VALUES = {
     Fraction(1, 3): {"mean_x": 3.89, "delta_x": 7.68, "collision_rate": 3.0 / 4.0},
 }
 
-MOMENT_COLUMNS = ("r_label", "r", "quantity", "paper", "exact", "solver", "simulation",
-                  "simulation_err", "reference", "z")
+MOMENT_COLUMNS = (
+    "r_label",
+    "r",
+    "quantity",
+    "paper",
+    "exact",
+    "solver",
+    "simulation",
+    "simulation_err",
+    "reference",
+    "z",
+)
 
 
 def moment_rows(label, restitution, simulation, solver, exact=None):
@@ -45,18 +55,20 @@ def moment_rows(label, restitution, simulation, solver, exact=None):
         value = float(simulation[quantity])
         error = float(simulation[f"{quantity}_err"])
         z = (value - reference) / error if np.isfinite(reference) and error > 0 else np.nan
-        rows.append({
-            "r_label": label,
-            "r": float(restitution),
-            "quantity": quantity,
-            "paper": paper[quantity] if paper else np.nan,
-            "exact": float(exact[quantity]) if exact is not None else np.nan,
-            "solver": float(solver[quantity]),
-            "simulation": value,
-            "simulation_err": error,
-            "reference": reference_name,
-            "z": z,
-        })
+        rows.append(
+            {
+                "r_label": label,
+                "r": float(restitution),
+                "quantity": quantity,
+                "paper": paper[quantity] if paper else np.nan,
+                "exact": float(exact[quantity]) if exact is not None else np.nan,
+                "solver": float(solver[quantity]),
+                "simulation": value,
+                "simulation_err": error,
+                "reference": reference_name,
+                "z": z,
+            }
+        )
     return rows
 
 
@@ -78,17 +90,23 @@ def value_with_error(value, error) -> str:
 
 def moments_markdown(table: pd.DataFrame) -> str:
     """The moments table for a reader: value +- error, the paper's rounded numbers, z."""
-    shown = pd.DataFrame({
-        "r": table.r_label,
-        "quantity": table.quantity.map(SYMBOLS),
-        "paper, eq. (xandDeltax)": table.paper.map(lambda value: _number(value, 4)),
-        "exact": table.exact.map(lambda value: _number(value, 10)),
-        "solver, eq. (inteq)": table.solver.map(lambda value: _number(value, 10)),
-        "simulation": [value_with_error(value, error)
-                       for value, error in zip(table.simulation, table.simulation_err)],
-        "z": [f"{z:+.2f} (vs {reference})" if np.isfinite(z) else ""
-              for z, reference in zip(table.z, table.reference)],
-    })
+    shown = pd.DataFrame(
+        {
+            "r": table.r_label,
+            "quantity": table.quantity.map(SYMBOLS),
+            "paper, eq. (xandDeltax)": table.paper.map(lambda value: _number(value, 4)),
+            "exact": table.exact.map(lambda value: _number(value, 10)),
+            "solver, eq. (inteq)": table.solver.map(lambda value: _number(value, 10)),
+            "simulation": [
+                value_with_error(value, error)
+                for value, error in zip(table.simulation, table.simulation_err)
+            ],
+            "z": [
+                f"{z:+.2f} (vs {reference})" if np.isfinite(z) else ""
+                for z, reference in zip(table.z, table.reference)
+            ],
+        }
+    )
     return shown.to_markdown(index=False, disable_numparse=True) + "\n"
 
 
@@ -103,15 +121,19 @@ def outgoing_speed_residuals(simulated: pd.DataFrame, solver_curve: pd.DataFrame
     """
     speeds, density = usable_curve(solver_curve.v.to_numpy(), solver_curve.p0v.to_numpy())
     inside = (
-        (simulated.v_lo >= speeds[0]) & (simulated.v_hi <= speeds[-1])
-        & np.isfinite(simulated.p0v_err) & (simulated.p0v_err > 0)
+        (simulated.v_lo >= speeds[0])
+        & (simulated.v_hi <= speeds[-1])
+        & np.isfinite(simulated.p0v_err)
+        & (simulated.p0v_err > 0)
     )
     bins = simulated[inside]
     reference = bin_averages_of_curve(speeds, density, bins.v_lo.to_numpy(), bins.v_hi.to_numpy())
-    return pd.DataFrame({
-        "v": bins.v.to_numpy(),
-        "v_lo": bins.v_lo.to_numpy(),
-        "v_hi": bins.v_hi.to_numpy(),
-        "residual": (bins.p0v.to_numpy() - reference) / bins.p0v_err.to_numpy(),
-        "count": bins["count"].to_numpy(),
-    })
+    return pd.DataFrame(
+        {
+            "v": bins.v.to_numpy(),
+            "v_lo": bins.v_lo.to_numpy(),
+            "v_hi": bins.v_hi.to_numpy(),
+            "residual": (bins.p0v.to_numpy() - reference) / bins.p0v_err.to_numpy(),
+            "count": bins["count"].to_numpy(),
+        }
+    )

@@ -40,9 +40,13 @@ def check_config(config: dict) -> dict[str, Fraction]:
         section, key = name.split(".")
         points = config[section][key]
         if not points["min"] < points["max"]:
-            raise ValueError(f"{name}: min = {points['min']} must be smaller than max = {points['max']}")
+            raise ValueError(
+                f"{name}: min = {points['min']} must be smaller than max = {points['max']}"
+            )
         if positive and not points["min"] > 0:
-            raise ValueError(f"{name}: min = {points['min']} must be positive (the grid is logarithmic)")
+            raise ValueError(
+                f"{name}: min = {points['min']} must be positive (the grid is logarithmic)"
+            )
     theory_grid = config["theory"]["restitution_grid"]
     if not 0 < theory_grid["min"] < theory_grid["max"] < 1:
         raise ValueError(
@@ -60,7 +64,9 @@ def check_config(config: dict) -> dict[str, Fraction]:
     for side in ("small_speed_window", "large_speed_window"):
         window = config["fits"][side]
         if window != "auto" and not window["min"] < window["max"]:
-            raise ValueError(f"fits.{side}: min = {window['min']} must be smaller than max = {window['max']}")
+            raise ValueError(
+                f"fits.{side}: min = {window['min']} must be smaller than max = {window['max']}"
+            )
     seen = {}
     for key in simulation.get("per_restitution", {}):
         where = f"simulation.per_restitution.{key}"
@@ -87,13 +93,19 @@ def figure_restitutions(config: dict, grid: dict | None = None) -> dict[str, Fra
     shown = {}
     for figure in ("fig4", "fig5"):
         values = config["figures"][figure]
-        for index, (label, value) in enumerate(restitution_grid(values, f"figures.{figure}").items()):
+        for index, (label, value) in enumerate(
+            restitution_grid(values, f"figures.{figure}").items()
+        ):
             where = f"figures.{figure}[{index}]"
             if figure == "fig5" and value not in EXACT_RESTITUTIONS:
-                raise ValueError(f"{where}: r = {values[index]!r} has no exact solution (only 1/2 and 1/3)")
+                raise ValueError(
+                    f"{where}: r = {values[index]!r} has no exact solution (only 1/2 and 1/3)"
+                )
             for other in (grid, shown):
                 if label in other and other[label] != value:
-                    raise ValueError(f"{where}: r = {value} and r = {other[label]} share the label {label}")
+                    raise ValueError(
+                        f"{where}: r = {value} and r = {other[label]} share the label {label}"
+                    )
             shown[label] = value
     return shown
 

@@ -14,7 +14,6 @@ from scipy import integrate, special
 from .restitution import EXACT_RESTITUTIONS  # noqa: F401 (re-exported: exact.EXACT_RESTITUTIONS)
 
 
-
 def _which(restitution) -> Fraction:
     value = Fraction(restitution).limit_denominator(1000)
     if value not in EXACT_RESTITUTIONS or abs(float(value) - float(restitution)) > 1e-12:
@@ -44,7 +43,9 @@ def outgoing_speed_bin_average(lo, hi, restitution):
     hi = np.asarray(hi, dtype=float)
     a = normalization_constant(restitution)
     if _which(restitution) == Fraction(1, 2):
-        rate = a * np.exp(-lo) * -np.expm1(lo - hi)  # int v^0 e^{-v}, no cancellation in narrow bins
+        rate = (
+            a * np.exp(-lo) * -np.expm1(lo - hi)
+        )  # int v^0 e^{-v}, no cancellation in narrow bins
     else:
         # int v^{-1/2} e^{-3v/2} dv = Gamma(1/2) (3/2)^{-1/2} [P(1/2, 3v/2)]
         # (the upper functions Q in the tail, where P -> 1 would cancel)
@@ -73,9 +74,7 @@ def _position_density_third(x):
 
     # e^{-2z} cuts off small F; e^{-F x} (or, at x = 0, nothing) large F
     upper = np.log(60.0 / x) if x > 0.0 else np.inf
-    value, _ = integrate.quad(
-        integrand, -8.0, max(upper, 8.0), limit=400, epsabs=0.0, epsrel=1e-11
-    )
+    value, _ = integrate.quad(integrand, -8.0, max(upper, 8.0), limit=400, epsabs=0.0, epsrel=1e-11)
     return value / (4.0 * np.pi)
 
 
@@ -107,6 +106,7 @@ def speed_squared_given_position_bin_average(lo, hi, restitution):
     lo = np.asarray(lo, dtype=float)
     hi = np.asarray(hi, dtype=float)
     if _which(restitution) == Fraction(1, 2):
+
         def primitive(x):
             u = np.sqrt(2.0 * x / 3.0)
             safe = np.where(u > 0, u, 1.0)
@@ -114,11 +114,15 @@ def speed_squared_given_position_bin_average(lo, hi, restitution):
 
         numerator = primitive(hi) - primitive(lo)
     else:
+
         def tail(x):
             return integrate.quad(_position_density_third, x, np.inf, epsrel=1e-10, limit=200)[0]
 
         numerator = np.asarray(
-            [integrate.quad(tail, a, b, epsrel=1e-9)[0] for a, b in zip(np.atleast_1d(lo), np.atleast_1d(hi))]
+            [
+                integrate.quad(tail, a, b, epsrel=1e-9)[0]
+                for a, b in zip(np.atleast_1d(lo), np.atleast_1d(hi))
+            ]
         ).reshape(np.shape(lo))
     return numerator / (position_bin_average(lo, hi, restitution) * (hi - lo))
 
@@ -176,7 +180,9 @@ def distribution_by_force_integral(x, v, restitution):
     """
     xi, vi = float(x), float(v)
     if xi < 0.0 or (xi == 0.0 and vi >= 0.0):
-        raise ValueError(f"the F integral of eq. (fpsol) needs x > 0, or x = 0 with v < 0 (x = {x}, v = {v})")
+        raise ValueError(
+            f"the F integral of eq. (fpsol) needs x > 0, or x = 0 with v < 0 (x = {x}, v = {v})"
+        )
     # w(F) vanishes like e^{-1/(6F)} at small F; e^{-F x} cuts large F (at x = 0, v < 0 the
     # Airy factor ~ exp(-(2/3) F^(1/2) |v|^(3/2)) does)
     upper = np.log(60.0 / xi) if xi > 0.0 else np.log((90.0 / abs(vi) ** 1.5) ** 2 + 1.0)

@@ -40,10 +40,9 @@ import pandas as pd
 from scipy import optimize, stats
 from scipy.interpolate import CubicSpline
 
-from .histograms import outgoing_speed_density
-
-from .asymptotics import large_speed_decay_rate, large_speed_exponent, small_speed_exponent
 from . import stages
+from .asymptotics import large_speed_decay_rate, large_speed_exponent, small_speed_exponent
+from .histograms import outgoing_speed_density
 
 # the modules whose code decides a fit table (see ``source_digest``)
 SOURCES = stages.FITS
@@ -125,7 +124,7 @@ def fit_asymptotic_form(side, lower, upper, values, errors, restitution, free):
             side,
             False,
             {"prefactor": prefactor, **dict(zip(names, theory))},
-            {"prefactor": 1.0 / np.sqrt(np.sum(weights * shape**2)), **{n: 0.0 for n in names}},
+            {"prefactor": 1.0 / np.sqrt(np.sum(weights * shape**2)), **dict.fromkeys(names, 0.0)},
             float(np.sum(residual**2)),
             len(values) - 1,
             float(lower[0]),
@@ -147,7 +146,10 @@ def fit_asymptotic_form(side, lower, upper, values, errors, restitution, free):
         side,
         True,
         {"prefactor": float(np.exp(best[0])), **dict(zip(names, map(float, best[1:])))},
-        {"prefactor": float(np.exp(best[0]) * spread[0]), **dict(zip(names, map(float, spread[1:])))},
+        {
+            "prefactor": float(np.exp(best[0]) * spread[0]),
+            **dict(zip(names, map(float, spread[1:]))),
+        },
         float(np.sum(residual**2)),
         len(values) - len(best),
         float(lower[0]),
@@ -182,12 +184,18 @@ def fit_shards(side, lower, upper, counts, times, errors, restitution, free):
 
     fit = fitted(counts.sum(axis=0), times.sum())
     leave_one_out = np.stack(
-        [_parameter_vector(fitted(counts.sum(axis=0) - counts[k], times.sum() - times[k])) for k in range(shards)]
+        [
+            _parameter_vector(fitted(counts.sum(axis=0) - counts[k], times.sum() - times[k]))
+            for k in range(shards)
+        ]
     )
     spread = leave_one_out - leave_one_out.mean(axis=0)
     covariance = (shards - 1) / shards * spread.T @ spread
     names = ("prefactor", *EXPONENT_NAMES[side])
-    errors_out = {n: float(np.sqrt(covariance[i, i])) if free or n == "prefactor" else 0.0 for i, n in enumerate(names)}
+    errors_out = {
+        n: float(np.sqrt(covariance[i, i])) if free or n == "prefactor" else 0.0
+        for i, n in enumerate(names)
+    }
     joint = np.nan
     if free:
         exponents = len(names) - 1
@@ -196,7 +204,9 @@ def fit_shards(side, lower, upper, counts, times, errors, restitution, free):
             t_squared = float(deviation @ np.linalg.solve(covariance[1:, 1:], deviation))
             statistic = (shards - exponents) * t_squared / (exponents * (shards - 1))
             joint = float(stats.f.sf(statistic, exponents, shards - exponents))
-    return AsymptoticFit(side, free, fit.parameters, errors_out, fit.chi2, fit.dof, fit.lower, fit.upper, joint)
+    return AsymptoticFit(
+        side, free, fit.parameters, errors_out, fit.chi2, fit.dof, fit.lower, fit.upper, joint
+    )
 
 
 def interval_factor(shards, level=0.95):
@@ -204,8 +214,9 @@ def interval_factor(shards, level=0.95):
     return float(stats.t.ppf(0.5 + level / 2.0, shards - 1))
 
 
-def asymptotic_window(side, lower, upper, counts, times, errors, reference, restitution,
-                      max_bias=0.5, minimum_bins=4):
+def asymptotic_window(
+    side, lower, upper, counts, times, errors, reference, restitution, max_bias=0.5, minimum_bins=4
+):
     """The default window on ``side`` as a slice of the usable bins; see the module docstring.
 
     ``reference`` are noise-free bin averages of P(0, v) (the solver's) in the same bins.
@@ -218,10 +229,17 @@ def asymptotic_window(side, lower, upper, counts, times, errors, reference, rest
     for size in range(minimum_bins, count + 1):
         window = slice(0, size) if side == SMALL_SPEED else slice(count - size, count)
         parts = (lower[window], upper[window])
-        drift = _parameter_vector(
-            fit_asymptotic_form(side, *parts, reference[window], errors[window], restitution, free=True)
-        )[1:] - theory
-        noisy = fit_shards(side, *parts, counts[:, window], times, errors[window], restitution, free=True)
+        drift = (
+            _parameter_vector(
+                fit_asymptotic_form(
+                    side, *parts, reference[window], errors[window], restitution, free=True
+                )
+            )[1:]
+            - theory
+        )
+        noisy = fit_shards(
+            side, *parts, counts[:, window], times, errors[window], restitution, free=True
+        )
         spread = np.array([noisy.errors[name] for name in EXPONENT_NAMES[side]])
         if np.any(np.abs(drift) > max_bias * spread):
             break
@@ -236,7 +254,9 @@ def asymptotic_window(side, lower, upper, counts, times, errors, reference, rest
 
 def window_from_range(side, lower, upper, speed_range):
     """The usable bins inside a configured [min, max] window."""
-    inside = np.flatnonzero((lower >= speed_range["min"] * (1 - 1e-12)) & (upper <= speed_range["max"] * (1 + 1e-12)))
+    inside = np.flatnonzero(
+        (lower >= speed_range["min"] * (1 - 1e-12)) & (upper <= speed_range["max"] * (1 + 1e-12))
+    )
     if len(inside) < 2 + len(EXPONENT_NAMES[side]):
         raise WindowError(
             f"{side} window [{speed_range['min']}, {speed_range['max']}] holds {len(inside)} usable bins, "
@@ -257,7 +277,10 @@ def fit_rows(source, fit, theory, shards=None):
     for name, value in fit.parameters.items():
         error = fit.errors[name] if shards else np.nan
         if name == "prefactor":
-            lower, upper = value * np.exp(-factor * error / value), value * np.exp(factor * error / value)
+            lower, upper = (
+                value * np.exp(-factor * error / value),
+                value * np.exp(factor * error / value),
+            )
         else:
             lower, upper = value - factor * error, value + factor * error
         rows.append(
@@ -281,7 +304,9 @@ def fit_rows(source, fit, theory, shards=None):
     return rows
 
 
-def asymptotic_fits(lower, upper, counts, times, errors, reference, restitution, windows, max_bias=0.5):
+def asymptotic_fits(
+    lower, upper, counts, times, errors, reference, restitution, windows, max_bias=0.5
+):
     """Every fit of issue 4 for one r, as a long table.
 
     ``counts`` (shards x bins) and ``times`` are the simulation's usable bins, ``errors``
@@ -302,17 +327,31 @@ def asymptotic_fits(lower, upper, counts, times, errors, reference, restitution,
         except WindowError as error:
             problems.append(str(error))
             names = ("prefactor", *EXPONENT_NAMES[side])
-            empty = AsymptoticFit(side, False, dict.fromkeys(names, np.nan), dict.fromkeys(names, np.nan),
-                                  np.nan, 0, np.nan, np.nan)
+            empty = AsymptoticFit(
+                side,
+                False,
+                dict.fromkeys(names, np.nan),
+                dict.fromkeys(names, np.nan),
+                np.nan,
+                0,
+                np.nan,
+                np.nan,
+            )
             for source in ("simulation", "solver"):
                 for free in (False, True):
-                    rows += fit_rows(source, AsymptoticFit(**{**empty.__dict__, "free": free}), theory)
+                    rows += fit_rows(
+                        source, AsymptoticFit(**{**empty.__dict__, "free": free}), theory
+                    )
             continue
         parts = (lower[window], upper[window])
         for free in (False, True):
-            simulated = fit_shards(side, *parts, counts[:, window], times, errors[window], restitution, free)
+            simulated = fit_shards(
+                side, *parts, counts[:, window], times, errors[window], restitution, free
+            )
             rows += fit_rows("simulation", simulated, theory, shards=len(times))
-            solved = fit_asymptotic_form(side, *parts, reference[window], errors[window], restitution, free)
+            solved = fit_asymptotic_form(
+                side, *parts, reference[window], errors[window], restitution, free
+            )
             rows += fit_rows("solver", solved, theory)
     return pd.DataFrame(rows), problems
 
@@ -350,11 +389,15 @@ def fit_errors(errors, reference, expected):
     """
     errors = np.array(errors, dtype=float)
     missing = ~(np.isfinite(errors) & (errors > 0.0))
-    errors[missing] = np.asarray(reference, dtype=float)[missing] / np.sqrt(np.asarray(expected, dtype=float)[missing])
+    errors[missing] = np.asarray(reference, dtype=float)[missing] / np.sqrt(
+        np.asarray(expected, dtype=float)[missing]
+    )
     return errors
 
 
 def expected_collisions(reference, lower, upper, total_time):
     """Collisions a run of ``total_time`` should put in each bin, from noise-free bin averages
     (eq. (collrate): rate = P-bar int_bin v dv)."""
-    return np.asarray(reference) * total_time * 0.5 * (np.asarray(upper) ** 2 - np.asarray(lower) ** 2)
+    return (
+        np.asarray(reference) * total_time * 0.5 * (np.asarray(upper) ** 2 - np.asarray(lower) ** 2)
+    )

@@ -23,6 +23,7 @@ its four monomial coefficients ``a0 + a1 t + a2 t^2 + a3 t^3``.
 import math
 
 import numpy as np
+
 from .jit import njit
 
 SQRT3 = math.sqrt(3.0)
@@ -85,7 +86,9 @@ def largest_safe_step(x, v, c):
     b = v / c
     if b >= 0.0:
         a2 = a * a
-        s = b + a * ((a3 + _P * a2 * b) / (a3 + b * (a2 * (_P + 2.0 / 3.0) + b * (_Q * a + _P * b))))
+        s = b + a * (
+            (a3 + _P * a2 * b) / (a3 + b * (a2 * (_P + 2.0 / 3.0) + b * (_Q * a + _P * b)))
+        )
     else:
         a2 = a * a
         s = math.sqrt(a3 / (-b + a2 * (a - _N3 * b) / (a2 - b * (_N1 * a - _N2 * b))))

@@ -9,8 +9,8 @@ the mean of the per-shard estimates).
 import numpy as np
 import pandas as pd
 
-from .tallies import ShardTallies, merge_shards
 from . import stages
+from .tallies import ShardTallies, merge_shards
 
 # the modules whose code decides the merged tables (see ``source_digest``)
 SOURCES = stages.MERGE
@@ -53,9 +53,7 @@ def outgoing_speed_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
     lower, upper = bins.lower, bins.upper
     counts = np.stack([s.speed_counts for s in shards])
     times = np.array([s.time for s in shards])[:, None]
-    p0v, err = jackknife(
-        lambda c, t: outgoing_speed_density(c, t, lower, upper), counts, times
-    )
+    p0v, err = jackknife(lambda c, t: outgoing_speed_density(c, t, lower, upper), counts, times)
     total = counts.sum(axis=0)
     p0v[~np.isfinite(upper)] = np.nan
     err[~np.isfinite(upper) | (total == 0)] = np.nan

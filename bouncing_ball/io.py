@@ -30,8 +30,12 @@ def atomic_path(path):
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     for stale in path.parent.glob(f".{path.stem}.*{path.suffix}"):
-        stale.unlink(missing_ok=True)  # left by a writer that was killed (SIGKILL skips the cleanup below)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+        stale.unlink(
+            missing_ok=True
+        )  # left by a writer that was killed (SIGKILL skips the cleanup below)
+    handle, temporary = tempfile.mkstemp(
+        prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent
+    )
     os.close(handle)
     try:
         yield temporary
@@ -80,5 +84,7 @@ def require_columns(frame: pd.DataFrame, path, columns) -> pd.DataFrame:
     """``frame`` if it has ``columns``; otherwise an error naming the file and what is missing."""
     missing = [column for column in columns if column not in frame.columns]
     if missing:
-        raise UnreadableFileError(f"{path}: not the expected table, it lacks the columns {', '.join(missing)}")
+        raise UnreadableFileError(
+            f"{path}: not the expected table, it lacks the columns {', '.join(missing)}"
+        )
     return frame

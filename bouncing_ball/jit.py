@@ -28,7 +28,9 @@ KEEP_CACHES = 3
 PRUNE_AFTER_SECONDS = 3600.0
 
 
-def prune_caches(base: Path, current: Path, keep: int = KEEP_CACHES, older_than: float = PRUNE_AFTER_SECONDS):
+def prune_caches(
+    base: Path, current: Path, keep: int = KEEP_CACHES, older_than: float = PRUNE_AFTER_SECONDS
+):
     """Remove ``numba-*`` folders under ``base`` other than ``current``, keeping the ``keep`` newest.
 
     Returns the folders removed.  Failures (a folder removed by another

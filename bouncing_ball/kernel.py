@@ -38,6 +38,7 @@ z0^2 as (v - u)^2 + v u.
 import math
 
 import numpy as np
+
 from .jit import njit, prange
 
 # Gauss-Legendre order of the tau integral: 2e-13 of a 64-node rule (``tests/test_kernel.py``)
@@ -91,7 +92,9 @@ def _kernel_pairs(v, u, nodes, weights):
 def return_speed_kernel(v, u):
     """G_g(v, u) of eq. (kernel3) for arrays v, u (broadcast), in the stable form above."""
     v, u = np.broadcast_arrays(np.asarray(v, dtype=float), np.asarray(u, dtype=float))
-    flat = _kernel_pairs(np.ascontiguousarray(v.ravel()), np.ascontiguousarray(u.ravel()), _NODES, _WEIGHTS)
+    flat = _kernel_pairs(
+        np.ascontiguousarray(v.ravel()), np.ascontiguousarray(u.ravel()), _NODES, _WEIGHTS
+    )
     return flat.reshape(v.shape)
 
 

@@ -58,9 +58,11 @@ def new_figure(rows=1, columns=1, width=6.4, height=4.0, **subplots):
 
 def _styled(function):
     """Run a figure function with the paper's style in force."""
+
     def wrapper(*args, **kwargs):
         with matplotlib.rc_context(STYLE):
             return function(*args, **kwargs)
+
     wrapper.__doc__, wrapper.__name__ = function.__doc__, function.__name__
     return wrapper
 
@@ -71,10 +73,24 @@ def save_figure(figure, pdf, png, dpi, provenance: dict) -> None:
     The provenance goes into the files' metadata; the PDF carries no creation
     date, so the same tables give the same file.
     """
-    description = json.dumps({"package_version": __version__, **provenance}, sort_keys=True, default=str)
+    description = json.dumps(
+        {"package_version": __version__, **provenance}, sort_keys=True, default=str
+    )
     for path, metadata, options in (
-        (pdf, {"Creator": f"bouncing_ball {__version__}", "Subject": description, "CreationDate": None}, {}),
-        (png, {"Software": f"bouncing_ball {__version__}", "Description": description}, {"dpi": dpi}),
+        (
+            pdf,
+            {
+                "Creator": f"bouncing_ball {__version__}",
+                "Subject": description,
+                "CreationDate": None,
+            },
+            {},
+        ),
+        (
+            png,
+            {"Software": f"bouncing_ball {__version__}", "Description": description},
+            {"dpi": dpi},
+        ),
     ):
         with atomic_path(path) as temporary, matplotlib.rc_context(STYLE):
             figure.savefig(temporary, metadata=metadata, **options)
@@ -93,8 +109,16 @@ def _error_bars(axis, x, y, error, log=True, **style):
     """Points with one-sigma error bars; on a log axis the lower bar stops above zero."""
     y, error = np.asarray(y, dtype=float), np.asarray(error, dtype=float)
     lower = np.minimum(error, 0.9 * y) if log else error
-    return axis.errorbar(x, y, yerr=[lower, error], linestyle="none", markersize=3.5,
-                         markerfacecolor="none", elinewidth=0.8, **style)
+    return axis.errorbar(
+        x,
+        y,
+        yerr=[lower, error],
+        linestyle="none",
+        markersize=3.5,
+        markerfacecolor="none",
+        elinewidth=0.8,
+        **style,
+    )
 
 
 @_styled
@@ -106,16 +130,27 @@ def exponents_figure(exponents, critical_restitution):
     half = np.isclose(r, 0.5, rtol=0, atol=1e-12)
     axis.plot(r, exponents.beta, color="C0", label=r"$\beta(r)$, eq. (asym2)")
     below, above = r < 0.5, (r > 0.5) & ~half
-    axis.plot(r[below], exponents.m[below], color="C3", linestyle="--",
-              label=r"$m(r)$, eqs. (asym3)-(asym6)")
+    axis.plot(
+        r[below],
+        exponents.m[below],
+        color="C3",
+        linestyle="--",
+        label=r"$m(r)$, eqs. (asym3)-(asym6)",
+    )
     # m -> 1 only logarithmically as r -> 1/2 from above (m(0.505) = 0.81): the branch
     # is drawn on to m(1/2) = 1, so that the one jump shown is the one at r = 1/2 from below
     axis.plot(np.r_[0.5, r[above]], np.r_[1.0, exponents.m[above]], color="C3", linestyle="--")
     axis.plot([0.5], [1.0], "o", color="C3", markersize=4)  # m(1/2) = 1
     axis.plot([0.5], [1.5], "o", color="C3", markersize=4, markerfacecolor="white")
     axis.axvline(critical_restitution, color="0.5", linestyle=":", linewidth=0.9)
-    axis.annotate(r"$r_c$", (critical_restitution, 2.45), xytext=(4, 0), textcoords="offset points",
-                  va="top", color="0.3")
+    axis.annotate(
+        r"$r_c$",
+        (critical_restitution, 2.45),
+        xytext=(4, 0),
+        textcoords="offset points",
+        va="top",
+        color="0.3",
+    )
     axis.set_xlim(0.0, 1.0)
     axis.set_ylim(0.0, 2.55)
     axis.set_xlabel(r"$r$")
@@ -131,8 +166,14 @@ def decay_rate_figure(exponents):
     axis = axes[0, 0]
     axis.plot(exponents.r, exponents.q, color="C0", label=r"$q(r)$, eqs. (asym4), (asym6)")
     axis.axvline(0.5, color="0.5", linestyle=":", linewidth=0.9)
-    axis.annotate(r"$r = 1/2$", (0.5, 0.02), xycoords=("data", "axes fraction"), xytext=(4, 0),
-                  textcoords="offset points", color="0.3")
+    axis.annotate(
+        r"$r = 1/2$",
+        (0.5, 0.02),
+        xycoords=("data", "axes fraction"),
+        xytext=(4, 0),
+        textcoords="offset points",
+        color="0.3",
+    )
     axis.set_yscale("log")
     axis.set_xlim(0.0, 1.0)
     axis.set_xlabel(r"$r$")
@@ -167,8 +208,16 @@ def exact_distribution_figure(panels):
 
 
 def _simulated_points(axis, bins, index):
-    return _error_bars(axis, bins.v, bins.p0v, bins.p0v_err, color="k",
-                       marker=SIMULATION_MARKERS[index % len(SIMULATION_MARKERS)], label="simulation", zorder=3)
+    return _error_bars(
+        axis,
+        bins.v,
+        bins.p0v,
+        bins.p0v_err,
+        color="k",
+        marker=SIMULATION_MARKERS[index % len(SIMULATION_MARKERS)],
+        label="simulation",
+        zorder=3,
+    )
 
 
 def _finish_outgoing_speed_panel(axis, bins, restitution):
@@ -183,8 +232,12 @@ def _finish_outgoing_speed_panel(axis, bins, restitution):
 
 
 def _fitted(fits, window, parameter):
-    row = fits[(fits.source == "simulation") & (fits.window == window) & (fits.fit == "fixed_exponents")
-               & (fits.parameter == parameter)]
+    row = fits[
+        (fits.source == "simulation")
+        & (fits.window == window)
+        & (fits.fit == "fixed_exponents")
+        & (fits.parameter == parameter)
+    ]
     return float(row.value.iloc[0]), float(row.v_min.iloc[0]), float(row.v_max.iloc[0])
 
 
@@ -203,23 +256,39 @@ def asymptotic_forms_figure(panels):
         _simulated_points(axis, bins, index)
         low, high = bins.v_lo.min(), bins.v_hi.max()
         solver = panel["solver"][(panel["solver"].v >= low) & (panel["solver"].v <= high)]
-        axis.plot(solver.v, solver.p0v, color="0.4", linestyle=":", zorder=5, label="solver, eq. (inteq)")
+        axis.plot(
+            solver.v, solver.p0v, color="0.4", linestyle=":", zorder=5, label="solver, eq. (inteq)"
+        )
         fits = panel["fits"]
         prefactor, v_min, v_max = _fitted(fits, "small_speed", "prefactor")
         beta, _, _ = _fitted(fits, "small_speed", "beta")
         if np.isfinite(prefactor):
             v = np.geomspace(low, high, 300)
-            axis.plot(v, prefactor * v**-beta, color="C0", linestyle="--", zorder=4,
-                      label=rf"$A v^{{-\beta}}$, $\beta = {beta:.4g}$")
+            axis.plot(
+                v,
+                prefactor * v**-beta,
+                color="C0",
+                linestyle="--",
+                zorder=4,
+                label=rf"$A v^{{-\beta}}$, $\beta = {beta:.4g}$",
+            )
             inside = (v >= v_min) & (v <= v_max)
-            axis.plot(v[inside], prefactor * v[inside] ** -beta, color="C0", linewidth=3, alpha=0.35)
+            axis.plot(
+                v[inside], prefactor * v[inside] ** -beta, color="C0", linewidth=3, alpha=0.35
+            )
         prefactor, v_min, v_max = _fitted(fits, "large_speed", "prefactor")
         m, _, _ = _fitted(fits, "large_speed", "m")
         q, _, _ = _fitted(fits, "large_speed", "q")
         if np.isfinite(prefactor):
             v = np.geomspace(low, high, 300)
             form = prefactor * v**-m * np.exp(-q * v)
-            axis.plot(v, form, color="C3", zorder=4, label=rf"$A v^{{-m}} e^{{-qv}}$, $m = {m:.4g}$, $q = {q:.4g}$")
+            axis.plot(
+                v,
+                form,
+                color="C3",
+                zorder=4,
+                label=rf"$A v^{{-m}} e^{{-qv}}$, $m = {m:.4g}$, $q = {q:.4g}$",
+            )
             inside = (v >= v_min) & (v <= v_max)
             axis.plot(v[inside], form[inside], color="C3", linewidth=3, alpha=0.35)
         _finish_outgoing_speed_panel(axis, bins, panel["restitution"])
@@ -268,17 +337,32 @@ def time_averages_figure(solved, simulated, exact, critical_restitution):
         finite = np.isfinite(values)
         axis.plot(solved.r[finite], values[finite], color="C0", label="solver, eq. (inteq)")
         if len(simulated):
-            _error_bars(axis, simulated.r, simulated[quantity], simulated[f"{quantity}_err"],
-                        color="k", marker="o", label="simulation", zorder=3)
+            _error_bars(
+                axis,
+                simulated.r,
+                simulated[quantity],
+                simulated[f"{quantity}_err"],
+                color="k",
+                marker="o",
+                label="simulation",
+                zorder=3,
+            )
         if len(exact):
-            axis.plot(exact.r, exact[quantity], "x", color="C3", markersize=6, label="exact, r = 1/2, 1/3")
+            axis.plot(
+                exact.r, exact[quantity], "x", color="C3", markersize=6, label="exact, r = 1/2, 1/3"
+            )
         axis.set_ylabel(TIME_AVERAGE_LABELS[quantity])
         axis.set_yscale("log")  # <x> and Delta x grow without bound as r -> 1, I as r -> r_c
         if quantity == "collision_rate":
             axis.axvline(critical_restitution, color="0.5", linestyle=":", linewidth=0.9)
-            axis.annotate(r"$r_c$: $I = \infty$ below", (critical_restitution, 0.9),
-                          xycoords=("data", "axes fraction"), xytext=(4, 0), textcoords="offset points",
-                          color="0.3")
+            axis.annotate(
+                r"$r_c$: $I = \infty$ below",
+                (critical_restitution, 0.9),
+                xycoords=("data", "axes fraction"),
+                xytext=(4, 0),
+                textcoords="offset points",
+                color="0.3",
+            )
     axes[0, 0].legend(loc="upper left")
     axes[-1, 0].set_xlim(0.0, 1.0)
     axes[-1, 0].set_xlabel(r"$r$")
@@ -291,17 +375,32 @@ def residuals_figure(panels):
 
     ``panels``: (r, residual table with columns v, residual) pairs.
     """
-    figure, axes = new_figure(len(panels), 1, width=5.0, height=1.3 + 1.2 * len(panels), sharex=True)
+    figure, axes = new_figure(
+        len(panels), 1, width=5.0, height=1.3 + 1.2 * len(panels), sharex=True
+    )
     for index, (axis, (restitution, residuals)) in enumerate(zip(axes[:, 0], panels)):
         axis.axhspan(-2, 2, color="0.92", zorder=0)
         axis.axhline(0.0, color="0.5", linewidth=0.8)
-        axis.plot(residuals.v, residuals.residual, linestyle="none", color="k",
-                  marker=SIMULATION_MARKERS[index % len(SIMULATION_MARKERS)], markersize=3.5,
-                  markerfacecolor="none")
+        axis.plot(
+            residuals.v,
+            residuals.residual,
+            linestyle="none",
+            color="k",
+            marker=SIMULATION_MARKERS[index % len(SIMULATION_MARKERS)],
+            markersize=3.5,
+            markerfacecolor="none",
+        )
         chi2 = float(np.mean(residuals.residual**2)) if len(residuals) else np.nan
-        axis.text(0.01, 0.93, f"{restitution_text(restitution)}:  "
-                  rf"$\chi^2/n = {chi2:.2f}$, $n = {len(residuals)}$", transform=axis.transAxes, va="top",
-                  bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.85, "pad": 1.5}, zorder=5)
+        axis.text(
+            0.01,
+            0.93,
+            f"{restitution_text(restitution)}:  "
+            rf"$\chi^2/n = {chi2:.2f}$, $n = {len(residuals)}$",
+            transform=axis.transAxes,
+            va="top",
+            bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.85, "pad": 1.5},
+            zorder=5,
+        )
         limit = max(4.5, 1.3 * float(np.max(np.abs(residuals.residual)))) if len(residuals) else 4.0
         axis.set_ylim(-limit, limit)
         axis.set_xscale("log")

@@ -38,7 +38,6 @@ LIBRARY_NAME = "shard_loop.so"
 FUNCTION = "bouncing_ball_shard_loop"
 
 
-
 def npyrandom_library() -> Path:
     """numpy's static library of C distributions (random_standard_normal and co.)."""
     path = Path(os.path.dirname(np.__file__)) / "random" / "lib" / "libnpyrandom.a"
@@ -111,7 +110,7 @@ _double_array = np.ctypeslib.ndpointer(dtype=np.float64, ndim=1, flags="C_CONTIG
 _int64_array = np.ctypeslib.ndpointer(dtype=np.int64, ndim=1, flags="C_CONTIGUOUS")
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _load(library: str):
     function = getattr(ctypes.CDLL(library), FUNCTION)
     function.restype = ctypes.c_int
@@ -157,7 +156,9 @@ def reference_shard(
     bit_generator = np.random.PCG64(seed_sequence)  # kept alive across the call
     v_edges = np.ascontiguousarray(speed_bins.edges, dtype=np.float64)
     x_edges = np.ascontiguousarray(position_bins.edges, dtype=np.float64)
-    speed_counts, position_time, position_v2_time, scalars = ShardTallies.loop_arrays(speed_bins, position_bins)
+    speed_counts, position_time, position_v2_time, scalars = ShardTallies.loop_arrays(
+        speed_bins, position_bins
+    )
     status = function(
         bit_generator.ctypes.bit_generator,
         float(restitution),
@@ -178,13 +179,28 @@ def reference_shard(
     )
     if status != 0:
         raise MemoryError("the C reference could not allocate its bin bounds")
-    return ShardTallies.from_loop(speed_bins, position_bins, speed_counts, position_time, position_v2_time, scalars)
+    return ShardTallies.from_loop(
+        speed_bins, position_bins, speed_counts, position_time, position_v2_time, scalars
+    )
 
 
-TALLY_FIELDS = ("speed_counts", "position_time", "position_v2_time", "time", "collisions", "steps",
-                "int_x", "int_x2", "budget_exhausted")
+TALLY_FIELDS = (
+    "speed_counts",
+    "position_time",
+    "position_v2_time",
+    "time",
+    "collisions",
+    "steps",
+    "int_x",
+    "int_x2",
+    "budget_exhausted",
+)
 
 
 def differing_tallies(first: ShardTallies, second: ShardTallies) -> list[str]:
     """The tally fields in which two shards' results differ (bit for bit); [] if none."""
-    return [name for name in TALLY_FIELDS if not np.array_equal(getattr(first, name), getattr(second, name))]
+    return [
+        name
+        for name in TALLY_FIELDS
+        if not np.array_equal(getattr(first, name), getattr(second, name))
+    ]

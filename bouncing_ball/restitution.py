@@ -16,7 +16,7 @@ def parse_restitution(value, where: str = "restitution") -> Fraction:
     """The exact value of r from a config entry or a label; ``where`` names it in errors."""
     if isinstance(value, bool) or not isinstance(value, (int, float, str, Fraction)):
         raise ValueError(
-            f"{where}: {value!r} is not a number; give a decimal such as 0.25 or a fraction such as \"1/3\""
+            f'{where}: {value!r} is not a number; give a decimal such as 0.25 or a fraction such as "1/3"'
         )
     try:
         exact = Fraction(str(value).strip()) if not isinstance(value, Fraction) else value
@@ -24,7 +24,7 @@ def parse_restitution(value, where: str = "restitution") -> Fraction:
         raise ValueError(f"{where}: {value!r} divides by zero; r must lie in (0, 1)") from None
     except ValueError:
         raise ValueError(
-            f"{where}: {value!r} is not a number; give a decimal such as 0.25 or a fraction such as \"1/3\""
+            f'{where}: {value!r} is not a number; give a decimal such as 0.25 or a fraction such as "1/3"'
         ) from None
     if not 0 < exact < 1:
         raise ValueError(f"{where}: r = {value!r} is outside the allowed range 0 < r < 1")

@@ -18,7 +18,9 @@ def read_shards(paths, label):
             raise UnreadableFileError(
                 f"{path}: simulated for r = {provenance.get('r_label')}, not r = {label}"
             )
-        repeated = [p for p, q in zip(paths, provenances) if q.get("shard") == provenance.get("shard")]
+        repeated = [
+            p for p, q in zip(paths, provenances) if q.get("shard") == provenance.get("shard")
+        ]
         if repeated:
             raise UnreadableFileError(f"{path}: the same shard as {repeated[0]}")
         if provenances and any(

@@ -52,8 +52,8 @@ as the floor goes to zero, is measured, not assumed (README).
 import math
 
 import numpy as np
-from .jit import njit
 
+from . import stages
 from .bins import LogBins
 from .free_flight import (
     cubic_level_time,
@@ -69,8 +69,8 @@ from .free_flight import (
     slope_zeros,
     speed_squared_coefficients,
 )
+from .jit import njit
 from .tallies import ShardTallies
-from . import stages
 
 # the modules whose code decides a shard's numbers (see ``source_digest``)
 SOURCES = stages.SIMULATION
@@ -276,8 +276,17 @@ def _run(
             int_x += ix
             int_x2 += ix2
             x_bin = _tally_step(
-                a, dt, tau, x_tau, v_tau, x_bin,
-                x_edges, x_bin_lower, x_bin_upper, position_time, position_v2_time,
+                a,
+                dt,
+                tau,
+                x_tau,
+                v_tau,
+                x_bin,
+                x_edges,
+                x_bin_lower,
+                x_bin_upper,
+                position_time,
+                position_v2_time,
             )
         t += tau
         if collided:
@@ -322,7 +331,9 @@ def simulate_shard(
     if not 0.0 < restitution < 1.0:
         raise ValueError(f"restitution must lie in (0, 1), got {restitution}")
     rng = np.random.Generator(np.random.PCG64(seed_sequence))
-    speed_counts, position_time, position_v2_time, scalars = ShardTallies.loop_arrays(speed_bins, position_bins)
+    speed_counts, position_time, position_v2_time, scalars = ShardTallies.loop_arrays(
+        speed_bins, position_bins
+    )
     _run(
         rng,
         float(restitution),
@@ -339,4 +350,6 @@ def simulate_shard(
         position_v2_time,
         scalars,
     )
-    return ShardTallies.from_loop(speed_bins, position_bins, speed_counts, position_time, position_v2_time, scalars)
+    return ShardTallies.from_loop(
+        speed_bins, position_bins, speed_counts, position_time, position_v2_time, scalars
+    )

@@ -55,9 +55,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import linalg, special
 
+from . import stages
 from .asymptotics import large_speed_decay_rate, small_speed_exponent
 from .kernel import kernel_small_u_limit, return_speed_kernel_matrix
-from . import stages
 
 # the modules whose code decides the solver's numbers
 SOURCES = stages.SOLVER
@@ -161,7 +161,9 @@ class OutgoingSpeedSolution:
         return float(main + tail)
 
 
-def solve_outgoing_speed_density(restitution, step=DEFAULT_STEP, lowest_speed=None, highest_speed=None):
+def solve_outgoing_speed_density(
+    restitution, step=DEFAULT_STEP, lowest_speed=None, highest_speed=None
+):
     """Solve eq. (inteq) for P(0, v), v > 0, normalised by the momentum balance M_2 = r / (1 + r)."""
     r = float(restitution)
     if not 0.0 < r < 1.0:

@@ -46,18 +46,30 @@ class ShardTallies:
     def loop_arrays(speed_bins, position_bins):
         """Zeroed arrays a compiled shard loop fills: speed counts, time and int v^2 dt per x bin
         (each with under- and overflow), and the scalars in the order of ``SCALARS``."""
-        return (np.zeros(speed_bins.n + 2, dtype=np.int64), np.zeros(position_bins.n + 2),
-                np.zeros(position_bins.n + 2), np.zeros(len(SCALARS)))
+        return (
+            np.zeros(speed_bins.n + 2, dtype=np.int64),
+            np.zeros(position_bins.n + 2),
+            np.zeros(position_bins.n + 2),
+            np.zeros(len(SCALARS)),
+        )
 
     @classmethod
-    def from_loop(cls, speed_bins, position_bins, speed_counts, position_time, position_v2_time, scalars):
+    def from_loop(
+        cls, speed_bins, position_bins, speed_counts, position_time, position_v2_time, scalars
+    ):
         """The tallies of a compiled shard loop: its three histograms and its scalar array,
         ordered as ``SCALARS`` (the numba loop and its C reference both fill them so)."""
         values = dict(zip(SCALARS, scalars))
         for name in _INTEGER:
             values[name] = int(values[name])
-        return cls(speed_bins=speed_bins, position_bins=position_bins, speed_counts=speed_counts,
-                   position_time=position_time, position_v2_time=position_v2_time, **values)
+        return cls(
+            speed_bins=speed_bins,
+            position_bins=position_bins,
+            speed_counts=speed_counts,
+            position_time=position_time,
+            position_v2_time=position_v2_time,
+            **values,
+        )
 
     def __add__(self, other: "ShardTallies") -> "ShardTallies":
         if (self.speed_bins, self.position_bins) != (other.speed_bins, other.position_bins):

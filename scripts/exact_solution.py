@@ -18,6 +18,7 @@ from bouncing_ball.config import exact_settings, read_config
 from bouncing_ball.io import write_table
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 
+
 def distribution_table(positions, speeds, r):
     """P(x, v) for every x in ``positions`` and v in ``speeds`` (long format), and the
     largest relative error quad estimates for it."""
@@ -75,17 +76,25 @@ def main(restitution, settings, outputs):
     )
     table, worst = distribution_table(settings["positions"], linear_grid(settings["speeds"]), r)
     write_table(table, outputs["distribution"], provenance)
-    logging.info("r=%s: P(x,v) at %d points, largest estimated relative error %.1e", label, len(table), worst)
+    logging.info(
+        "r=%s: P(x,v) at %d points, largest estimated relative error %.1e", label, len(table), worst
+    )
     if worst > 1e-6:
         logging.warning("r=%s: P(x,v) is less accurate than 1e-6 somewhere (%.1e)", label, worst)
     logging.info(
         "r=%s: A = %.12g, <x> = %.12g, Delta x = %.12g, I = %.12g",
-        label, exact.normalization_constant(r), moments["mean_x"], moments["delta_x"], moments["collision_rate"],
+        label,
+        exact.normalization_constant(r),
+        moments["mean_x"],
+        moments["delta_x"],
+        moments["collision_rate"],
     )
 
 
 def _command_line():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--restitution", required=True, help="1/2 or 1/3")
     parser.add_argument("--outdir", required=True, type=Path)
     parser.add_argument("--config", default="config/config.yaml", help="grids from here")
@@ -93,7 +102,10 @@ def _command_line():
     config = read_config(args.config)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     args.outdir.mkdir(parents=True, exist_ok=True)
-    outputs = {name: args.outdir / f"{name}.parquet" for name in ("p0v", "distribution", "position", "summary")}
+    outputs = {
+        name: args.outdir / f"{name}.parquet"
+        for name in ("p0v", "distribution", "position", "summary")
+    }
     main(args.restitution, exact_settings(config), outputs)
 
 

@@ -18,6 +18,7 @@ from bouncing_ball.io import read_table, write_table
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 from bouncing_ball.shards import read_shards
 
+
 def main(shard_paths, solver_path, restitution, settings, output):
     value = parse_restitution(restitution)
     label = restitution_label(value)
@@ -27,14 +28,22 @@ def main(shard_paths, solver_path, restitution, settings, output):
     times = np.array([s.time for s in shards])
     curve, solver_provenance = read_table(solver_path)
     if solver_provenance.get("r_label") != label:
-        raise ValueError(f"{solver_path}: solved for r = {solver_provenance.get('r_label')}, not r = {label}")
+        raise ValueError(
+            f"{solver_path}: solved for r = {solver_provenance.get('r_label')}, not r = {label}"
+        )
     # the solver's output speeds (solver.output_speeds) up to where P(0, v) underflows
     speeds, density = fits.usable_curve(curve.v.to_numpy(), curve.p0v.to_numpy())
-    inside = (np.isfinite(table.v_hi) & (table.v_lo >= speeds[0]) & (table.v_hi <= speeds[-1])).to_numpy()
+    inside = (
+        np.isfinite(table.v_hi) & (table.v_lo >= speeds[0]) & (table.v_hi <= speeds[-1])
+    ).to_numpy()
     beyond = int(np.sum(np.isfinite(table.v_hi) & (table.v_hi > speeds[-1]) & (table["count"] > 0)))
     if beyond:
-        logging.warning("r=%s: %d populated bins above v = %g, where the solver's curve ends, are left out",
-                        label, beyond, speeds[-1])
+        logging.warning(
+            "r=%s: %d populated bins above v = %g, where the solver's curve ends, are left out",
+            label,
+            beyond,
+            speeds[-1],
+        )
     lower_all, upper_all = table.v_lo.to_numpy()[inside], table.v_hi.to_numpy()[inside]
     reference_all = fits.bin_averages_of_curve(speeds, density, lower_all, upper_all)
     # bins chosen by the collisions they should hold, not by those they happen to hold
@@ -46,10 +55,17 @@ def main(shard_paths, solver_path, restitution, settings, output):
     errors = fits.fit_errors(jackknife_errors, reference, expected[keep])
     replaced = int(np.sum(errors != jackknife_errors))
     if replaced:
-        logging.warning("r=%s: %d bins without a jackknife error (too few shards?) are weighted by their "
-                        "Poisson error", label, replaced)
+        logging.warning(
+            "r=%s: %d bins without a jackknife error (too few shards?) are weighted by their "
+            "Poisson error",
+            label,
+            replaced,
+        )
     counts = np.stack([s.speed_counts[rows] for s in shards])
-    windows = {fits.SMALL_SPEED: settings["small_speed_window"], fits.LARGE_SPEED: settings["large_speed_window"]}
+    windows = {
+        fits.SMALL_SPEED: settings["small_speed_window"],
+        fits.LARGE_SPEED: settings["large_speed_window"],
+    }
     result, problems = fits.asymptotic_fits(
         lower, upper, counts, times, errors, reference, r, windows, settings["max_bias"]
     )
@@ -66,18 +82,32 @@ def main(shard_paths, solver_path, restitution, settings, output):
         "solver_code": solver_provenance.get("code"),
     }
     write_table(result, output, provenance)
-    for row in result[(result.source == "simulation") & (result.fit == "free_exponents")].itertuples():
+    for row in result[
+        (result.source == "simulation") & (result.fit == "free_exponents")
+    ].itertuples():
         if row.parameter != "prefactor":
             logging.info(
                 "r=%s %s [%.3g, %.3g]: %s = %.5g +- %.2g (95%%: %.5g .. %.5g), theory %.5g; "
                 "theory's exponents together: p = %.3g; chi2/dof %.2f",
-                label, row.window, row.v_min, row.v_max, row.parameter, row.value, row.error,
-                row.lower_95, row.upper_95, row.theory, row.joint_p_value, row.chi2_per_dof,
+                label,
+                row.window,
+                row.v_min,
+                row.v_max,
+                row.parameter,
+                row.value,
+                row.error,
+                row.lower_95,
+                row.upper_95,
+                row.theory,
+                row.joint_p_value,
+                row.chi2_per_dof,
             )
 
 
 def _command_line():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("shards", nargs="+")
     parser.add_argument("--restitution", required=True)
     parser.add_argument("--solver", required=True, help="the solver's p0v.parquet for this r")

@@ -9,8 +9,8 @@ Snakemake (rule merge_shards), or by hand:
 import argparse
 import logging
 
-from bouncing_ball.config import SHARD_SETTINGS
 from bouncing_ball import source_digest
+from bouncing_ball.config import SHARD_SETTINGS
 from bouncing_ball.histograms import (
     SOURCES,
     outgoing_speed_histogram,
@@ -18,8 +18,8 @@ from bouncing_ball.histograms import (
     position_moments_summary,
 )
 from bouncing_ball.io import write_table
-from bouncing_ball.shards import read_shards
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
+from bouncing_ball.shards import read_shards
 
 
 def main(shard_paths, restitution, p0v_path, position_path, summary_path):
@@ -43,20 +43,31 @@ def main(shard_paths, restitution, p0v_path, position_path, summary_path):
     row = summary.iloc[0]
     logging.info(
         "r=%s: %d shards, time %.6g, <x> = %.5g +- %.2g, Delta x = %.5g +- %.2g, I = %.5g +- %.2g",
-        label, len(shards), row.total_time, row.mean_x, row.mean_x_err,
-        row.delta_x, row.delta_x_err, row.collision_rate, row.collision_rate_err,
+        label,
+        len(shards),
+        row.total_time,
+        row.mean_x,
+        row.mean_x_err,
+        row.delta_x,
+        row.delta_x_err,
+        row.collision_rate,
+        row.collision_rate_err,
     )
     if row.shards_out_of_budget:
         logging.warning(
             "r=%s: %d of %d shards stopped before shard_time (step budget simulation.max_steps exhausted, "
             "or below/near r_c a speed collapse: see simulation.min_step_floor); the estimates weight "
             "every shard by the time it recorded",
-            label, row.shards_out_of_budget, len(shards),
+            label,
+            row.shards_out_of_budget,
+            len(shards),
         )
 
 
 def _command_line():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("shards", nargs="+")
     parser.add_argument("--restitution", required=True)
     parser.add_argument("--p0v", required=True)

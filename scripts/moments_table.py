@@ -28,33 +28,61 @@ def main(simulation_paths, solver_paths, exact_paths, csv_path, md_path):
     rows = []
     for simulation, solver in zip(simulation_paths, solver_paths, strict=True):
         simulated, provenance = read_table(simulation)
-        require_columns(simulated, simulation, [*QUANTITIES, *(f"{name}_err" for name in QUANTITIES)])
+        require_columns(
+            simulated, simulation, [*QUANTITIES, *(f"{name}_err" for name in QUANTITIES)]
+        )
         solved, solver_provenance = read_table(solver)
         require_columns(solved, solver, QUANTITIES)
         restitution = parse_restitution(provenance["r"])
         if parse_restitution(solver_provenance["r"]) != restitution:
-            raise ValueError(f"{simulation} (r = {provenance['r']}) and {solver} "
-                             f"(r = {solver_provenance['r']}) are not the same r")
-        rows += moment_rows(provenance["r_label"], restitution, simulated.iloc[0], solved.iloc[0],
-                            exact.get(restitution))
+            raise ValueError(
+                f"{simulation} (r = {provenance['r']}) and {solver} "
+                f"(r = {solver_provenance['r']}) are not the same r"
+            )
+        rows += moment_rows(
+            provenance["r_label"],
+            restitution,
+            simulated.iloc[0],
+            solved.iloc[0],
+            exact.get(restitution),
+        )
     table = moments_table(rows)
     with atomic_path(csv_path) as path:
         table.to_csv(path, index=False, float_format="%.12g")
     with atomic_path(md_path) as path:
         Path(path).write_text(moments_markdown(table))
     for row in table.itertuples():
-        logging.info("r=%s %s: simulation %.6g +- %.2g, %s %.10g, z = %+.2f", row.r_label, row.quantity,
-                     row.simulation, row.simulation_err, row.reference, getattr(row, row.reference), row.z)
+        logging.info(
+            "r=%s %s: simulation %.6g +- %.2g, %s %.10g, z = %+.2f",
+            row.r_label,
+            row.quantity,
+            row.simulation,
+            row.simulation_err,
+            row.reference,
+            getattr(row, row.reference),
+            row.z,
+        )
 
 
 if "snakemake" in globals():
     logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, format="%(message)s")  # noqa: F821
-    main(snakemake.input.simulation, snakemake.input.solver, snakemake.input.exact,  # noqa: F821
-         snakemake.output.csv, snakemake.output.md)  # noqa: F821
+    main(
+        snakemake.input.simulation,
+        snakemake.input.solver,
+        snakemake.input.exact,  # noqa: F821
+        snakemake.output.csv,
+        snakemake.output.md,
+    )  # noqa: F821
 elif __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--simulation", nargs="+", required=True, help="results/simulation/r{r}/summary.parquet")
-    parser.add_argument("--solver", nargs="+", required=True, help="results/solver/r{r}/summary.parquet")
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument(
+        "--simulation", nargs="+", required=True, help="results/simulation/r{r}/summary.parquet"
+    )
+    parser.add_argument(
+        "--solver", nargs="+", required=True, help="results/solver/r{r}/summary.parquet"
+    )
     parser.add_argument("--exact", nargs="*", default=[], help="results/exact/r{r}/summary.parquet")
     parser.add_argument("--csv", required=True)
     parser.add_argument("--md", required=True)

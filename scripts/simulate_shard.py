@@ -52,9 +52,16 @@ def main(output, restitution, shard, seed, settings):
     write_table(tallies_to_frame(tallies), output, provenance)
     logging.info(
         "r=%s shard %d: time %.6g, %d collisions, %d steps, %.1f s%s",
-        label, shard, tallies.time, tallies.collisions, tallies.steps, elapsed,
+        label,
+        shard,
+        tallies.time,
+        tallies.collisions,
+        tallies.steps,
+        elapsed,
         " -- STOPPED EARLY: STEP BUDGET EXHAUSTED (simulation.max_steps) or the speed collapsed towards 0"
-        " (below or near r_c; see simulation.min_step_floor)" if tallies.budget_exhausted else "",
+        " (below or near r_c; see simulation.min_step_floor)"
+        if tallies.budget_exhausted
+        else "",
     )
 
 
@@ -65,7 +72,9 @@ def _command_line():
     parser.add_argument("output")
     parser.add_argument("--restitution", required=True, help='r, e.g. 0.25 or "1/3"')
     parser.add_argument("--shard", type=int, required=True)
-    parser.add_argument("--config", default="config/config.yaml", help="settings and seed from here")
+    parser.add_argument(
+        "--config", default="config/config.yaml", help="settings and seed from here"
+    )
     parser.add_argument("--shard-time", type=float, help="override the config's shard_time")
     parser.add_argument("--max-steps", type=int, help="override the config's max_steps")
     parser.add_argument("--min-step-floor", type=float, help="override the config's min_step_floor")

@@ -13,7 +13,7 @@ import time
 import numpy as np
 import pandas as pd
 
-from bouncing_ball import source_digest, solver
+from bouncing_ball import solver, source_digest
 from bouncing_ball.bins import log_grid
 from bouncing_ball.config import read_config, solver_settings
 from bouncing_ball.io import write_table
@@ -36,7 +36,13 @@ def accuracy_estimate(solution):
     )
     reference = finer.outgoing_speed_density(CHECKED_SPEEDS)
     usable = reference > 0.0  # below r ~ 0.015, P(0, 20) underflows
-    return float(np.max(np.abs(solution.outgoing_speed_density(CHECKED_SPEEDS[usable]) / reference[usable] - 1.0)))
+    return float(
+        np.max(
+            np.abs(
+                solution.outgoing_speed_density(CHECKED_SPEEDS[usable]) / reference[usable] - 1.0
+            )
+        )
+    )
 
 
 def main(restitution, settings, p0v_path, summary_path):
@@ -80,15 +86,26 @@ def main(restitution, settings, p0v_path, summary_path):
     logging.info(
         "r=%s: %d nodes, solved in %.1f ms (first call: includes loading the compiled kernel); <x> = %.10g, Delta x = %.10g, I = %.10g; "
         "energy balance residual %.1e, eigenvalue - 1 = %.1e, accuracy estimate %.1e",
-        label, row.grid_size, 1e3 * elapsed, row.mean_x, row.delta_x, row.collision_rate,
-        row.energy_balance_residual, row.eigenvalue_residual, row.accuracy_estimate,
+        label,
+        row.grid_size,
+        1e3 * elapsed,
+        row.mean_x,
+        row.delta_x,
+        row.collision_rate,
+        row.energy_balance_residual,
+        row.eigenvalue_residual,
+        row.accuracy_estimate,
     )
     if not row.accuracy_estimate <= 1e-8:
-        logging.warning("r=%s: accuracy estimate %.1e misses the 1e-8 target", label, row.accuracy_estimate)
+        logging.warning(
+            "r=%s: accuracy estimate %.1e misses the 1e-8 target", label, row.accuracy_estimate
+        )
 
 
 def _command_line():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--restitution", required=True)
     parser.add_argument("--p0v", required=True)
     parser.add_argument("--summary", required=True)

@@ -23,12 +23,14 @@ def main(grid_spec, step, output):
     rows = []
     for r in linear_grid(grid_spec):
         solution = solver.solve_outgoing_speed_density(float(r), step=step)
-        rows.append({
-            "r": float(r),
-            "small_speed_exponent": solution.small_speed_exponent,
-            **solver.time_averages(solution),
-            "energy_balance_residual": solver.energy_balance_residual(solution),
-        })
+        rows.append(
+            {
+                "r": float(r),
+                "small_speed_exponent": solution.small_speed_exponent,
+                **solver.time_averages(solution),
+                "energy_balance_residual": solver.energy_balance_residual(solution),
+            }
+        )
     table = pd.DataFrame(rows)
     provenance = {
         "rule": "solve_grid",
@@ -39,16 +41,26 @@ def main(grid_spec, step, output):
     }
     write_table(table, output, provenance)
     worst = table.energy_balance_residual.abs().max()
-    logging.info("<x>, Delta x, I at %d values of r in [%g, %g] in %.1f s; largest energy balance residual %.1e",
-                 len(table), table.r.min(), table.r.max(), time.perf_counter() - started, worst)
+    logging.info(
+        "<x>, Delta x, I at %d values of r in [%g, %g] in %.1f s; largest energy balance residual %.1e",
+        len(table),
+        table.r.min(),
+        table.r.max(),
+        time.perf_counter() - started,
+        worst,
+    )
     if not worst <= 1e-8:
         logging.warning("energy balance residual %.1e misses the 1e-8 target", worst)
 
 
 def _command_line():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("output")
-    parser.add_argument("--config", default="config/config.yaml", help="the r grid and step from here")
+    parser.add_argument(
+        "--config", default="config/config.yaml", help="the r grid and step from here"
+    )
     args = parser.parse_args()
     config = read_config(args.config)
     logging.basicConfig(level=logging.INFO, format="%(message)s")

@@ -8,7 +8,6 @@ Writes results/theory/exponents.parquet (r, beta, m, q).  Run by Snakemake
 import argparse
 import logging
 
-
 from bouncing_ball import source_digest
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION, SOURCES, exponents_table
 from bouncing_ball.bins import linear_grid
@@ -25,12 +24,19 @@ def main(grid_spec, output):
         "code": source_digest(SOURCES),
     }
     write_table(table, output, provenance)
-    logging.info("beta, m, q at %d values of r in [%g, %g]; r_c = %.12g",
-                 len(table), table.r.min(), table.r.max(), CRITICAL_RESTITUTION)
+    logging.info(
+        "beta, m, q at %d values of r in [%g, %g]; r_c = %.12g",
+        len(table),
+        table.r.min(),
+        table.r.max(),
+        CRITICAL_RESTITUTION,
+    )
 
 
 def _command_line():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("output")
     parser.add_argument("--config", default="config/config.yaml", help="the r grid from here")
     args = parser.parse_args()

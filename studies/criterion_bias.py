@@ -5,11 +5,15 @@ usage:  python studies/criterion_bias.py run C R SHARD_TIME FIRST LAST   (append
 
 The README numbers (Performance, "c = 3"): run 3 1/2 2e7 0 32 and run 3 1/3 8.5e6 0 32 (about 700 CPU s each).
 """
-import json, os, sys, time
+
+import json
+import os
+import sys
+import time
 from fractions import Fraction
+
 import numpy as np
 
-import bouncing_ball
 from bouncing_ball import exact
 from bouncing_ball.bins import LogBins
 from bouncing_ball.histograms import jackknife, outgoing_speed_density
@@ -43,16 +47,41 @@ def run(c, rkey, shard_time, first, last):
     r = RS[rkey]
     for k in range(first, last):
         t0 = time.process_time()
-        s = simulate_shard(float(r), shard_seed_sequence(SEED, restitution_label(r), k), shard_time,
-                           1e3, float(c), 500.0, 10**12, SPEED_BINS, POSITION_BINS)
+        s = simulate_shard(
+            float(r),
+            shard_seed_sequence(SEED, restitution_label(r), k),
+            shard_time,
+            1e3,
+            float(c),
+            500.0,
+            10**12,
+            SPEED_BINS,
+            POSITION_BINS,
+        )
         cpu = time.process_time() - t0
         rows = load()
-        rows.append(dict(c=float(c), r=rkey, shard=k, shard_time=shard_time, cpu=cpu, time=s.time,
-                         collisions=s.collisions, steps=s.steps, int_x=s.int_x, int_x2=s.int_x2,
-                         exhausted=int(s.budget_exhausted), speed_counts=s.speed_counts.tolist()))
+        rows.append(
+            dict(
+                c=float(c),
+                r=rkey,
+                shard=k,
+                shard_time=shard_time,
+                cpu=cpu,
+                time=s.time,
+                collisions=s.collisions,
+                steps=s.steps,
+                int_x=s.int_x,
+                int_x2=s.int_x2,
+                exhausted=int(s.budget_exhausted),
+                speed_counts=s.speed_counts.tolist(),
+            )
+        )
         save(rows)
-        print(f"c={c} r={rkey} shard {k}: cpu {cpu:.1f}s, coll {s.collisions}, I {s.collisions/s.time:.5f}, "
-              f"steps/coll {s.steps/s.collisions:.2f}", flush=True)
+        print(
+            f"c={c} r={rkey} shard {k}: cpu {cpu:.1f}s, coll {s.collisions}, I {s.collisions / s.time:.5f}, "
+            f"steps/coll {s.steps / s.collisions:.2f}",
+            flush=True,
+        )
 
 
 def group(rows, c, rkey):
@@ -63,16 +92,33 @@ def group(rows, c, rkey):
 def analyse_group(g, rkey):
     r = RS[rkey]
     ex = exact.position_moments(r)
-    T = np.array([x["time"] for x in g]); C = np.array([x["collisions"] for x in g], float)
-    IX = np.array([x["int_x"] for x in g]); IX2 = np.array([x["int_x2"] for x in g])
-    cpu = sum(x["cpu"] for x in g); steps = sum(x["steps"] for x in g)
-    out = {"shards": len(g), "cpu": cpu, "collisions": C.sum(), "steps_per_coll": steps / C.sum(),
-           "coll_per_cpu": C.sum() / cpu, "exhausted": sum(x["exhausted"] for x in g)}
-    for name, est, args, key in [("I", lambda c, t: c / t, (C, T), "collision_rate"),
-                                 ("mean_x", lambda a, t: a / t, (IX, T), "mean_x"),
-                                 ("delta_x", lambda a, b, t: np.sqrt(b / t - (a / t) ** 2), (IX, IX2, T), "delta_x")]:
+    T = np.array([x["time"] for x in g])
+    C = np.array([x["collisions"] for x in g], float)
+    IX = np.array([x["int_x"] for x in g])
+    IX2 = np.array([x["int_x2"] for x in g])
+    cpu = sum(x["cpu"] for x in g)
+    steps = sum(x["steps"] for x in g)
+    out = {
+        "shards": len(g),
+        "cpu": cpu,
+        "collisions": C.sum(),
+        "steps_per_coll": steps / C.sum(),
+        "coll_per_cpu": C.sum() / cpu,
+        "exhausted": sum(x["exhausted"] for x in g),
+    }
+    for name, est, args, key in [
+        ("I", lambda c, t: c / t, (C, T), "collision_rate"),
+        ("mean_x", lambda a, t: a / t, (IX, T), "mean_x"),
+        ("delta_x", lambda a, b, t: np.sqrt(b / t - (a / t) ** 2), (IX, IX2, T), "delta_x"),
+    ]:
         v, e = jackknife(est, *args)
-        out[name] = (float(v), float(e), float((v - ex[key]) / e), float(v / ex[key] - 1), float(e / ex[key]))
+        out[name] = (
+            float(v),
+            float(e),
+            float((v - ex[key]) / e),
+            float(v / ex[key] - 1),
+            float(e / ex[key]),
+        )
     out["relerrI2_cpu"] = out["I"][4] ** 2 * cpu
     # P(0,v)
     lo, hi = SPEED_BINS.lower, SPEED_BINS.upper
@@ -82,22 +128,27 @@ def analyse_group(g, rkey):
     lo_u, hi_u = lo[use], hi[use]
     e = exact.outgoing_speed_bin_average(lo_u, hi_u, r)
     z = (p[use] - e) / pe[use]
-    out["p0v_n"] = int(use.sum()); out["p0v_chi2n"] = float(np.mean(z**2))
+    out["p0v_n"] = int(use.sum())
+    out["p0v_chi2n"] = float(np.mean(z**2))
     out["p0v_signs"] = "".join("+" if zz > 0 else "-" for zz in z)
     out["p0v_z"] = np.round(z, 2).tolist()
     out["p0v_vrange"] = (float(lo_u[0]), float(hi_u[-1]))
     # tilt: relative deviation = a + b log10 v, weighted LS with merged errors; error from per-shard scatter
     per = outgoing_speed_density(counts[:, use], T[:, None], lo_u, hi_u) / e - 1.0
-    lv = np.log10(np.sqrt(lo_u * hi_u)); w = (e / pe[use]) ** 2
+    lv = np.log10(np.sqrt(lo_u * hi_u))
+    w = (e / pe[use]) ** 2
     X = np.stack([np.ones_like(lv), lv - np.average(lv, weights=w)], 1)
     A = np.linalg.solve(X.T @ (w[:, None] * X), (X * w[:, None]).T)
     coef = per @ A.T  # per-shard (offset, slope)
     n = len(g)
-    m = coef.mean(0); se = coef.std(0, ddof=1) / np.sqrt(n)
-    out["p0v_offset"] = (float(m[0]), float(se[0])); out["p0v_tilt_per_decade"] = (float(m[1]), float(se[1]))
+    m = coef.mean(0)
+    se = coef.std(0, ddof=1) / np.sqrt(n)
+    out["p0v_offset"] = (float(m[0]), float(se[0]))
+    out["p0v_tilt_per_decade"] = (float(m[1]), float(se[1]))
     # sign-flip p for chi^2 (bin correlations), as tests/shard_statistics.py
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
     from shard_statistics import sign_flip_p_values
+
     chi2, p_chi2, p_worst = sign_flip_p_values(per * e)
     out["p0v_signflip"] = (chi2, float(p_chi2), float(p_worst))
     return out
@@ -112,10 +163,13 @@ def paired(rows, rkey):
     Ia = np.array([a[k]["collisions"] / a[k]["time"] for k in ks])
     Ib = np.array([b[k]["collisions"] / b[k]["time"] for k in ks])
     d = (Ia - Ib) / Ib.mean()
-    return {"shards": len(ks), "rel_diff_I_c3_minus_c5": (float(d.mean()), float(d.std(ddof=1) / np.sqrt(len(ks)))),
-            "corr": float(np.corrcoef(Ia, Ib)[0, 1]),
-            "cpu_ratio_c3_over_c5": sum(a[k]["cpu"] for k in ks) / sum(b[k]["cpu"] for k in ks),
-            "steps_ratio": sum(a[k]["steps"] for k in ks) / sum(b[k]["steps"] for k in ks)}
+    return {
+        "shards": len(ks),
+        "rel_diff_I_c3_minus_c5": (float(d.mean()), float(d.std(ddof=1) / np.sqrt(len(ks)))),
+        "corr": float(np.corrcoef(Ia, Ib)[0, 1]),
+        "cpu_ratio_c3_over_c5": sum(a[k]["cpu"] for k in ks) / sum(b[k]["cpu"] for k in ks),
+        "steps_ratio": sum(a[k]["steps"] for k in ks) / sum(b[k]["steps"] for k in ks),
+    }
 
 
 if __name__ == "__main__":
@@ -127,7 +181,9 @@ if __name__ == "__main__":
             for rk in RS:
                 g = group(rows, c, rk)
                 if len(g) >= 3:
-                    print(f"== c={c} r={rk}"); print(json.dumps(analyse_group(g, rk)))
+                    print(f"== c={c} r={rk}")
+                    print(json.dumps(analyse_group(g, rk)))
         for rk in RS:
             p = paired(rows, rk)
-            if p: print(f"== paired r={rk}", json.dumps(p))
+            if p:
+                print(f"== paired r={rk}", json.dumps(p))

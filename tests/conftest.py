@@ -1,7 +1,6 @@
 """Fixtures shared by the test modules."""
 
 import pytest
-
 from workflow_support import SMALL, copy_repository, snakemake
 
 

@@ -12,9 +12,9 @@ from bouncing_ball.restitution import restitution_label
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 
 # the exact-result tests hold the simulation to the settings users run: the default config's
-DEFAULT_SIMULATION = yaml.safe_load((Path(__file__).resolve().parents[1] / "config" / "config.yaml").read_text())[
-    "simulation"
-]
+DEFAULT_SIMULATION = yaml.safe_load(
+    (Path(__file__).resolve().parents[1] / "config" / "config.yaml").read_text()
+)["simulation"]
 CRITERION_C = float(DEFAULT_SIMULATION["criterion_c"])
 MIN_STEP_DIVISOR = float(DEFAULT_SIMULATION["min_step_divisor"])
 SPEED_BINS = LogBins(1e-4, 1e2, 10)
@@ -40,7 +40,11 @@ def _shard(arguments):
 def simulate_shards(shard_times, shards, seed, min_step_floor=0.0, criterion_c=CRITERION_C):
     """{r: [ShardTallies]} for {r: recorded time per shard}, two processes, the default config's c
     (or ``criterion_c``) and delta rule (with a floor on delta if ``min_step_floor`` > 0)."""
-    jobs = [(r, k, time, seed, min_step_floor, criterion_c) for r, time in shard_times.items() for k in range(shards)]
+    jobs = [
+        (r, k, time, seed, min_step_floor, criterion_c)
+        for r, time in shard_times.items()
+        for k in range(shards)
+    ]
     with ProcessPoolExecutor(2) as pool:
         results = list(pool.map(_shard, jobs))
     return {r: [s for (rr, *_), s in zip(jobs, results) if rr == r] for r in shard_times}
@@ -49,9 +53,13 @@ def simulate_shards(shard_times, shards, seed, min_step_floor=0.0, criterion_c=C
 def outgoing_speed_bins(shards, minimum_count=100):
     """Bin edges and each shard's P(0,v) in the finite bins with at least ``minimum_count`` collisions."""
     table = outgoing_speed_histogram(shards)
-    usable = ((table["count"] >= minimum_count) & np.isfinite(table.v_hi) & (table.v_lo > 0)).to_numpy()
+    usable = (
+        (table["count"] >= minimum_count) & np.isfinite(table.v_hi) & (table.v_lo > 0)
+    ).to_numpy()
     lower, upper = table.v_lo.to_numpy()[usable], table.v_hi.to_numpy()[usable]
-    per_shard = np.stack([outgoing_speed_density(s.speed_counts[usable], s.time, lower, upper) for s in shards])
+    per_shard = np.stack(
+        [outgoing_speed_density(s.speed_counts[usable], s.time, lower, upper) for s in shards]
+    )
     return lower, upper, per_shard
 
 

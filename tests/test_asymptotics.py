@@ -23,8 +23,8 @@ def test_beta_at_known_points(r, beta):
 
 
 def test_critical_restitution():
-    assert CRITICAL_RESTITUTION == pytest.approx(np.exp(-np.pi / np.sqrt(3.0)), rel=1e-15)
-    assert CRITICAL_RESTITUTION == pytest.approx(0.163, abs=5e-4)
+    assert pytest.approx(np.exp(-np.pi / np.sqrt(3.0)), rel=1e-15) == CRITICAL_RESTITUTION
+    assert pytest.approx(0.163, abs=5e-4) == CRITICAL_RESTITUTION
 
 
 @pytest.mark.parametrize("r", [0.01, 0.1, 0.2, 0.45, 0.6, 0.9, 0.999])
@@ -32,7 +32,9 @@ def test_beta_is_the_physical_root_of_asym2(r):
     beta = small_speed_exponent(r)
     assert 0.0 < beta < 2.5 and beta != pytest.approx(2.0)
     # eq. (asym2): r = [2 sin((2 beta + 1) pi / 6)]^(1 / (beta - 2))
-    assert (2.0 * np.sin((2.0 * beta + 1.0) * np.pi / 6.0)) ** (1.0 / (beta - 2.0)) == pytest.approx(r, rel=1e-10)
+    assert (2.0 * np.sin((2.0 * beta + 1.0) * np.pi / 6.0)) ** (
+        1.0 / (beta - 2.0)
+    ) == pytest.approx(r, rel=1e-10)
 
 
 def test_beta_decreases_from_five_halves_to_zero():
@@ -50,12 +52,18 @@ def _one_sided_derivatives(function, x, h=1e-5):
 
 def test_q_and_its_slope_continuous_at_one_half_but_not_its_curvature():
     half = 0.5
-    assert large_speed_decay_rate(half - 1e-9) == pytest.approx(large_speed_decay_rate(half + 1e-9), abs=1e-7)
+    assert large_speed_decay_rate(half - 1e-9) == pytest.approx(
+        large_speed_decay_rate(half + 1e-9), abs=1e-7
+    )
     left, right = _one_sided_derivatives(large_speed_decay_rate, half, h=1e-6)
     assert left == pytest.approx(-2.0, abs=1e-4) and right == pytest.approx(-2.0, abs=1e-4)
 
     def second(x, h):
-        return (large_speed_decay_rate(x + h) - 2 * large_speed_decay_rate(x) + large_speed_decay_rate(x - h)) / h**2
+        return (
+            large_speed_decay_rate(x + h)
+            - 2 * large_speed_decay_rate(x)
+            + large_speed_decay_rate(x - h)
+        ) / h**2
 
     below, above = second(half - 0.01, 1e-4), second(half + 0.01, 1e-4)
     assert abs(below - above) > 1.0  # 1/r^3 -> 8 below, -8/3 above
@@ -76,7 +84,10 @@ def test_solver_large_speed_decay(r):
     q, m = large_speed_decay_rate(r), large_speed_exponent(r)
     v = np.array([10.0, 20.0, 40.0, 80.0])
     h = 1e-3 * v
-    slope = -(np.log(solution.outgoing_speed_density(v + h)) - np.log(solution.outgoing_speed_density(v - h))) / (2 * h)
+    slope = -(
+        np.log(solution.outgoing_speed_density(v + h))
+        - np.log(solution.outgoing_speed_density(v - h))
+    ) / (2 * h)
     assert np.all(np.diff(np.abs(slope - q)) < 0.0)
     assert abs(slope[-1] - q) < 0.02 * q + 0.02
     approach = (slope - q) * v - m

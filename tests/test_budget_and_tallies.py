@@ -15,10 +15,15 @@ REPOSITORY = Path(__file__).resolve().parents[1]
 
 def _run(recorded_time, equilibration_time, max_steps, r=0.5):
     return simulate_shard(
-        restitution=r, seed_sequence=shard_seed_sequence(2, str(r), 0),
-        recorded_time=recorded_time, equilibration_time=equilibration_time,
-        criterion_c=5.0, min_step_divisor=500.0, max_steps=max_steps,
-        speed_bins=LogBins(1e-4, 1e2, 10), position_bins=LogBins(1e-3, 1e3, 5),
+        restitution=r,
+        seed_sequence=shard_seed_sequence(2, str(r), 0),
+        recorded_time=recorded_time,
+        equilibration_time=equilibration_time,
+        criterion_c=5.0,
+        min_step_divisor=500.0,
+        max_steps=max_steps,
+        speed_bins=LogBins(1e-4, 1e2, 10),
+        position_bins=LogBins(1e-3, 1e3, 5),
     )
 
 
@@ -44,16 +49,38 @@ def test_merge_refuses_a_shard_that_recorded_nothing(tmp_path):
     (tmp_path / "config.yaml").write_text(yaml.safe_dump(config))
     shard = tmp_path / "shard0.parquet"
     made = subprocess.run(
-        [sys.executable, "scripts/simulate_shard.py", "--restitution", "0.5", "--shard", "0",
-         "--config", str(tmp_path / "config.yaml"), "--shard-time", "10", str(shard)],
-        cwd=REPOSITORY, capture_output=True, text=True, timeout=300,
+        [
+            sys.executable,
+            "scripts/simulate_shard.py",
+            "--restitution",
+            "0.5",
+            "--shard",
+            "0",
+            "--config",
+            str(tmp_path / "config.yaml"),
+            "--shard-time",
+            "10",
+            str(shard),
+        ],
+        cwd=REPOSITORY,
+        capture_output=True,
+        text=True,
+        timeout=300,
     )
     assert made.returncode == 0 and "STEP BUDGET EXHAUSTED" in made.stderr
     merged = subprocess.run(
-        [sys.executable, "scripts/merge_shards.py", "--restitution", "0.5",
-         *[f"--{name}={tmp_path / name}.parquet" for name in ("p0v", "position", "summary")],
-         str(shard)],
-        cwd=REPOSITORY, capture_output=True, text=True, timeout=300,
+        [
+            sys.executable,
+            "scripts/merge_shards.py",
+            "--restitution",
+            "0.5",
+            *[f"--{name}={tmp_path / name}.parquet" for name in ("p0v", "position", "summary")],
+            str(shard),
+        ],
+        cwd=REPOSITORY,
+        capture_output=True,
+        text=True,
+        timeout=300,
     )
     assert merged.returncode != 0
     assert "shard0.parquet: recorded no time" in merged.stderr

@@ -30,7 +30,9 @@ def _return_speed_ratios(u, c, divisor, n, seed):
         x, v, t = 0.0, u, 0.0
         while t < 1e4 * u * u:  # returns take a time of order u^2
             dt = largest_safe_step(x, v, c) + delta
-            x1, v1 = free_flight_step(x, v, dt, np.random.standard_normal(), np.random.standard_normal())
+            x1, v1 = free_flight_step(
+                x, v, dt, np.random.standard_normal(), np.random.standard_normal()
+            )
             if x1 < 0.0:
                 a0, a1, a2, a3 = hermite_cubic(x, v, x1, v1, dt)
                 tau = first_crossing_time(a0, a1, a2, a3, dt, x1)
@@ -55,4 +57,6 @@ def test_return_speed_follows_mckean_law():
     observed[-1] += int(np.sum(~np.isfinite(ratios)))
     chi2 = float(np.sum((observed - expected) ** 2 / expected))
     p_value = stats.chi2.sf(chi2, len(expected) - 1)
-    assert p_value > 1e-3, f"chi^2 = {chi2:.1f} for {len(expected) - 1} dof; {observed} vs {expected.round()}"
+    assert p_value > 1e-3, (
+        f"chi^2 = {chi2:.1f} for {len(expected) - 1} dof; {observed} vs {expected.round()}"
+    )

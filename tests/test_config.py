@@ -26,8 +26,16 @@ def test_fractions_stay_exact():
 
 @pytest.mark.parametrize(
     "value, message",
-    [(0, "outside"), (1, "outside"), (-0.5, "outside"), ("1/0", "divides by zero"),
-     ("abc", "not a number"), (True, "not a number"), (None, "not a number"), ("4/3", "outside")],
+    [
+        (0, "outside"),
+        (1, "outside"),
+        (-0.5, "outside"),
+        ("1/0", "divides by zero"),
+        ("abc", "not a number"),
+        (True, "not a number"),
+        (None, "not a number"),
+        ("4/3", "outside"),
+    ],
 )
 def test_bad_r_named(value, message):
     with pytest.raises(ValueError, match=message) as error:

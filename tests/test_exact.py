@@ -41,7 +41,9 @@ def _speed_moments(x, r):
     """int v^n P(x, v) dv for n = 0, 1, 2 on a composite Gauss-Legendre grid in v."""
     nodes, weights = np.polynomial.legendre.leggauss(24)
     edges = [-80.0, -30.0, -10.0, -3.0, -1.0, 0.0, 1.0, 3.0, 7.0, 14.0, 26.0]
-    v = np.concatenate([0.5 * (b - a) * nodes + 0.5 * (b + a) for a, b in zip(edges[:-1], edges[1:])])
+    v = np.concatenate(
+        [0.5 * (b - a) * nodes + 0.5 * (b + a) for a, b in zip(edges[:-1], edges[1:])]
+    )
     w = np.concatenate([0.5 * (b - a) * weights for a, b in zip(edges[:-1], edges[1:])])
     with warnings.catch_warnings():
         # far out on the outgoing side the F integral cancels to e^{-v/2}; its error there is negligible
@@ -59,7 +61,9 @@ def test_distribution_obeys_moment_identities(r, x):
     px = float(exact.position_density(x, r))
     assert zeroth == pytest.approx(px, rel=1e-6)
     assert abs(first) <= 1e-6 * absolute_first
-    assert second / zeroth == pytest.approx(float(exact.mean_speed_squared_given_position(x, r)), rel=1e-6)
+    assert second / zeroth == pytest.approx(
+        float(exact.mean_speed_squared_given_position(x, r)), rel=1e-6
+    )
 
 
 @pytest.mark.parametrize("r", EXACT, ids=str)
@@ -87,7 +91,9 @@ def test_mean_speed_squared_agrees_between_forms():
     # r = 1/2 has the closed form u K1(u) / P(x); the r = 1/3 route (quadrature) must agree with it
     x = np.array([0.01, 1.0, 10.0])
     closed = exact.mean_speed_squared_given_position(x, Fraction(1, 2))
-    tail = [integrate.quad(lambda y: float(exact.position_density(y, 0.5)), xi, np.inf)[0] for xi in x]
+    tail = [
+        integrate.quad(lambda y: float(exact.position_density(y, 0.5)), xi, np.inf)[0] for xi in x
+    ]
     np.testing.assert_allclose(closed, np.array(tail) / exact.position_density(x, 0.5), rtol=1e-9)
 
 
@@ -96,6 +102,8 @@ def test_mean_speed_squared_agrees_between_forms():
 def test_bin_average_of_the_outgoing_density(r, lo, hi):
     """int v P(0,v) dv / int v dv over a bin, closed form against quadrature of eq. (P(0,v)),
     also far in the tail (where a difference of regularised gamma functions near 1 would cancel)."""
-    direct, _ = integrate.quad(lambda v: v * exact.outgoing_speed_density(v, r), lo, hi, epsrel=1e-13)
+    direct, _ = integrate.quad(
+        lambda v: v * exact.outgoing_speed_density(v, r), lo, hi, epsrel=1e-13
+    )
     closed = exact.outgoing_speed_bin_average(np.array([lo]), np.array([hi]), r)[0]
     assert closed == pytest.approx(direct / (0.5 * (hi * hi - lo * lo)), rel=1e-12)

@@ -50,13 +50,15 @@ def test_intervals_cover_the_truth_as_often_as_they_claim(side):
     lower, upper = _bins(edges)
     rng = np.random.default_rng(20061121)
     names = fits.EXPONENT_NAMES[side]
-    within_95, estimates = {n: 0 for n in names}, {n: [] for n in names}
+    within_95, estimates = dict.fromkeys(names, 0), {n: [] for n in names}
     joint_rejected = 0
     trials = 600
     t95 = fits.interval_factor(SHARDS)
     for _ in range(trials):
         counts, times = synthetic_shards(rng, side, truth, edges, time)
-        _, errors = jackknife(lambda c, t: outgoing_speed_density(c, t, lower, upper), counts, times)
+        _, errors = jackknife(
+            lambda c, t: outgoing_speed_density(c, t, lower, upper), counts, times
+        )
         fit = fits.fit_shards(side, lower, upper, counts, times, errors, r, free=True)
         # the truth is the theory of r = 0.25, which fit_shards tests jointly
         joint_rejected += fit.joint_p_value < 0.05
@@ -85,8 +87,12 @@ def test_bin_averages_of_a_curve_match_the_solver():
     solution = solver.solve_outgoing_speed_density(0.25)
     speeds = np.geomspace(1e-4, 50.0, 401)
     lower, upper = _bins(np.geomspace(1e-4, 10**1.6, 57))
-    from_curve = fits.bin_averages_of_curve(speeds, solution.outgoing_speed_density(speeds), lower, upper)
-    np.testing.assert_allclose(from_curve, solver.outgoing_speed_bin_average(solution, lower, upper), rtol=1e-6)
+    from_curve = fits.bin_averages_of_curve(
+        speeds, solution.outgoing_speed_density(speeds), lower, upper
+    )
+    np.testing.assert_allclose(
+        from_curve, solver.outgoing_speed_bin_average(solution, lower, upper), rtol=1e-6
+    )
     with pytest.raises(ValueError, match="beyond the curve"):
         fits.bin_averages_of_curve(speeds, solution.outgoing_speed_density(speeds), [40.0], [60.0])
 
@@ -97,8 +103,13 @@ def test_a_side_without_a_window_gives_nan_rows_and_says_why():
     counts, times = synthetic_shards(np.random.default_rng(1), fits.SMALL_SPEED, truth, edges, time)
     _, errors = jackknife(lambda c, t: outgoing_speed_density(c, t, lower, upper), counts, times)
     reference = fits.bin_average(fits.small_speed_form, lower, upper, *truth)
-    windows = {fits.SMALL_SPEED: "auto", fits.LARGE_SPEED: {"min": 1.0, "max": 2.0}}  # no bins there
-    table, problems = fits.asymptotic_fits(lower, upper, counts, times, errors, reference, r, windows)
+    windows = {
+        fits.SMALL_SPEED: "auto",
+        fits.LARGE_SPEED: {"min": 1.0, "max": 2.0},
+    }  # no bins there
+    table, problems = fits.asymptotic_fits(
+        lower, upper, counts, times, errors, reference, r, windows
+    )
     assert len(problems) == 1 and "large_speed window" in problems[0]
     assert table[table.window == fits.LARGE_SPEED].value.isna().all()
     assert table[table.window == fits.SMALL_SPEED].value.notna().all()
@@ -109,7 +120,9 @@ def test_one_shard_is_refused():
     lower, upper = _bins(edges)
     counts, times = synthetic_shards(np.random.default_rng(2), fits.SMALL_SPEED, truth, edges, time)
     with pytest.raises(ValueError, match="at least 2"):
-        fits.fit_shards(fits.SMALL_SPEED, lower, upper, counts[:1], times[:1], np.ones(len(lower)), r, True)
+        fits.fit_shards(
+            fits.SMALL_SPEED, lower, upper, counts[:1], times[:1], np.ones(len(lower)), r, True
+        )
 
 
 def test_bins_without_a_jackknife_error_are_weighted_by_their_poisson_error():

@@ -34,7 +34,9 @@ def test_largest_safe_step_is_the_root_of_the_criterion(c):
         assert _criterion(x, v, c, 1.001 * step) < 0  # refused just above
     assert largest_safe_step(0.0, -1.0, c) == 0.0
     # at x = 0 the root is that of v - c s - s^2/2 = 0
-    assert largest_safe_step(0.0, 2.0, c) == pytest.approx((np.sqrt(c * c + 4.0) - c) ** 2, rel=1e-12)
+    assert largest_safe_step(0.0, 2.0, c) == pytest.approx(
+        (np.sqrt(c * c + 4.0) - c) ** 2, rel=1e-12
+    )
 
 
 @njit
@@ -42,7 +44,9 @@ def _many_steps(x0, v0, dt, n, seed):
     np.random.seed(seed)
     out = np.empty((n, 4))
     for i in range(n):
-        x1, v1 = free_flight_step(x0, v0, dt, np.random.standard_normal(), np.random.standard_normal())
+        x1, v1 = free_flight_step(
+            x0, v0, dt, np.random.standard_normal(), np.random.standard_normal()
+        )
         a0, a1, a2, a3 = hermite_cubic(x0, v0, x1, v1, dt)
         int_x, int_x2 = mean_path_integrals(a0, a1, a2, a3, dt, dt)
         out[i] = x1, v1, int_x, int_x2
@@ -87,7 +91,9 @@ def _speed_squared_integrals(x0, v0, dt, n, seed):
     np.random.seed(seed)
     out = np.empty(n)
     for i in range(n):
-        x1, v1 = free_flight_step(x0, v0, dt, np.random.standard_normal(), np.random.standard_normal())
+        x1, v1 = free_flight_step(
+            x0, v0, dt, np.random.standard_normal(), np.random.standard_normal()
+        )
         a0, a1, a2, a3 = hermite_cubic(x0, v0, x1, v1, dt)
         out[i] = quintic_antiderivative_value(*speed_squared_coefficients(a1, a2, a3, dt), dt)
     return out
@@ -109,7 +115,12 @@ def test_level_crossing_time_is_the_root_to_rounding():
     where the root is well conditioned the time itself is right to 1e-12 of the piece."""
     from scipy.optimize import brentq
 
-    from bouncing_ball.free_flight import cubic_level_time, cubic_value, monotone_piece_end, slope_zeros
+    from bouncing_ball.free_flight import (
+        cubic_level_time,
+        cubic_value,
+        monotone_piece_end,
+        slope_zeros,
+    )
 
     rng = np.random.default_rng(3)
     near_ends = [1e-5, 1e-7, 1e-9, 1 - 1e-5, 1 - 1e-7, 1 - 1e-9]
@@ -134,10 +145,14 @@ def test_level_crossing_time_is_the_root_to_rounding():
                 residual = abs(cubic_value(*a, t) - level) / (1e-10 * abs(m_hi - m_lo) + rounding)
                 worst_value = max(worst_value, residual)
                 if 0.01 <= fraction <= 0.99:
-                    exact = brentq(lambda s: cubic_value(*a, s) - level, start, stop, xtol=1e-300, rtol=1e-15)
+                    exact = brentq(
+                        lambda s: cubic_value(*a, s) - level, start, stop, xtol=1e-300, rtol=1e-15
+                    )
                     # the level is known only to rounding of x: that sets how well t can be known
                     conditioning = 4e-16 * max(abs(m_lo), abs(m_hi)) / abs(m_hi - m_lo)
-                    worst_time = max(worst_time, abs(t - exact) / (stop - start) / (1e-12 + conditioning))
+                    worst_time = max(
+                        worst_time, abs(t - exact) / (stop - start) / (1e-12 + conditioning)
+                    )
                 checked += 1
             start = stop
     assert checked > 3000
@@ -153,5 +168,7 @@ def test_a_grazing_crossing_has_the_right_impact_speed():
     depth = 1e-7
     a = (1.0 - depth, -2.0, 1.0, 0.0)
     t = cubic_level_time(*a, 0.0, 0.0, 1.0, a[0], -depth)
-    assert t == pytest.approx(1.0 - np.sqrt(depth), abs=1e-10)  # bisection stops at 1e-10 of the piece
+    assert t == pytest.approx(
+        1.0 - np.sqrt(depth), abs=1e-10
+    )  # bisection stops at 1e-10 of the piece
     assert cubic_slope(*a[1:], t) == pytest.approx(-2.0 * np.sqrt(depth), rel=1e-6)

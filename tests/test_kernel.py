@@ -28,7 +28,9 @@ def _printed_kernel3(v, u):
 
     width = np.sqrt((v + u) / (6.0 * v * u))
     points = [p for p in (0.5 * width, width, 2.0 * width, 4.0 * width) if p < 1.0]
-    value, _ = integrate.quad(integrand, 0.0, 1.0, points=points or None, epsabs=0.0, epsrel=1e-13, limit=200)
+    value, _ = integrate.quad(
+        integrand, 0.0, 1.0, points=points or None, epsabs=0.0, epsrel=1e-13, limit=200
+    )
     return 1.5 / np.pi * np.sqrt(v * u) * np.exp(0.5 * (v + u)) * value
 
 
@@ -41,7 +43,9 @@ def test_equals_printed_form_where_that_is_safe(v, u):
 def _bessel_k_imaginary_order(gamma, x):
     """K_{i gamma}(x) = int_0^inf e^{-x cosh t} cos(gamma t) dt."""
     upper = np.arccosh(1.0 + 60.0 / x)
-    value, _ = integrate.quad(lambda t: np.exp(-x * np.cosh(t)), 0.0, upper, weight="cos", wvar=gamma, limit=400)
+    value, _ = integrate.quad(
+        lambda t: np.exp(-x * np.cosh(t)), 0.0, upper, weight="cos", wvar=gamma, limit=400
+    )
     return value
 
 
@@ -50,7 +54,12 @@ def _kernel2(v, u):
 
     def integrand(gamma):
         ratio = np.sinh(np.pi * gamma) / np.cosh(np.pi * gamma / 3.0)
-        return gamma * ratio * _bessel_k_imaginary_order(gamma, v) * _bessel_k_imaginary_order(gamma, u)
+        return (
+            gamma
+            * ratio
+            * _bessel_k_imaginary_order(gamma, v)
+            * _bessel_k_imaginary_order(gamma, u)
+        )
 
     value, _ = integrate.quad(integrand, 0.0, 18.0, limit=400, epsrel=1e-12)
     return np.exp(0.5 * (v + u)) / (np.pi**2 * v * u) * value

@@ -24,10 +24,15 @@ def test_fig1_shows_the_jump_of_m_at_one_half(exponents):
     assert below.max() < 0.5 and above.min() == 0.5 and above[1] > 0.5  # joined only to m(1/2) = 1
     assert dashed[1].get_ydata()[0] == 1.0
     assert np.allclose(dashed[0].get_ydata(), 1.5)
-    dots = {(float(line.get_xdata()[0]), float(line.get_ydata()[0])) for line in axis.lines
-            if line.get_marker() == "o"}
+    dots = {
+        (float(line.get_xdata()[0]), float(line.get_ydata()[0]))
+        for line in axis.lines
+        if line.get_marker() == "o"
+    }
     assert dots == {(0.5, 1.0), (0.5, 1.5)}
-    vertical = [line for line in axis.lines if np.ptp(line.get_xdata()) == 0 and line.get_marker() != "o"]
+    vertical = [
+        line for line in axis.lines if np.ptp(line.get_xdata()) == 0 and line.get_marker() != "o"
+    ]
     assert vertical[0].get_xdata()[0] == pytest.approx(CRITICAL_RESTITUTION)
 
 
@@ -35,20 +40,48 @@ def test_fig4_draws_what_it_can_when_a_fit_window_failed():
     speeds = np.geomspace(1e-4, 50, 101)
     edges = np.geomspace(1e-3, 10, 41)
     truth = exact.outgoing_speed_bin_average(edges[:-1], edges[1:], Fraction(1, 2))
-    simulated = pd.DataFrame({"v_lo": edges[:-1], "v_hi": edges[1:], "v": np.sqrt(edges[:-1] * edges[1:]),
-                              "p0v": truth, "p0v_err": 0.01 * truth, "count": 100})
+    simulated = pd.DataFrame(
+        {
+            "v_lo": edges[:-1],
+            "v_hi": edges[1:],
+            "v": np.sqrt(edges[:-1] * edges[1:]),
+            "p0v": truth,
+            "p0v_err": 0.01 * truth,
+            "count": 100,
+        }
+    )
     rows = []
-    for window, names in (("small_speed", ("prefactor", "beta")), ("large_speed", ("prefactor", "m", "q"))):
+    for window, names in (
+        ("small_speed", ("prefactor", "beta")),
+        ("large_speed", ("prefactor", "m", "q")),
+    ):
         for name in names:
             value = np.nan if window == "large_speed" else {"prefactor": 1 / 3, "beta": 1.0}[name]
-            rows.append({"source": "simulation", "window": window, "fit": "fixed_exponents",
-                         "parameter": name, "value": value, "v_min": 1e-3, "v_max": 1e-2})
-    panel = {"restitution": Fraction(1, 2), "simulated": simulated, "fits": pd.DataFrame(rows),
-             "solver": pd.DataFrame({"v": speeds, "p0v": exact.outgoing_speed_density(speeds, Fraction(1, 2))})}
+            rows.append(
+                {
+                    "source": "simulation",
+                    "window": window,
+                    "fit": "fixed_exponents",
+                    "parameter": name,
+                    "value": value,
+                    "v_min": 1e-3,
+                    "v_max": 1e-2,
+                }
+            )
+    panel = {
+        "restitution": Fraction(1, 2),
+        "simulated": simulated,
+        "fits": pd.DataFrame(rows),
+        "solver": pd.DataFrame(
+            {"v": speeds, "p0v": exact.outgoing_speed_density(speeds, Fraction(1, 2))}
+        ),
+    }
     axis = plotting.asymptotic_forms_figure([panel]).axes[0]
     labels = [text.get_text() for text in axis.get_legend().get_texts()]
     assert labels[0] == "solver, eq. (inteq)" and "simulation" in labels
-    assert any(r"\beta = 1" in label for label in labels) and not any("e^{-qv}" in label for label in labels)
+    assert any(r"\beta = 1" in label for label in labels) and not any(
+        "e^{-qv}" in label for label in labels
+    )
     assert axis.get_xscale() == axis.get_yscale() == "log"
 
 

@@ -37,12 +37,25 @@ def library():
         pytest.skip(f"the C reference cannot be built here: {str(error).splitlines()[0]}")
 
 
-def _both(library, r, seed=3, recorded_time=2e3, equilibration_time=100.0, max_steps=10**9,
-          min_step_floor=0.0, criterion_c=5.0):
+def _both(
+    library,
+    r,
+    seed=3,
+    recorded_time=2e3,
+    equilibration_time=100.0,
+    max_steps=10**9,
+    min_step_floor=0.0,
+    criterion_c=5.0,
+):
     settings = dict(
-        recorded_time=recorded_time, equilibration_time=equilibration_time, criterion_c=criterion_c,
-        min_step_divisor=500.0, max_steps=max_steps, speed_bins=SPEED_BINS,
-        position_bins=POSITION_BINS, min_step_floor=min_step_floor,
+        recorded_time=recorded_time,
+        equilibration_time=equilibration_time,
+        criterion_c=criterion_c,
+        min_step_divisor=500.0,
+        max_steps=max_steps,
+        speed_bins=SPEED_BINS,
+        position_bins=POSITION_BINS,
+        min_step_floor=min_step_floor,
     )
     stream = shard_seed_sequence(seed, str(r), 0)
     numba_tallies = simulate_shard(r, stream, **settings)
@@ -71,8 +84,9 @@ def test_c_reference_gives_bit_identical_tallies(library, r, criterion_c):
 
 @needs_gcc
 def test_identical_with_a_floor_on_delta_below_r_c(library):
-    numba_tallies, c_tallies = _both(library, 0.05, recorded_time=500.0, equilibration_time=10.0,
-                                     min_step_floor=1e-10)
+    numba_tallies, c_tallies = _both(
+        library, 0.05, recorded_time=500.0, equilibration_time=10.0, min_step_floor=1e-10
+    )
     assert numba_tallies.budget_exhausted == 0 and numba_tallies.time == pytest.approx(500.0)
     _assert_identical(numba_tallies, c_tallies)
 
@@ -87,8 +101,9 @@ def test_identical_when_the_step_budget_runs_out(library):
 @needs_gcc
 def test_identical_through_a_collapse_without_a_floor(library):
     # below r_c with the paper's rule alone: speeds fall to ~1e-37 and the shard stops early
-    numba_tallies, c_tallies = _both(library, 0.05, recorded_time=1e3, equilibration_time=0.0,
-                                     max_steps=2_000_000)
+    numba_tallies, c_tallies = _both(
+        library, 0.05, recorded_time=1e3, equilibration_time=0.0, max_steps=2_000_000
+    )
     assert numba_tallies.budget_exhausted == 1 and numba_tallies.collisions > 10
     assert numba_tallies.steps < 2_000_000  # stopped by COLLAPSED_STEP, not by the budget
     _assert_identical(numba_tallies, c_tallies)
@@ -117,17 +132,27 @@ def test_edited_source_builds_into_a_new_cache_folder(tmp_path):
     assert not [p for p in cache.rglob(".build-*")]  # no scratch left behind
     # and the edited library still works
     stream = shard_seed_sequence(1, "0.5", 0)
-    settings = dict(recorded_time=100.0, equilibration_time=10.0, criterion_c=5.0,
-                    min_step_divisor=500.0, max_steps=10**9, speed_bins=SPEED_BINS,
-                    position_bins=POSITION_BINS)
-    _assert_identical(reference_shard(0.5, stream, **settings, library=first),
-                      reference_shard(0.5, stream, **settings, library=second))
+    settings = dict(
+        recorded_time=100.0,
+        equilibration_time=10.0,
+        criterion_c=5.0,
+        min_step_divisor=500.0,
+        max_steps=10**9,
+        speed_bins=SPEED_BINS,
+        position_bins=POSITION_BINS,
+    )
+    _assert_identical(
+        reference_shard(0.5, stream, **settings, library=first),
+        reference_shard(0.5, stream, **settings, library=second),
+    )
 
 
 def test_cache_key_covers_source_and_flags():
     command = ["gcc", "-O3", "x.c"]
     assert reference_loop.cache_key(b"a", command) != reference_loop.cache_key(b"b", command)
-    assert reference_loop.cache_key(b"a", command) != reference_loop.cache_key(b"a", command + ["-g"])
+    assert reference_loop.cache_key(b"a", command) != reference_loop.cache_key(
+        b"a", command + ["-g"]
+    )
 
 
 def test_missing_compiler_is_named(monkeypatch, tmp_path):

@@ -1,8 +1,8 @@
 """Interrupted runs, corrupt files and reruns: the workflow recovers and the numbers do not change."""
 
 import os
-import signal
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -12,9 +12,9 @@ import numpy as np
 import pandas as pd
 import pytest
 import yaml
+from workflow_support import SMALL, copy_repository, snakemake
 
 from bouncing_ball.io import read_table
-from workflow_support import SMALL, copy_repository, snakemake
 
 pytestmark = pytest.mark.workflow
 
@@ -43,15 +43,23 @@ def _shard_processes(directory):
             folder = os.readlink(entry / "cwd")
         except OSError:
             continue
-        if b"simulate_shard" in command and b"snakemake" not in command.split(b"\0")[0] and folder == str(directory):
+        if (
+            b"simulate_shard" in command
+            and b"snakemake" not in command.split(b"\0")[0]
+            and folder == str(directory)
+        ):
             found.append(int(entry.name))
     return found
 
 
 def _start(directory):
     return subprocess.Popen(
-        [sys.executable, "-m", "snakemake", "--cores", "2", *TABLES], cwd=directory,
-        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True,
+        [sys.executable, "-m", "snakemake", "--cores", "2", *TABLES],
+        cwd=directory,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        start_new_session=True,
     )
 
 
@@ -83,7 +91,9 @@ def _assert_no_half_files(directory):
     assert not list(folder.glob(".*")), "temporary files left behind"
 
 
-@pytest.mark.parametrize("how", ["kill the shard job", "kill snakemake and its jobs", "interrupt (Ctrl-C)"])
+@pytest.mark.parametrize(
+    "how", ["kill the shard job", "kill snakemake and its jobs", "interrupt (Ctrl-C)"]
+)
 def test_an_interrupted_run_completes_on_rerun_with_the_same_numbers(uninterrupted, tmp_path, how):
     directory = copy_repository(tmp_path, LONG)
     run = _start(directory)
@@ -132,9 +142,14 @@ def test_a_corrupt_merged_table_is_named_by_the_rule_that_reads_it(finished_run,
     shutil.copytree(finished_run, directory)
     table = directory / "results/simulation/r0.5/p0v.parquet"
     table.write_bytes(b"not parquet at all")
-    result = snakemake(directory, "results/figures/fig5.pdf")  # newer than fig5: fig5 re-runs, reads it
+    result = snakemake(
+        directory, "results/figures/fig5.pdf"
+    )  # newer than fig5: fig5 re-runs, reads it
     assert result.returncode != 0
-    assert "results/simulation/r0.5/p0v.parquet: not a readable Parquet file" in result.stdout + result.stderr
+    assert (
+        "results/simulation/r0.5/p0v.parquet: not a readable Parquet file"
+        in result.stdout + result.stderr
+    )
 
 
 def test_extreme_r_runs_end_to_end_within_its_budget(tmp_path):
@@ -143,10 +158,18 @@ def test_extreme_r_runs_end_to_end_within_its_budget(tmp_path):
     config = yaml.safe_load(yaml.safe_dump(SMALL)) | {"restitution": [0.05, 0.98]}
     config["simulation"]["per_restitution"] = {"0.05": {"min_step_floor": 1.0e-12}}
     directory = copy_repository(tmp_path, config)
-    targets = [f"results/{kind}/r{label}/summary.parquet" for kind in ("simulation", "solver")
-               for label in ("0.05", "0.98")]
-    result = snakemake(directory, *targets, "results/fits/r0.05.parquet", "results/fits/r0.98.parquet",
-                       "results/tables/moments.csv")
+    targets = [
+        f"results/{kind}/r{label}/summary.parquet"
+        for kind in ("simulation", "solver")
+        for label in ("0.05", "0.98")
+    ]
+    result = snakemake(
+        directory,
+        *targets,
+        "results/fits/r0.05.parquet",
+        "results/fits/r0.98.parquet",
+        "results/tables/moments.csv",
+    )
     assert result.returncode == 0, result.stderr[-3000:]
     for label in ("0.05", "0.98"):
         simulated, _ = read_table(directory / f"results/simulation/r{label}/summary.parquet")

@@ -10,7 +10,6 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
-
 from shard_statistics import CRITERION_C, outgoing_speed_bins, sign_flip_p_values, simulate_shards
 
 from bouncing_ball import exact
@@ -23,7 +22,11 @@ SEED = 20061121
 # eq. (xandDeltax) in closed form
 PAPER = {
     Fraction(1, 2): {"mean_x": 6.0, "delta_x": 6.0 * np.sqrt(3.0), "collision_rate": 1.0 / 3.0},
-    Fraction(1, 3): {"mean_x": 35.0 / 9.0, "delta_x": np.sqrt(4781.0) / 9.0, "collision_rate": 0.75},
+    Fraction(1, 3): {
+        "mean_x": 35.0 / 9.0,
+        "delta_x": np.sqrt(4781.0) / 9.0,
+        "collision_rate": 0.75,
+    },
 }
 
 

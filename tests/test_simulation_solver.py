@@ -75,9 +75,15 @@ def test_free_exponent_fits_agree_with_theory(shards, solutions, r):
     counts = np.stack([s.speed_counts[inside][keep] for s in shards[r]])
     _, errors = jackknife(lambda c, t: outgoing_speed_density(c, t, lower, upper), counts, times)
     windows = {fits.SMALL_SPEED: "auto", fits.LARGE_SPEED: "auto"}
-    table, problems = fits.asymptotic_fits(lower, upper, counts, times, errors, reference, r, windows)
+    table, problems = fits.asymptotic_fits(
+        lower, upper, counts, times, errors, reference, r, windows
+    )
     assert problems == []
-    free = table[(table.source == "simulation") & (table.fit == "free_exponents") & (table.parameter != "prefactor")]
+    free = table[
+        (table.source == "simulation")
+        & (table.fit == "free_exponents")
+        & (table.parameter != "prefactor")
+    ]
     assert sorted(free.parameter) == ["beta", "m", "q"]
     for window, rows in free.groupby("window"):
         assert rows.joint_p_value.iloc[0] > 1e-3, rows.to_string()

@@ -3,9 +3,7 @@
 import re
 
 import yaml
-
 from snakemake.cli import get_argument_parser
-
 from workflow_support import REPOSITORY
 
 PROFILE = REPOSITORY / "profiles" / "slurm" / "config.yaml"
@@ -14,7 +12,10 @@ PROFILE = REPOSITORY / "profiles" / "slurm" / "config.yaml"
 def rule_blocks():
     """{rule name: its text} over the Snakefile and workflow/rules/*.smk."""
     blocks = {}
-    for path in [REPOSITORY / "Snakefile", *sorted((REPOSITORY / "workflow" / "rules").glob("*.smk"))]:
+    for path in [
+        REPOSITORY / "Snakefile",
+        *sorted((REPOSITORY / "workflow" / "rules").glob("*.smk")),
+    ]:
         parts = re.split(r"^rule (\w+):\n", path.read_text(), flags=re.MULTILINE)
         for name, body in zip(parts[1::2], parts[2::2]):
             blocks[name] = re.split(r"^\S", body, maxsplit=1, flags=re.MULTILINE)[0]
@@ -61,4 +62,6 @@ def test_every_submitted_rule_sets_its_resources_and_local_rules_exist():
         keys = set(re.findall(r"(\w+)=", resources.group(1)))
         assert {"runtime", "mem_mb", "cpus_per_task"} <= keys, f"rule {name}: {sorted(keys)}"
         threads = re.search(r"threads:\n\s+(\S+)", blocks[name])
-        assert threads is None or threads.group(1) == "1", f"rule {name}: threads > 1 meets cores: 1"
+        assert threads is None or threads.group(1) == "1", (
+            f"rule {name}: threads > 1 meets cores: 1"
+        )

@@ -11,7 +11,11 @@ from bouncing_ball.asymptotics import small_speed_exponent
 # eq. (xandDeltax) in closed form
 PAPER = {
     Fraction(1, 2): {"mean_x": 6.0, "delta_x": 6.0 * np.sqrt(3.0), "collision_rate": 1.0 / 3.0},
-    Fraction(1, 3): {"mean_x": 35.0 / 9.0, "delta_x": np.sqrt(4781.0) / 9.0, "collision_rate": 0.75},
+    Fraction(1, 3): {
+        "mean_x": 35.0 / 9.0,
+        "delta_x": np.sqrt(4781.0) / 9.0,
+        "collision_rate": 0.75,
+    },
 }
 SPEEDS = np.geomspace(1e-3, 20.0, 400)
 
@@ -25,7 +29,9 @@ def exact_case(request):
 def test_matches_exact_outgoing_speed_density(exact_case):
     """eq. (P(0,v)) with eq. (constants): relative error <= 1e-8 for v in [1e-3, 20]."""
     r, solution = exact_case
-    relative = solution.outgoing_speed_density(SPEEDS) / exact.outgoing_speed_density(SPEEDS, r) - 1.0
+    relative = (
+        solution.outgoing_speed_density(SPEEDS) / exact.outgoing_speed_density(SPEEDS, r) - 1.0
+    )
     assert np.max(np.abs(relative)) <= 1e-8
     # also at the nodes themselves, over the whole grid where P is a normal number
     nodes = solution.speeds[(solution.speeds >= 1e-10) & (solution.speeds <= 40.0)]
@@ -68,12 +74,16 @@ def test_small_speed_power_law(r):
     """The local log-slope of P(0, v) tends to -beta of eq. (asym2) as v -> 0."""
     solution = solver.solve_outgoing_speed_density(r)
     v = np.array([1e-8, 1e-6, 1e-4])
-    slope = np.log(solution.outgoing_speed_density(1.01 * v) / solution.outgoing_speed_density(v)) / np.log(1.01)
+    slope = np.log(
+        solution.outgoing_speed_density(1.01 * v) / solution.outgoing_speed_density(v)
+    ) / np.log(1.01)
     beta = small_speed_exponent(r)
     deviation = np.abs(slope + beta)
     # the approach is O(v): ~100 times closer per two decades
     assert deviation[0] < 1e-6, f"slopes {slope}, beta {beta}"
-    assert np.all((deviation[1:] / deviation[:-1] > 30.0) & (deviation[1:] / deviation[:-1] < 300.0)), deviation
+    assert np.all(
+        (deviation[1:] / deviation[:-1] > 30.0) & (deviation[1:] / deviation[:-1] < 300.0)
+    ), deviation
 
 
 def test_collision_rate_diverges_below_critical():

@@ -9,10 +9,15 @@ from bouncing_ball.tallies import tallies_to_frame
 
 def _run(label, shard, seed=11):
     return simulate_shard(
-        restitution=float(label), seed_sequence=shard_seed_sequence(seed, label, shard),
-        recorded_time=500.0, equilibration_time=10.0, criterion_c=5.0,
-        min_step_divisor=500.0, max_steps=10**9,
-        speed_bins=LogBins(1e-4, 1e2, 10), position_bins=LogBins(1e-3, 1e3, 5),
+        restitution=float(label),
+        seed_sequence=shard_seed_sequence(seed, label, shard),
+        recorded_time=500.0,
+        equilibration_time=10.0,
+        criterion_c=5.0,
+        min_step_divisor=500.0,
+        max_steps=10**9,
+        speed_bins=LogBins(1e-4, 1e2, 10),
+        position_bins=LogBins(1e-3, 1e3, 5),
     )
 
 
@@ -32,4 +37,6 @@ def test_different_shards_and_r_get_different_streams():
 
 
 def test_other_seed_other_stream():
-    assert not tallies_to_frame(_run("0.5", 0, seed=1)).equals(tallies_to_frame(_run("0.5", 0, seed=2)))
+    assert not tallies_to_frame(_run("0.5", 0, seed=1)).equals(
+        tallies_to_frame(_run("0.5", 0, seed=2))
+    )

@@ -69,23 +69,41 @@ def test_frame_round_trip(shard):
 
 def test_parquet_round_trip_keeps_provenance(tmp_path):
     shard = ShardTallies(
-        SPEED_BINS, POSITION_BINS,
-        np.arange(SPEED_BINS.n + 2), np.ones(POSITION_BINS.n + 2), np.ones(POSITION_BINS.n + 2),
-        10.0, 5, 50, 1.0, 2.0, 0,
+        SPEED_BINS,
+        POSITION_BINS,
+        np.arange(SPEED_BINS.n + 2),
+        np.ones(POSITION_BINS.n + 2),
+        np.ones(POSITION_BINS.n + 2),
+        10.0,
+        5,
+        50,
+        1.0,
+        2.0,
+        0,
     )
     path = tmp_path / "shard0.parquet"
     write_table(tallies_to_frame(shard), path, {"r": "1/3", "seed": 7})
     frame, provenance = read_table(path)
     assert provenance["r"] == "1/3" and provenance["seed"] == 7 and "package_version" in provenance
-    assert np.array_equal(tallies_from_frame(frame, SPEED_BINS, POSITION_BINS).speed_counts, shard.speed_counts)
+    assert np.array_equal(
+        tallies_from_frame(frame, SPEED_BINS, POSITION_BINS).speed_counts, shard.speed_counts
+    )
     assert [p.name for p in tmp_path.iterdir()] == ["shard0.parquet"]  # no temporary left
 
 
 def test_shards_on_other_bins_are_refused():
     shard = ShardTallies(
-        SPEED_BINS, POSITION_BINS,
-        np.zeros(SPEED_BINS.n + 2, dtype=np.int64), np.zeros(POSITION_BINS.n + 2),
-        np.zeros(POSITION_BINS.n + 2), 1.0, 0, 0, 0.0, 0.0, 0,
+        SPEED_BINS,
+        POSITION_BINS,
+        np.zeros(SPEED_BINS.n + 2, dtype=np.int64),
+        np.zeros(POSITION_BINS.n + 2),
+        np.zeros(POSITION_BINS.n + 2),
+        1.0,
+        0,
+        0,
+        0.0,
+        0.0,
+        0,
     )
     with pytest.raises(ValueError, match="not on the configured bins"):
         tallies_from_frame(tallies_to_frame(shard), LogBins(1e-2, 1e1, 3), POSITION_BINS)
@@ -103,8 +121,17 @@ def test_outgoing_speed_density_counts_rate_over_bin():
     # one shard, 10 collisions in [1, 10) over time 2: p0v = 10 / (2 * (100 - 1) / 2)
     bins = LogBins(1.0, 10.0, 1)
     shard = ShardTallies(
-        bins, POSITION_BINS, np.array([0, 10, 0]), np.zeros(POSITION_BINS.n + 2),
-        np.zeros(POSITION_BINS.n + 2), 2.0, 10, 100, 0.0, 0.0, 0,
+        bins,
+        POSITION_BINS,
+        np.array([0, 10, 0]),
+        np.zeros(POSITION_BINS.n + 2),
+        np.zeros(POSITION_BINS.n + 2),
+        2.0,
+        10,
+        100,
+        0.0,
+        0.0,
+        0,
     )
     table = outgoing_speed_histogram([shard])
     assert table.p0v.iloc[1] == pytest.approx(10.0 / 99.0)
@@ -115,10 +142,25 @@ def test_truncated_file_gives_an_error_that_names_it(tmp_path):
     from bouncing_ball.io import UnreadableFileError
 
     path = tmp_path / "shard3.parquet"
-    write_table(tallies_to_frame(ShardTallies(
-        SPEED_BINS, POSITION_BINS, np.zeros(SPEED_BINS.n + 2, dtype=np.int64),
-        np.zeros(POSITION_BINS.n + 2), np.zeros(POSITION_BINS.n + 2), 1.0, 0, 0, 0.0, 0.0, 0,
-    )), path, {})
+    write_table(
+        tallies_to_frame(
+            ShardTallies(
+                SPEED_BINS,
+                POSITION_BINS,
+                np.zeros(SPEED_BINS.n + 2, dtype=np.int64),
+                np.zeros(POSITION_BINS.n + 2),
+                np.zeros(POSITION_BINS.n + 2),
+                1.0,
+                0,
+                0,
+                0.0,
+                0.0,
+                0,
+            )
+        ),
+        path,
+        {},
+    )
     path.write_bytes(path.read_bytes()[:200])
     with pytest.raises(UnreadableFileError, match="shard3.parquet"):
         read_table(path)
@@ -128,6 +170,19 @@ def test_the_compiled_loop_fills_its_scalars_in_the_order_of_SCALARS():
     from bouncing_ball import simulation
     from bouncing_ball.tallies import SCALARS
 
-    indices = (simulation._TIME, simulation._COLLISIONS, simulation._STEPS, simulation._INT_X,
-               simulation._INT_X2, simulation._EXHAUSTED)
-    assert [SCALARS[k] for k in indices] == ["time", "collisions", "steps", "int_x", "int_x2", "budget_exhausted"]
+    indices = (
+        simulation._TIME,
+        simulation._COLLISIONS,
+        simulation._STEPS,
+        simulation._INT_X,
+        simulation._INT_X2,
+        simulation._EXHAUSTED,
+    )
+    assert [SCALARS[k] for k in indices] == [
+        "time",
+        "collisions",
+        "steps",
+        "int_x",
+        "int_x2",
+        "budget_exhausted",
+    ]

@@ -10,13 +10,12 @@ from pathlib import Path
 import pandas as pd
 import pytest
 import yaml
-
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
+from workflow_support import FIGURES, REPOSITORY, SMALL, copy_repository, planned_jobs, snakemake
 
 from bouncing_ball.config import check_config
 from bouncing_ball.io import read_table
-from workflow_support import FIGURES, REPOSITORY, SMALL, copy_repository, planned_jobs, snakemake
 
 pytestmark = pytest.mark.workflow
 
@@ -32,11 +31,27 @@ def test_run_produces_the_documented_tables(finished_run):
         assert provenance["r_label"] == label and provenance["shards"] == shards
         position, _ = read_table(folder / "position.parquet")
         assert list(position.columns) == [
-            "x_lo", "x_hi", "x", "px", "px_err", "v2_given_x", "v2_given_x_err"
+            "x_lo",
+            "x_hi",
+            "x",
+            "px",
+            "px_err",
+            "v2_given_x",
+            "v2_given_x_err",
         ]
         summary, _ = read_table(folder / "summary.parquet")
-        for column in ("r", "mean_x", "mean_x_err", "delta_x", "delta_x_err", "collision_rate",
-                       "collision_rate_err", "total_time", "collisions", "shards"):
+        for column in (
+            "r",
+            "mean_x",
+            "mean_x_err",
+            "delta_x",
+            "delta_x_err",
+            "collision_rate",
+            "collision_rate_err",
+            "total_time",
+            "collisions",
+            "shards",
+        ):
             assert column in summary.columns
         assert summary.total_time.iloc[0] == pytest.approx(shards * 2.0e3)
         assert p0v["count"].sum() == summary.collisions.iloc[0]
@@ -48,8 +63,16 @@ def test_run_produces_the_documented_tables(finished_run):
         assert list(p0v.columns) == ["v", "p0v"] and len(p0v) == 41
         assert provenance["r_label"] == label
         summary, _ = read_table(finished_run / f"results/solver/r{label}/summary.parquet")
-        for column in ("r", "mean_x", "delta_x", "collision_rate", "momentum_balance_residual",
-                       "energy_balance_residual", "grid_size", "accuracy_estimate"):
+        for column in (
+            "r",
+            "mean_x",
+            "delta_x",
+            "collision_rate",
+            "momentum_balance_residual",
+            "energy_balance_residual",
+            "grid_size",
+            "accuracy_estimate",
+        ):
             assert column in summary.columns
         assert summary.accuracy_estimate.iloc[0] < 1e-8
         distribution, _ = read_table(finished_run / f"results/exact/r{label}/distribution.parquet")
@@ -63,14 +86,37 @@ def test_run_produces_the_documented_tables(finished_run):
     assert exponents.beta[exponents.r.round(9) == 0.5].iloc[0] == pytest.approx(1.0)
     for label in ("0.5", "0.333333"):
         fitted, provenance = read_table(finished_run / f"results/fits/r{label}.parquet")
-        assert list(fitted.columns) == ["source", "window", "fit", "parameter", "value", "error", "lower_95",
-                                        "upper_95", "theory", "joint_p_value", "chi2_per_dof", "dof",
-                                        "v_min", "v_max"]
+        assert list(fitted.columns) == [
+            "source",
+            "window",
+            "fit",
+            "parameter",
+            "value",
+            "error",
+            "lower_95",
+            "upper_95",
+            "theory",
+            "joint_p_value",
+            "chi2_per_dof",
+            "dof",
+            "v_min",
+            "v_max",
+        ]
         assert len(fitted) == 20 and provenance["shards"] == {"0.5": 3, "0.333333": 2}[label]
 
 
-MOMENT_COLUMNS = ["r_label", "r", "quantity", "paper", "exact", "solver", "simulation", "simulation_err",
-                  "reference", "z"]
+MOMENT_COLUMNS = [
+    "r_label",
+    "r",
+    "quantity",
+    "paper",
+    "exact",
+    "solver",
+    "simulation",
+    "simulation_err",
+    "reference",
+    "z",
+]
 
 
 def test_run_draws_every_figure_and_writes_the_moments_table(finished_run):
@@ -82,7 +128,10 @@ def test_run_draws_every_figure_and_writes_the_moments_table(finished_run):
     assert list(table.columns) == MOMENT_COLUMNS and len(table) == 6
     assert sorted(table.r_label.astype(str).unique()) == ["0.333333", "0.5"]
     assert (table.reference == "exact").all()
-    for label, paper in (("0.5", {"mean_x": 6.0, "delta_x": 10.4}), ("0.333333", {"mean_x": 3.89, "delta_x": 7.68})):
+    for label, paper in (
+        ("0.5", {"mean_x": 6.0, "delta_x": 10.4}),
+        ("0.333333", {"mean_x": 3.89, "delta_x": 7.68}),
+    ):
         summary, _ = read_table(finished_run / f"results/simulation/r{label}/summary.parquet")
         exact, _ = read_table(finished_run / f"results/exact/r{label}/summary.parquet")
         rows = table[table.r_label.astype(str) == label].set_index("quantity")
@@ -91,7 +140,9 @@ def test_run_draws_every_figure_and_writes_the_moments_table(finished_run):
             assert row.exact == pytest.approx(exact[quantity].iloc[0], rel=1e-11)
             assert row.solver == pytest.approx(row.exact, rel=1e-8)
             assert row.simulation == pytest.approx(summary[quantity].iloc[0], rel=1e-11)
-            z = (summary[quantity].iloc[0] - exact[quantity].iloc[0]) / summary[f"{quantity}_err"].iloc[0]
+            z = (summary[quantity].iloc[0] - exact[quantity].iloc[0]) / summary[
+                f"{quantity}_err"
+            ].iloc[0]
             assert row.z == pytest.approx(z, rel=1e-9)
             if quantity in paper:
                 assert row.paper == paper[quantity]
@@ -111,10 +162,16 @@ def test_the_report_has_every_figure_and_table_with_its_caption(finished_run, tm
     text = report.read_text()
     for name in [*(f"fig{n}.png" for n in range(1, 8)), "moments.csv"]:
         assert name in text, name
-    for phrase in ("The exponents beta(r)", "The decay rate q(r)", "The exact P(x,v) against v",
-                   "Double-logarithmic plot of P(0,v)", "exact solution, eq. (P(0,v))",
-                   "The mean height", "Residuals (simulation - solver) / sigma",
-                   "The time averages of eq. (xandDeltax)"):
+    for phrase in (
+        "The exponents beta(r)",
+        "The decay rate q(r)",
+        "The exact P(x,v) against v",
+        "Double-logarithmic plot of P(0,v)",
+        "exact solution, eq. (P(0,v))",
+        "The mean height",
+        "Residuals (simulation - solver) / sigma",
+        "The time averages of eq. (xandDeltax)",
+    ):
         assert phrase in text, phrase
 
 
@@ -141,7 +198,10 @@ def test_an_r_not_in_the_config_is_a_valid_target(finished_run, tmp_path):
 def test_exact_solutions_exist_only_for_one_half_and_one_third(finished_run):
     result = snakemake(finished_run, "--dry-run", "results/exact/r0.6/summary.parquet")
     assert result.returncode != 0
-    assert "exact solutions exist only for r0.5 (r = 1/2) and r0.333333 (r = 1/3)" in result.stdout + result.stderr
+    assert (
+        "exact solutions exist only for r0.5 (r = 1/2) and r0.333333 (r = 1/3)"
+        in result.stdout + result.stderr
+    )
 
 
 def test_exact_one_third_does_not_need_one_third_in_the_config(finished_run, tmp_path):
@@ -167,7 +227,12 @@ def test_adding_a_shard_runs_only_that_shard(finished_run, tmp_path):
     config["simulation"]["per_restitution"]["0.5"] = {"shards": 4}
     (directory / "config" / "config.yaml").write_text(yaml.safe_dump(config))
     assert planned_jobs(directory) == {
-        "simulate_shard": 1, "merge_shards": 1, "fit": 1, "fig4": 1, "fig5": 1, **AGGREGATES
+        "simulate_shard": 1,
+        "merge_shards": 1,
+        "fit": 1,
+        "fig4": 1,
+        "fig5": 1,
+        **AGGREGATES,
     }
 
 
@@ -181,21 +246,39 @@ def test_adding_an_r_runs_only_its_jobs_and_the_aggregates(finished_run, tmp_pat
     config["restitution"].append(0.6)
     (directory / "config" / "config.yaml").write_text(yaml.safe_dump(config))
     planned = planned_jobs(directory)
-    assert planned == {"simulate_shard": 3, "merge_shards": 1, "solve": 1, "fit": 1, **AGGREGATES}, planned
-    before = {path: path.stat().st_mtime_ns for path in (directory / "results").rglob("*") if path.is_file()}
+    assert planned == {
+        "simulate_shard": 3,
+        "merge_shards": 1,
+        "solve": 1,
+        "fit": 1,
+        **AGGREGATES,
+    }, planned
+    before = {
+        path: path.stat().st_mtime_ns
+        for path in (directory / "results").rglob("*")
+        if path.is_file()
+    }
     result = snakemake(directory)
     assert result.returncode == 0, result.stderr[-3000:]
     changed = sorted(
-        str(path.relative_to(directory)) for path in (directory / "results").rglob("*")
+        str(path.relative_to(directory))
+        for path in (directory / "results").rglob("*")
         if path.is_file() and before.get(path) != path.stat().st_mtime_ns
     )
-    assert changed == sorted([
-        *(f"results/simulation/r0.6/{name}.parquet" for name in ("shard0", "shard1", "shard2", "p0v",
-                                                                 "position", "summary")),
-        "results/solver/r0.6/p0v.parquet", "results/solver/r0.6/summary.parquet", "results/fits/r0.6.parquet",
-        *(f"results/figures/fig{n}.{ext}" for n in (6, 7) for ext in ("pdf", "png")),
-        "results/tables/moments.csv", "results/tables/moments.md",
-    ])
+    assert changed == sorted(
+        [
+            *(
+                f"results/simulation/r0.6/{name}.parquet"
+                for name in ("shard0", "shard1", "shard2", "p0v", "position", "summary")
+            ),
+            "results/solver/r0.6/p0v.parquet",
+            "results/solver/r0.6/summary.parquet",
+            "results/fits/r0.6.parquet",
+            *(f"results/figures/fig{n}.{ext}" for n in (6, 7) for ext in ("pdf", "png")),
+            "results/tables/moments.csv",
+            "results/tables/moments.md",
+        ]
+    )
     assert len(pd.read_csv(directory / "results/tables/moments.csv")) == 9
 
 
@@ -214,21 +297,40 @@ def test_editing_a_plotting_script_reruns_only_figures(finished_run, tmp_path):
 def test_one_target_builds_only_what_it_needs(tmp_path):
     directory = copy_repository(tmp_path, SMALL)
     assert planned_jobs(directory, None, "results/figures/fig5.pdf") == {
-        "simulate_shard": 5, "merge_shards": 2, "exact_solution": 2, "fig5": 1
+        "simulate_shard": 5,
+        "merge_shards": 2,
+        "exact_solution": 2,
+        "fig5": 1,
     }
     assert planned_jobs(directory, None, "tables") == {
-        "simulate_shard": 5, "merge_shards": 2, "solve": 2, "exact_solution": 2, "moments_table": 1, "tables": 1
+        "simulate_shard": 5,
+        "merge_shards": 2,
+        "solve": 2,
+        "exact_solution": 2,
+        "moments_table": 1,
+        "tables": 1,
     }
     result = snakemake(directory, "results/figures/fig1.png")
     assert result.returncode == 0, result.stderr[-3000:]
-    built = sorted(str(path.relative_to(directory)) for path in (directory / "results").rglob("*") if path.is_file())
-    assert built == ["results/figures/fig1.pdf", "results/figures/fig1.png", "results/theory/exponents.parquet"]
+    built = sorted(
+        str(path.relative_to(directory))
+        for path in (directory / "results").rglob("*")
+        if path.is_file()
+    )
+    assert built == [
+        "results/figures/fig1.pdf",
+        "results/figures/fig1.png",
+        "results/theory/exponents.parquet",
+    ]
 
 
 def _packagecopy_repository(tmp_path):
     """A copy of the library that PYTHONPATH puts in front of the installed one."""
-    shutil.copytree(REPOSITORY / "bouncing_ball", tmp_path / "lib" / "bouncing_ball",
-                    ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(
+        REPOSITORY / "bouncing_ball",
+        tmp_path / "lib" / "bouncing_ball",
+        ignore=shutil.ignore_patterns("__pycache__"),
+    )
     return tmp_path / "lib" / "bouncing_ball", {**os.environ, "PYTHONPATH": str(tmp_path / "lib")}
 
 
@@ -241,8 +343,21 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
     assert planned_jobs(finished_run, env) == {"merge_shards": 2, "fit": 2, **downstream}
     with open(package / "free_flight.py", "a") as handle:
         handle.write("\n# an edit\n")
-    assert planned_jobs(finished_run, env) == {"simulate_shard": 5, "merge_shards": 2, "fit": 2, **downstream}
-    solved = {"solve": 2, "fit": 2, "solve_grid": 1, "fig4": 1, "fig6": 1, "fig7": 1, "moments_table": 1}
+    assert planned_jobs(finished_run, env) == {
+        "simulate_shard": 5,
+        "merge_shards": 2,
+        "fit": 2,
+        **downstream,
+    }
+    solved = {
+        "solve": 2,
+        "fit": 2,
+        "solve_grid": 1,
+        "fig4": 1,
+        "fig6": 1,
+        "fig7": 1,
+        "moments_table": 1,
+    }
     for module, expected in (
         ("kernel", solved),
         ("solver", solved),
@@ -262,9 +377,20 @@ def test_results_do_not_depend_on_cores(finished_run, tmp_path):
     """The same config with --cores 1 gives bit-identical tables."""
     directory = copy_repository(tmp_path, SMALL)
     result = subprocess.run(
-        [sys.executable, "-m", "snakemake", "--cores", "1", "results/simulation/r0.5/p0v.parquet",
-         "results/simulation/r0.5/summary.parquet", "results/simulation/r0.5/position.parquet"],
-        cwd=directory, capture_output=True, text=True, timeout=600,
+        [
+            sys.executable,
+            "-m",
+            "snakemake",
+            "--cores",
+            "1",
+            "results/simulation/r0.5/p0v.parquet",
+            "results/simulation/r0.5/summary.parquet",
+            "results/simulation/r0.5/position.parquet",
+        ],
+        cwd=directory,
+        capture_output=True,
+        text=True,
+        timeout=600,
     )
     assert result.returncode == 0, result.stderr[-3000:]
     for table in ("p0v", "position", "summary"):
@@ -290,7 +416,10 @@ def _with(path, value):
 
 
 BAD = [
-    (_with(["restitution"], [0.5, 0.0]), "restitution[1]: r = 0.0 is outside the allowed range 0 < r < 1"),
+    (
+        _with(["restitution"], [0.5, 0.0]),
+        "restitution[1]: r = 0.0 is outside the allowed range 0 < r < 1",
+    ),
     (_with(["restitution"], [1.0]), "restitution[0]: r = 1.0 is outside"),
     (_with(["restitution"], ["1/0"]), "restitution[0]: '1/0' divides by zero"),
     (_with(["restitution"], ["half"]), "restitution[0]: 'half' is not a number"),
@@ -304,7 +433,10 @@ BAD = [
     (_with(["simulation", "min_step_floor"], -1.0e-12), "min_step_floor"),
     (_with(["simulation", "min_step_floor"], 1.0e-3), "0.001 is greater than the maximum of 1e-06"),
     (_with(["simulation", "per_restitution"], {"0.5": {"min_step_floor": -1}}), "min_step_floor"),
-    (_with(["simulation", "per_restitution"], {"0.5": {"shard_tme": 5}}), "'shard_tme' was unexpected"),
+    (
+        _with(["simulation", "per_restitution"], {"0.5": {"shard_tme": 5}}),
+        "'shard_tme' was unexpected",
+    ),
     (_with(["simulation", "shard_time"], -1.0), "shard_time"),
     (_with(["simulation", "criterion_c"], 0.0), "criterion_c"),
     (_with(["simulation", "shard_time"], "1e5"), "shard_time"),
@@ -314,19 +446,34 @@ BAD = [
     (_with(["simulation", "per_restitution"], {"2": {"shards": 2}}), "per_restitution.2"),
     (_with(["solver", "quadrature_step"], 0.05), "quadrature_step"),
     (_with(["solver", "quadrature_step"], 0.7), "quadrature_step"),
-    (_with(["solver", "output_speeds", "min"], 0.0), "solver.output_speeds: min = 0.0 must be positive"),
+    (
+        _with(["solver", "output_speeds", "min"], 0.0),
+        "solver.output_speeds: min = 0.0 must be positive",
+    ),
     (_with(["exact", "speeds", "max"], -3), "exact.speeds: min = -2 must be smaller"),
     (_with(["exact", "positions"], [-0.1]), "positions"),
     (_with(["exact", "positions"], [0, 1.0e-5]), "positions"),
     (_with(["solvr"], {}), "'solvr' was unexpected"),
-    (_with(["theory", "restitution_grid", "max"], 1.0), "theory.restitution_grid: need 0 < min < max < 1"),
+    (
+        _with(["theory", "restitution_grid", "max"], 1.0),
+        "theory.restitution_grid: need 0 < min < max < 1",
+    ),
     (_with(["fits", "small_speed_window"], "automatic"), "small_speed_window"),
     (_with(["fits", "max_bias"], 2.0), "max_bias"),
     (_with(["simulation", "shards"], 1), "shards"),
-    (_with(["fits", "large_speed_window"], {"min": 5, "max": 2}), "fits.large_speed_window: min = 5"),
-    (_with(["solver", "restitution_grid", "min"], 0.01), "solver.restitution_grid: need 0.02 <= min"),
+    (
+        _with(["fits", "large_speed_window"], {"min": 5, "max": 2}),
+        "fits.large_speed_window: min = 5",
+    ),
+    (
+        _with(["solver", "restitution_grid", "min"], 0.01),
+        "solver.restitution_grid: need 0.02 <= min",
+    ),
     (_with(["figures", "fig4"], [0.6, "3/5"]), "figures.fig4[1]: r = '3/5' repeats"),
-    (_with(["figures", "fig4"], [0.3333333]), "figures.fig4[0]: r = 3333333/10000000 and r = 1/3 share the label"),
+    (
+        _with(["figures", "fig4"], [0.3333333]),
+        "figures.fig4[0]: r = 3333333/10000000 and r = 1/3 share the label",
+    ),
     (_with(["figures", "fig5"], [0.5, 0.5]), "figures.fig5[1]: r = 0.5 repeats"),
     (_with(["figures", "fig5"], [0.25]), "figures.fig5[0]: r = 0.25 has no exact solution"),
     (_with(["figures", "png_dpi"], 10), "png_dpi"),
@@ -357,11 +504,15 @@ def test_bad_config_is_refused_with_a_message_naming_the_key(config, key):
 
 # one of each kind, end to end: refused by Snakemake before any job runs, nothing written
 END_TO_END = [BAD[i] for i in (0, 4, 5, 8, 16, 19, 20)] + [
-    (config, key) for config, key in BAD if key.startswith(("figures.fig5", "solver.restitution_grid"))
+    (config, key)
+    for config, key in BAD
+    if key.startswith(("figures.fig5", "solver.restitution_grid"))
 ]
 
 
-@pytest.mark.parametrize("config, key", END_TO_END, ids=[key.split(":")[0] for _, key in END_TO_END])
+@pytest.mark.parametrize(
+    "config, key", END_TO_END, ids=[key.split(":")[0] for _, key in END_TO_END]
+)
 def test_bad_config_is_refused_before_any_job_runs(tmp_path, config, key):
     directory = copy_repository(tmp_path, config)
     result = snakemake(directory)
@@ -374,27 +525,41 @@ def test_a_bad_config_leaves_existing_results_untouched(finished_run, tmp_path):
     directory = tmp_path / "copy"
     shutil.copytree(finished_run, directory)
     before = {path: path.stat().st_mtime_ns for path in (directory / "results").rglob("*")}
-    (directory / "config" / "config.yaml").write_text(yaml.safe_dump(_with(["restitution"], [0.5, "1/2"])))
+    (directory / "config" / "config.yaml").write_text(
+        yaml.safe_dump(_with(["restitution"], [0.5, "1/2"]))
+    )
     result = snakemake(directory)
-    assert result.returncode != 0 and "restitution[1]: r = '1/2' repeats" in result.stderr + result.stdout
+    assert (
+        result.returncode != 0
+        and "restitution[1]: r = '1/2' repeats" in result.stderr + result.stdout
+    )
     assert {path: path.stat().st_mtime_ns for path in (directory / "results").rglob("*")} == before
 
 
 def test_lint_is_clean_and_rule_files_are_formatted():
     lint = subprocess.run(
-        [sys.executable, "-m", "snakemake", "--lint"], cwd=REPOSITORY,
-        capture_output=True, text=True, timeout=120,
+        [sys.executable, "-m", "snakemake", "--lint"],
+        cwd=REPOSITORY,
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     assert lint.returncode == 0, lint.stdout + lint.stderr
     rule_files = ["Snakefile", *map(str, (REPOSITORY / "workflow").rglob("*.smk"))]
     formatted = subprocess.run(
-        [sys.executable, "-m", "snakefmt", "--check", *rule_files], cwd=REPOSITORY,
-        capture_output=True, text=True, timeout=120,
+        [sys.executable, "-m", "snakefmt", "--check", *rule_files],
+        cwd=REPOSITORY,
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     assert formatted.returncode == 0, formatted.stderr
     quick = subprocess.run(
         [sys.executable, "-m", "snakemake", "--dry-run", "--configfile", "config/quick.yaml"],
-        cwd=REPOSITORY, capture_output=True, text=True, timeout=120,
+        cwd=REPOSITORY,
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     assert quick.returncode == 0, quick.stderr[-2000:]
 
@@ -407,15 +572,38 @@ def test_scripts_run_by_hand(tmp_path):
     for k in range(2):
         shards.append(tmp_path / f"shard{k}.parquet")
         subprocess.run(
-            [sys.executable, "scripts/simulate_shard.py", "--restitution", "1/3", "--shard", str(k),
-             "--config", str(config), "--shard-time", "200", str(shards[-1])],
-            cwd=REPOSITORY, check=True, capture_output=True, timeout=300,
+            [
+                sys.executable,
+                "scripts/simulate_shard.py",
+                "--restitution",
+                "1/3",
+                "--shard",
+                str(k),
+                "--config",
+                str(config),
+                "--shard-time",
+                "200",
+                str(shards[-1]),
+            ],
+            cwd=REPOSITORY,
+            check=True,
+            capture_output=True,
+            timeout=300,
         )
     outputs = {name: tmp_path / f"{name}.parquet" for name in ("p0v", "position", "summary")}
     subprocess.run(
-        [sys.executable, "scripts/merge_shards.py", "--restitution", "1/3",
-         *[f"--{name}={path}" for name, path in outputs.items()], *map(str, shards)],
-        cwd=REPOSITORY, check=True, capture_output=True, timeout=300,
+        [
+            sys.executable,
+            "scripts/merge_shards.py",
+            "--restitution",
+            "1/3",
+            *[f"--{name}={path}" for name, path in outputs.items()],
+            *map(str, shards),
+        ],
+        cwd=REPOSITORY,
+        check=True,
+        capture_output=True,
+        timeout=300,
     )
     summary, provenance = read_table(outputs["summary"])
     assert provenance["r"] == "1/3" and summary.shards.iloc[0] == 2
@@ -423,21 +611,53 @@ def test_scripts_run_by_hand(tmp_path):
     # a shard of another r is refused by name
     wrong = tmp_path / "other.parquet"
     subprocess.run(
-        [sys.executable, "scripts/simulate_shard.py", "--restitution", "0.5", "--shard", "0",
-         "--config", str(config), "--shard-time", "200", str(wrong)],
-        cwd=REPOSITORY, check=True, capture_output=True, timeout=300,
+        [
+            sys.executable,
+            "scripts/simulate_shard.py",
+            "--restitution",
+            "0.5",
+            "--shard",
+            "0",
+            "--config",
+            str(config),
+            "--shard-time",
+            "200",
+            str(wrong),
+        ],
+        cwd=REPOSITORY,
+        check=True,
+        capture_output=True,
+        timeout=300,
     )
     refused = subprocess.run(
-        [sys.executable, "scripts/merge_shards.py", "--restitution", "1/3",
-         *[f"--{name}={path}" for name, path in outputs.items()], str(shards[0]), str(wrong)],
-        cwd=REPOSITORY, capture_output=True, text=True, timeout=300,
+        [
+            sys.executable,
+            "scripts/merge_shards.py",
+            "--restitution",
+            "1/3",
+            *[f"--{name}={path}" for name, path in outputs.items()],
+            str(shards[0]),
+            str(wrong),
+        ],
+        cwd=REPOSITORY,
+        capture_output=True,
+        text=True,
+        timeout=300,
     )
     assert refused.returncode != 0 and "other.parquet" in refused.stderr
     solved = {name: tmp_path / f"solver_{name}.parquet" for name in ("p0v", "summary")}
     subprocess.run(
-        [sys.executable, "scripts/solve.py", "--restitution", "0.6",
-         *[f"--{name}={path}" for name, path in solved.items()]],
-        cwd=REPOSITORY, check=True, capture_output=True, timeout=300,
+        [
+            sys.executable,
+            "scripts/solve.py",
+            "--restitution",
+            "0.6",
+            *[f"--{name}={path}" for name, path in solved.items()],
+        ],
+        cwd=REPOSITORY,
+        check=True,
+        capture_output=True,
+        timeout=300,
     )
     summary, provenance = read_table(solved["summary"])
     assert provenance["r"] == "3/5" and abs(summary.energy_balance_residual.iloc[0]) < 1e-8
@@ -450,18 +670,53 @@ def test_figure_and_table_scripts_run_by_hand(tmp_path):
     exponents = tmp_path / "exponents.parquet"
     for command in (
         ["scripts/theory.py", str(exponents), "--config", str(config)],
-        ["scripts/figures/fig1.py", str(exponents), "--pdf", str(tmp_path / "fig1.pdf"),
-         "--png", str(tmp_path / "fig1.png"), "--dpi", "50"],
-        ["scripts/solve.py", "--restitution", "1/2", "--p0v", str(tmp_path / "p0v.parquet"),
-         "--summary", str(tmp_path / "solved.parquet"), "--config", str(config)],
+        [
+            "scripts/figures/fig1.py",
+            str(exponents),
+            "--pdf",
+            str(tmp_path / "fig1.pdf"),
+            "--png",
+            str(tmp_path / "fig1.png"),
+            "--dpi",
+            "50",
+        ],
+        [
+            "scripts/solve.py",
+            "--restitution",
+            "1/2",
+            "--p0v",
+            str(tmp_path / "p0v.parquet"),
+            "--summary",
+            str(tmp_path / "solved.parquet"),
+            "--config",
+            str(config),
+        ],
     ):
-        subprocess.run([sys.executable, *command], cwd=REPOSITORY, check=True, capture_output=True, timeout=300)
+        subprocess.run(
+            [sys.executable, *command], cwd=REPOSITORY, check=True, capture_output=True, timeout=300
+        )
     assert (tmp_path / "fig1.pdf").read_bytes().startswith(b"%PDF")
     # the solver's summary stands in for a simulation's: it has no errors, so it is refused by name
     result = subprocess.run(
-        [sys.executable, "scripts/moments_table.py", "--simulation", str(tmp_path / "solved.parquet"),
-         "--solver", str(tmp_path / "solved.parquet"), "--csv", str(tmp_path / "m.csv"), "--md", str(tmp_path / "m.md")],
-        cwd=REPOSITORY, capture_output=True, text=True, timeout=300,
+        [
+            sys.executable,
+            "scripts/moments_table.py",
+            "--simulation",
+            str(tmp_path / "solved.parquet"),
+            "--solver",
+            str(tmp_path / "solved.parquet"),
+            "--csv",
+            str(tmp_path / "m.csv"),
+            "--md",
+            str(tmp_path / "m.md"),
+        ],
+        cwd=REPOSITORY,
+        capture_output=True,
+        text=True,
+        timeout=300,
     )
     assert result.returncode != 0 and not (tmp_path / "m.csv").exists()
-    assert f"{tmp_path / 'solved.parquet'}: not the expected table, it lacks the columns mean_x_err" in result.stderr
+    assert (
+        f"{tmp_path / 'solved.parquet'}: not the expected table, it lacks the columns mean_x_err"
+        in result.stderr
+    )

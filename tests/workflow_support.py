@@ -33,10 +33,16 @@ SMALL = {
         "position_grid": {"min": 1.0e-3, "max": 100, "points": 6},
     },
     "theory": {"restitution_grid": {"min": 0.1, "max": 0.9, "points": 9}},
-    "fits": {"minimum_count": 5, "max_bias": 0.5, "small_speed_window": "auto", "large_speed_window": "auto"},
+    "fits": {
+        "minimum_count": 5,
+        "max_bias": 0.5,
+        "small_speed_window": "auto",
+        "large_speed_window": "auto",
+    },
     "figures": {"fig4": [0.5], "fig5": ["1/3", "1/2"], "png_dpi": 60},
 }
 FIGURES = [f"results/figures/fig{n}.{ext}" for n in range(1, 8) for ext in ("pdf", "png")]
+
 
 def copy_repository(tmp_path, config):
     for name in ("Snakefile", "workflow", "scripts", "config", "profiles"):
@@ -52,21 +58,38 @@ def copy_repository(tmp_path, config):
 def snakemake(directory, *arguments):
     return subprocess.run(
         [sys.executable, "-m", "snakemake", "--cores", "2", *arguments],
-        cwd=directory, capture_output=True, text=True, timeout=600,
+        cwd=directory,
+        capture_output=True,
+        text=True,
+        timeout=600,
     )
 
 
 def planned_jobs(directory, env=None, *targets):
     """{rule: count} of the jobs a dry run would execute (empty if nothing to do)."""
     result = subprocess.run(
-        [sys.executable, "-m", "snakemake", "--cores", "2", "--dry-run", *targets, "--quiet", "rules"],
-        cwd=directory, capture_output=True, text=True, timeout=300, env=env,
+        [
+            sys.executable,
+            "-m",
+            "snakemake",
+            "--cores",
+            "2",
+            "--dry-run",
+            *targets,
+            "--quiet",
+            "rules",
+        ],
+        cwd=directory,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
     )
     assert result.returncode == 0, result.stderr[-3000:]
     jobs = {}
     lines = (result.stdout + result.stderr).splitlines()
     if "Job stats:" in lines:
-        for line in lines[lines.index("Job stats:") + 3:]:
+        for line in lines[lines.index("Job stats:") + 3 :]:
             parts = line.split()
             if len(parts) != 2 or parts[0] == "total":
                 break

@@ -22,7 +22,9 @@ if "snakemake" in globals():
     logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, format="%(message)s")  # noqa: F821
     main(snakemake.input[0], *snakemake.output, snakemake.params.dpi)  # noqa: F821
 elif __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("exponents", help="results/theory/exponents.parquet")
     args = plotting.figure_arguments(parser).parse_args()
     logging.basicConfig(level=logging.INFO, format="%(message)s")

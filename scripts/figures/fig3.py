@@ -20,15 +20,21 @@ def main(distribution_paths, pdf, png, dpi):
         distribution, provenance = read_table(path)
         panels.append((parse_restitution(provenance["r"]), distribution))
     figure = plotting.exact_distribution_figure(panels)
-    plotting.save_figure(figure, pdf, png, dpi, {"figure": "fig3", "inputs": list(map(str, distribution_paths))})
+    plotting.save_figure(
+        figure, pdf, png, dpi, {"figure": "fig3", "inputs": list(map(str, distribution_paths))}
+    )
 
 
 if "snakemake" in globals():
     logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, format="%(message)s")  # noqa: F821
     main(list(snakemake.input), *snakemake.output, snakemake.params.dpi)  # noqa: F821
 elif __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("distributions", nargs="+", help="results/exact/r{r}/distribution.parquet, one per panel")
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument(
+        "distributions", nargs="+", help="results/exact/r{r}/distribution.parquet, one per panel"
+    )
     args = plotting.figure_arguments(parser).parse_args()
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     main(args.distributions, args.pdf, args.png, args.dpi)

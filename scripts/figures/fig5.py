@@ -20,20 +20,37 @@ def main(simulation_paths, exact_paths, pdf, png, dpi):
         simulated, provenance = read_table(simulation)
         solution, exact_provenance = read_table(exact)
         if parse_restitution(exact_provenance["r"]) != parse_restitution(provenance["r"]):
-            raise ValueError(f"{simulation} (r = {provenance['r']}) and {exact} "
-                             f"(r = {exact_provenance['r']}) are not the same r")
-        panels.append({"restitution": parse_restitution(provenance["r"]), "simulated": simulated, "exact": solution})
+            raise ValueError(
+                f"{simulation} (r = {provenance['r']}) and {exact} "
+                f"(r = {exact_provenance['r']}) are not the same r"
+            )
+        panels.append(
+            {
+                "restitution": parse_restitution(provenance["r"]),
+                "simulated": simulated,
+                "exact": solution,
+            }
+        )
     figure = plotting.exact_comparison_figure(panels)
-    plotting.save_figure(figure, pdf, png, dpi,
-                         {"figure": "fig5", "inputs": [*map(str, simulation_paths), *map(str, exact_paths)]})
+    plotting.save_figure(
+        figure,
+        pdf,
+        png,
+        dpi,
+        {"figure": "fig5", "inputs": [*map(str, simulation_paths), *map(str, exact_paths)]},
+    )
 
 
 if "snakemake" in globals():
     logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, format="%(message)s")  # noqa: F821
     main(snakemake.input.simulation, snakemake.input.exact, *snakemake.output, snakemake.params.dpi)  # noqa: F821
 elif __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--simulation", nargs="+", required=True, help="results/simulation/r{r}/p0v.parquet")
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument(
+        "--simulation", nargs="+", required=True, help="results/simulation/r{r}/p0v.parquet"
+    )
     parser.add_argument("--exact", nargs="+", required=True, help="results/exact/r{r}/p0v.parquet")
     args = plotting.figure_arguments(parser).parse_args()
     logging.basicConfig(level=logging.INFO, format="%(message)s")

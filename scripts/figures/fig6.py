@@ -25,20 +25,30 @@ def _rows(paths):
 
 def main(grid_path, simulation_paths, exact_paths, pdf, png, dpi):
     solved, _ = read_table(grid_path)
-    figure = plotting.time_averages_figure(solved, _rows(simulation_paths), _rows(exact_paths),
-                                           CRITICAL_RESTITUTION)
+    figure = plotting.time_averages_figure(
+        solved, _rows(simulation_paths), _rows(exact_paths), CRITICAL_RESTITUTION
+    )
     inputs = [str(grid_path), *map(str, simulation_paths), *map(str, exact_paths)]
     plotting.save_figure(figure, pdf, png, dpi, {"figure": "fig6", "inputs": inputs})
 
 
 if "snakemake" in globals():
     logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, format="%(message)s")  # noqa: F821
-    main(snakemake.input.grid, snakemake.input.simulation, snakemake.input.exact,  # noqa: F821
-         *snakemake.output, snakemake.params.dpi)  # noqa: F821
+    main(
+        snakemake.input.grid,
+        snakemake.input.simulation,
+        snakemake.input.exact,  # noqa: F821
+        *snakemake.output,
+        snakemake.params.dpi,
+    )  # noqa: F821
 elif __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("grid", help="results/solver/time_averages.parquet")
-    parser.add_argument("--simulation", nargs="*", default=[], help="results/simulation/r{r}/summary.parquet")
+    parser.add_argument(
+        "--simulation", nargs="*", default=[], help="results/simulation/r{r}/summary.parquet"
+    )
     parser.add_argument("--exact", nargs="*", default=[], help="results/exact/r{r}/summary.parquet")
     args = plotting.figure_arguments(parser).parse_args()
     logging.basicConfig(level=logging.INFO, format="%(message)s")

@@ -21,20 +21,38 @@ def main(simulation_paths, solver_paths, pdf, png, dpi):
         simulated, provenance = read_table(simulation)
         residuals = outgoing_speed_residuals(simulated, read_table(solver)[0])
         panels.append((parse_restitution(provenance["r"]), residuals))
-        logging.info("r=%s: %d bins, mean squared residual %.3f, largest |residual| %.2f", provenance["r_label"],
-                     len(residuals), (residuals.residual**2).mean(), residuals.residual.abs().max())
+        logging.info(
+            "r=%s: %d bins, mean squared residual %.3f, largest |residual| %.2f",
+            provenance["r_label"],
+            len(residuals),
+            (residuals.residual**2).mean(),
+            residuals.residual.abs().max(),
+        )
     figure = plotting.residuals_figure(panels)
-    plotting.save_figure(figure, pdf, png, dpi,
-                         {"figure": "fig7", "inputs": [*map(str, simulation_paths), *map(str, solver_paths)]})
+    plotting.save_figure(
+        figure,
+        pdf,
+        png,
+        dpi,
+        {"figure": "fig7", "inputs": [*map(str, simulation_paths), *map(str, solver_paths)]},
+    )
 
 
 if "snakemake" in globals():
     logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, format="%(message)s")  # noqa: F821
-    main(snakemake.input.simulation, snakemake.input.solver, *snakemake.output, snakemake.params.dpi)  # noqa: F821
+    main(
+        snakemake.input.simulation, snakemake.input.solver, *snakemake.output, snakemake.params.dpi
+    )  # noqa: F821
 elif __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--simulation", nargs="+", required=True, help="results/simulation/r{r}/p0v.parquet")
-    parser.add_argument("--solver", nargs="+", required=True, help="results/solver/r{r}/p0v.parquet")
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument(
+        "--simulation", nargs="+", required=True, help="results/simulation/r{r}/p0v.parquet"
+    )
+    parser.add_argument(
+        "--solver", nargs="+", required=True, help="results/solver/r{r}/p0v.parquet"
+    )
     args = plotting.figure_arguments(parser).parse_args()
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     main(args.simulation, args.solver, args.pdf, args.png, args.dpi)
