@@ -19,27 +19,9 @@ wildcard_constraints:
     shard=r"[0-9]+",
 
 
-# run by Snakemake itself, never submitted to a cluster (profiles/slurm): the stage
-# targets, and jobs of a few seconds whose queue wait would exceed their run time
-localrules:
-    all,
-    simulation,
-    solver,
-    exact,
-    fits,
-    figures,
-    tables,
-    theory,
-    solve,
-    solve_grid,
-    moments_table,
-    fig1,
-    fig2,
-    fig3,
-    fig4,
-    fig5,
-    fig6,
-    fig7,
+# rules with `localrule: True` (the stage targets below, and jobs of a few seconds whose
+# queue wait would exceed their run time) run in Snakemake's own process, never submitted
+# to a cluster (profiles/slurm)
 
 
 include: "workflow/rules/common.smk"
@@ -62,12 +44,14 @@ rule all:
         "results/solver/time_averages.parquet",
         figure_targets(),
         table_targets(),
+    localrule: True
 
 
 # stage target: every simulated r, merged
 rule simulation:
     input:
         simulation_targets(),
+    localrule: True
 
 
 # stage target: the solver at every r of the config
@@ -75,12 +59,14 @@ rule solver:
     input:
         solver_targets(),
         "results/solver/time_averages.parquet",
+    localrule: True
 
 
 # stage target: the exact solutions at r = 1/2 and 1/3
 rule exact:
     input:
         exact_targets(),
+    localrule: True
 
 
 # stage target: the theory's exponents and the fits at every r of the config
@@ -88,15 +74,18 @@ rule fits:
     input:
         "results/theory/exponents.parquet",
         fit_targets(),
+    localrule: True
 
 
 # stage target: Figs. 1-7, PDF and PNG
 rule figures:
     input:
         figure_targets(),
+    localrule: True
 
 
 # stage target: the moments table, CSV and Markdown
 rule tables:
     input:
         table_targets(),
+    localrule: True

@@ -54,3 +54,19 @@ def log_grid(spec: dict):
 
 def linear_grid(spec: dict):
     return np.linspace(float(spec["min"]), float(spec["max"]), int(spec["points"]))
+
+
+_GAUSS_NODES, _GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(8)
+
+
+def outgoing_speed_bin_average(density, lower, upper):
+    """int_lo^hi v P(0, v) dv / int_lo^hi v dv for each bin [lo, hi): what a bin of
+    outgoing speeds measures (eq. (collrate): collisions with v_out in the bin come at the
+    rate int v P(0, v) dv).  ``density`` is P(0, v) as a function of an array of v;
+    8-point Gauss-Legendre in ln v on each bin."""
+    lower = np.asarray(lower, dtype=float)[:, None]
+    upper = np.asarray(upper, dtype=float)[:, None]
+    half = 0.5 * np.log(upper / lower)
+    v = np.exp(half * _GAUSS_NODES[None, :] + 0.5 * np.log(upper * lower))
+    flux = half[:, 0] * ((v * v * density(v)) @ _GAUSS_WEIGHTS)
+    return flux / (0.5 * (upper[:, 0] ** 2 - lower[:, 0] ** 2))

@@ -12,6 +12,7 @@ from fractions import Fraction
 import yaml
 
 from .restitution import EXACT_RESTITUTIONS, parse_restitution, restitution_grid, restitution_label
+from .settings import ShardSettings
 
 
 def read_config(path) -> dict:
@@ -116,19 +117,6 @@ def known_restitutions(config: dict) -> dict[str, Fraction]:
     return {**figure_restitutions(config, grid), **grid}
 
 
-# the keys of config["simulation"] that change the numbers a shard produces
-SHARD_SETTINGS = (
-    "shard_time",
-    "equilibration_time",
-    "criterion_c",
-    "min_step_divisor",
-    "min_step_floor",
-    "max_steps",
-    "speed_bins",
-    "position_bins",
-)
-
-
 def simulation_settings(config: dict, label: str) -> dict:
     """The simulation parameters of one r: the defaults with its overrides applied."""
     simulation = config["simulation"]
@@ -140,14 +128,9 @@ def simulation_settings(config: dict, label: str) -> dict:
     return settings
 
 
-def shard_settings(config: dict, label: str) -> dict:
-    """What a shard of r = ``label`` is run with: only what changes its result.
-
-    The number of shards is not among them, so adding shards leaves the
-    existing ones alone.
-    """
-    settings = simulation_settings(config, label)
-    return {key: settings[key] for key in SHARD_SETTINGS}
+def shard_settings(config: dict, label: str) -> ShardSettings:
+    """What a shard of r = ``label`` is run with: only what changes its result."""
+    return ShardSettings.from_mapping(simulation_settings(config, label))
 
 
 def shard_count(config: dict, label: str) -> int:

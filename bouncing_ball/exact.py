@@ -9,6 +9,7 @@ that a test can compare them with the paper's closed forms.
 from fractions import Fraction
 
 import numpy as np
+import pandas as pd
 from scipy import integrate, special
 
 from .restitution import EXACT_RESTITUTIONS  # noqa: F401 (re-exported: exact.EXACT_RESTITUTIONS)
@@ -141,10 +142,8 @@ def position_moments(restitution) -> dict:
     norm, first, second = moments
     mean_x = first / norm
     a = normalization_constant(restitution)
-    if _which(restitution) == Fraction(1, 2):
-        rate = a  # int_0^inf v * v^-1 e^-v dv
-    else:
-        rate = a * special.gamma(0.5) / np.sqrt(1.5)
+    # r = 1/2: int_0^inf v * v^-1 e^-v dv
+    rate = a if _which(restitution) == Fraction(1, 2) else a * special.gamma(0.5) / np.sqrt(1.5)
     return {
         "normalization": norm,
         "mean_x": mean_x,
@@ -239,3 +238,13 @@ def mean_speed_squared_given_position(x, restitution):
         return integrate.quad(_position_density_third, xi, np.inf, epsrel=1e-11, limit=400)[0]
 
     return np.vectorize(tail)(x) / position_density(x, restitution)
+
+
+def distribution_table(positions, speeds, restitution):
+    """P(x, v) for every x in ``positions`` and v in ``speeds`` (long format: x, v, pxv), and
+    the largest relative error quad estimates for it."""
+    x, v = np.meshgrid(np.asarray(positions, dtype=float), speeds, indexing="ij")
+    pxv, error = distribution_with_error(x, v, restitution)
+    finite = np.isfinite(pxv) & (pxv > 0.0)
+    worst = float(np.max(error[finite] / pxv[finite])) if finite.any() else 0.0
+    return pd.DataFrame({"x": x.ravel(), "v": v.ravel(), "pxv": pxv.ravel()}), worst

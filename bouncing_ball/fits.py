@@ -42,6 +42,7 @@ from scipy.interpolate import CubicSpline
 
 from . import stages
 from .asymptotics import large_speed_decay_rate, large_speed_exponent, small_speed_exponent
+from .bins import outgoing_speed_bin_average
 from .histograms import outgoing_speed_density
 
 # the modules whose code decides a fit table (see ``source_digest``)
@@ -50,8 +51,6 @@ SOURCES = stages.FITS
 SMALL_SPEED = "small_speed"
 LARGE_SPEED = "large_speed"
 INTERVAL_95 = 1.959963984540054  # scipy.stats.norm.ppf(0.975)
-
-_NODES, _WEIGHTS = np.polynomial.legendre.leggauss(8)
 
 
 class WindowError(ValueError):
@@ -80,13 +79,8 @@ def theory_exponents(side, restitution):
 
 
 def bin_average(form, lower, upper, *parameters):
-    """int_lo^hi v f(v) dv / int_lo^hi v dv for each bin (Gauss-Legendre in ln v)."""
-    lower = np.asarray(lower, dtype=float)[:, None]
-    upper = np.asarray(upper, dtype=float)[:, None]
-    half = 0.5 * np.log(upper / lower)
-    v = np.exp(half * _NODES[None, :] + 0.5 * np.log(upper * lower))
-    flux = half[:, 0] * ((v * v * form(v, *parameters)) @ _WEIGHTS)
-    return flux / (0.5 * (upper[:, 0] ** 2 - lower[:, 0] ** 2))
+    """The bin averages (``bins.outgoing_speed_bin_average``) of ``form(v, *parameters)``."""
+    return outgoing_speed_bin_average(lambda v: form(v, *parameters), lower, upper)
 
 
 @dataclass(frozen=True)
@@ -375,7 +369,7 @@ def bin_averages_of_curve(speeds, density, lower, upper):
     spline = CubicSpline(np.log(speeds), np.log(density))
     if lower.min() < speeds[0] or upper.max() > speeds[-1]:
         raise ValueError(f"bins reach beyond the curve's speeds [{speeds[0]}, {speeds[-1]}]")
-    return bin_average(lambda v: np.exp(spline(np.log(v))), lower, upper)
+    return outgoing_speed_bin_average(lambda v: np.exp(spline(np.log(v))), lower, upper)
 
 
 def fit_errors(errors, reference, expected):
@@ -401,3 +395,31 @@ def expected_collisions(reference, lower, upper, total_time):
     return (
         np.asarray(reference) * total_time * 0.5 * (np.asarray(upper) ** 2 - np.asarray(lower) ** 2)
     )
+
+
+@dataclass(frozen=True)
+class FitBins:
+    """The P(0, v) bins a fit uses, chosen by the collisions they should hold."""
+
+    rows: np.ndarray  # indices into the merged p0v table (and a shard's speed counts)
+    lower: np.ndarray
+    upper: np.ndarray
+    reference: np.ndarray  # the reference curve's bin averages
+    expected: np.ndarray  # collisions a run of the total time should put in each
+    beyond: int  # populated bins above the curve's last speed, left out
+
+
+def select_fit_bins(table, speeds, density, total_time, minimum_count) -> FitBins:
+    """The finite bins of a merged p0v ``table`` inside the reference curve's speeds (``speeds``,
+    ``density``: the solver's P(0, v), see ``usable_curve``) that should hold at least
+    ``minimum_count`` collisions in ``total_time``.  Chosen by the collisions a bin should hold,
+    not by those it happens to hold, so the choice does not select on the data."""
+    v_lo, v_hi = table.v_lo.to_numpy(), table.v_hi.to_numpy()
+    finite = np.isfinite(v_hi)
+    inside = finite & (v_lo >= speeds[0]) & (v_hi <= speeds[-1])
+    beyond = int(np.sum(finite & (v_hi > speeds[-1]) & (table["count"].to_numpy() > 0)))
+    reference = bin_averages_of_curve(speeds, density, v_lo[inside], v_hi[inside])
+    expected = expected_collisions(reference, v_lo[inside], v_hi[inside], total_time)
+    keep = expected >= minimum_count
+    rows = np.flatnonzero(inside)[keep]
+    return FitBins(rows, v_lo[rows], v_hi[rows], reference[keep], expected[keep], beyond)

@@ -88,3 +88,16 @@ def require_columns(frame: pd.DataFrame, path, columns) -> pd.DataFrame:
             f"{path}: not the expected table, it lacks the columns {', '.join(missing)}"
         )
     return frame
+
+
+def read_tables_of_one_restitution(*paths) -> list[tuple[pd.DataFrame, dict]]:
+    """``read_table`` of each path, refused unless all were made for the same r
+    (e.g. the simulation, solver and fits that one figure panel compares)."""
+    tables = [read_table(path) for path in paths]
+    values = [provenance.get("r") for _, provenance in tables]
+    if len(set(values)) > 1:
+        which = ", ".join(
+            f"{path} (r = {value})" for path, value in zip(paths, values, strict=True)
+        )
+        raise UnreadableFileError(f"not the same r: {which}")
+    return tables

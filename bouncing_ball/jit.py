@@ -1,19 +1,21 @@
-"""numba for the compiled modules, its cache kept in a folder named after the package's source.
+"""numba for the compiled modules, its cache kept in a folder named after their source.
 
 ``cache=True`` checks only the file that holds a compiled function, not the
 files it calls into: after an edit of free_flight.py a cached simulation loop
-would silently keep the old code.  So the cache folder is keyed on the whole
-package's source, inside numba's own cache folder or, where the user set
+would silently keep the old code.  So the cache folder is keyed on the source
+of every module numba compiles (``stages.COMPILED``: an edit of plotting.py
+does not recompile), inside numba's own cache folder or, where the user set
 NUMBA_CACHE_DIR, inside that one.  Only the compiled
 modules import this, so importing the package (as the workflow does to plan a
 run) does not load numba.
 
-Every edit of the library makes a new folder; the old ones are pruned here,
+Every edit of compiled code makes a new folder; the old ones are pruned here,
 keeping the ``KEEP_CACHES`` most recently used besides the current one (so
 switching between two versions does not recompile) and never one used in the
 last ``PRUNE_AFTER_SECONDS`` (a job of another version may still be running).
 """
 
+import contextlib
 import functools
 import os
 import shutil
@@ -22,7 +24,7 @@ from pathlib import Path
 
 import numba
 
-from . import PACKAGE, source_digest
+from . import PACKAGE, source_digest, stages
 
 KEEP_CACHES = 3
 PRUNE_AFTER_SECONDS = 3600.0
@@ -55,12 +57,10 @@ def prune_caches(
 
 
 _base = Path(numba.config.CACHE_DIR) if numba.config.CACHE_DIR else PACKAGE / "__pycache__"
-CACHE = _base / f"numba-{source_digest()}"
+CACHE = _base / f"numba-{source_digest(stages.COMPILED)}"
 numba.config.CACHE_DIR = str(CACHE)
-try:
+with contextlib.suppress(OSError):  # not there yet, or not ours to touch (a read-only cache)
     os.utime(CACHE)  # in use: the newest to keep
-except OSError:
-    pass  # not there yet, or not ours to touch (a shared or read-only cache)
 prune_caches(_base, CACHE)
 
 # IEEE division (inf or NaN) instead of a Python ZeroDivisionError check on every division:

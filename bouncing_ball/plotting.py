@@ -407,11 +407,3 @@ def residuals_figure(panels):
         axis.set_ylabel(r"$\Delta P / \sigma$")
     axes[-1, 0].set_xlabel(r"$v$")
     return figure
-
-
-def figure_arguments(parser):
-    """The output options every figure script takes when run by hand."""
-    parser.add_argument("--pdf", required=True, help="the figure as PDF")
-    parser.add_argument("--png", required=True, help="the figure as PNG")
-    parser.add_argument("--dpi", type=int, default=200, help="PNG resolution")
-    return parser

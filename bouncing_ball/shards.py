@@ -2,9 +2,9 @@
 
 from .asymptotics import CRITICAL_RESTITUTION
 from .bins import log_bins
-from .config import SHARD_SETTINGS
 from .io import UnreadableFileError, read_table
 from .restitution import parse_restitution
+from .settings import ShardSettings
 from .tallies import tallies_from_frame
 
 
@@ -25,7 +25,7 @@ def read_shards(paths, label):
             raise UnreadableFileError(f"{path}: the same shard as {repeated[0]}")
         if provenances and any(
             provenance.get(key) != provenances[0].get(key)
-            for key in ("seed", "code", *SHARD_SETTINGS)
+            for key in ("seed", "code", *ShardSettings.names())
         ):
             raise UnreadableFileError(
                 f"{path}: made with other settings than {paths[0]}; rerun the stale shards"

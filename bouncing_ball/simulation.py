@@ -54,7 +54,6 @@ import math
 import numpy as np
 
 from . import stages
-from .bins import LogBins
 from .free_flight import (
     cubic_level_time,
     cubic_slope,
@@ -70,6 +69,7 @@ from .free_flight import (
     speed_squared_coefficients,
 )
 from .jit import njit
+from .settings import ShardSettings
 from .tallies import ShardTallies
 
 # the modules whose code decides a shard's numbers (see ``source_digest``)
@@ -312,24 +312,16 @@ def _run(
 
 
 def simulate_shard(
-    restitution: float,
-    seed_sequence: np.random.SeedSequence,
-    recorded_time: float,
-    equilibration_time: float,
-    criterion_c: float,
-    min_step_divisor: float,
-    max_steps: int,
-    speed_bins: LogBins,
-    position_bins: LogBins,
-    min_step_floor: float = 0.0,
+    restitution: float, seed_sequence: np.random.SeedSequence, settings: ShardSettings
 ) -> ShardTallies:
-    """Run one shard and return its tallies (pure: no I/O).
+    """Run one shard of r = ``restitution`` and return its tallies (pure: no I/O).
 
-    ``min_step_floor`` is a lower bound on delta (0: the paper's rule alone).
-    Below r_c it is what keeps the simulation going: see the module docstring.
+    ``settings.min_step_floor`` is a lower bound on delta (0: the paper's rule
+    alone); below r_c it is what keeps the simulation going (module docstring).
     """
     if not 0.0 < restitution < 1.0:
         raise ValueError(f"restitution must lie in (0, 1), got {restitution}")
+    speed_bins, position_bins = settings.speed_bins, settings.position_bins
     rng = np.random.Generator(np.random.PCG64(seed_sequence))
     speed_counts, position_time, position_v2_time, scalars = ShardTallies.loop_arrays(
         speed_bins, position_bins
@@ -337,12 +329,12 @@ def simulate_shard(
     _run(
         rng,
         float(restitution),
-        float(criterion_c),
-        float(min_step_divisor),
-        float(min_step_floor),
-        float(equilibration_time),
-        float(recorded_time),
-        int(max_steps),
+        settings.criterion_c,
+        settings.min_step_divisor,
+        settings.min_step_floor,
+        settings.equilibration_time,
+        settings.shard_time,
+        settings.max_steps,
         speed_bins.edges,
         position_bins.edges,
         speed_counts,

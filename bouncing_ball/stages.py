@@ -8,11 +8,25 @@ importing numba, scipy or matplotlib.
 
 # "bins" also builds the config's grids; "restitution" parses r and makes the labels
 # that key the random streams; "jit" is how the compiled modules are compiled
-SIMULATION = ("bins", "free_flight", "jit", "restitution", "simulation", "tallies")
-MERGE = ("bins", "histograms", "io", "restitution", "shards", "tallies")
+SIMULATION = ("bins", "free_flight", "jit", "restitution", "settings", "simulation", "tallies")
+MERGE = ("bins", "histograms", "io", "restitution", "settings", "shards", "tallies")
 SOLVER = ("asymptotics", "bins", "jit", "kernel", "solver")
 EXACT = ("bins", "exact")
 THEORY = ("asymptotics", "bins")
-FITS = ("asymptotics", "bins", "fits", "histograms", "io", "restitution", "shards", "tallies")
+FITS = (
+    "asymptotics",
+    "bins",
+    "fits",
+    "histograms",
+    "io",
+    "restitution",
+    "settings",
+    "shards",
+    "tallies",
+)
 PLOTTING = ("io", "plotting", "restitution")
 COMPARISON = ("comparison", "fits", "io")
+
+# what numba compiles: the modules with compiled functions and what those call into (the
+# key of numba's cache folder, bouncing_ball.jit); an edit elsewhere does not recompile
+COMPILED = ("free_flight", "jit", "kernel", "simulation")

@@ -8,39 +8,9 @@ from pathlib import Path
 import yaml
 
 REPOSITORY = Path(__file__).resolve().parents[1]
-SMALL = {
-    "restitution": [0.5, "1/3"],
-    "seed": 5,
-    "simulation": {
-        "shards": 3,
-        "shard_time": 2.0e3,
-        "equilibration_time": 50.0,
-        "criterion_c": 3.0,
-        "min_step_divisor": 500,
-        "max_steps": 1.0e9,
-        "speed_bins": {"lo": 1.0e-4, "hi": 1.0e2, "per_decade": 10},
-        "position_bins": {"lo": 1.0e-3, "hi": 1.0e3, "per_decade": 5},
-        "per_restitution": {"1/3": {"shards": 2}},
-    },
-    "solver": {
-        "quadrature_step": 0.25,
-        "output_speeds": {"min": 1.0e-4, "max": 50, "points": 41},
-        "restitution_grid": {"min": 0.1, "max": 0.9, "points": 5},
-    },
-    "exact": {
-        "positions": [0, 0.1],
-        "speeds": {"min": -2, "max": 3, "points": 6},
-        "position_grid": {"min": 1.0e-3, "max": 100, "points": 6},
-    },
-    "theory": {"restitution_grid": {"min": 0.1, "max": 0.9, "points": 9}},
-    "fits": {
-        "minimum_count": 5,
-        "max_bias": 0.5,
-        "small_speed_window": "auto",
-        "large_speed_window": "auto",
-    },
-    "figures": {"fig4": [0.5], "fig5": ["1/3", "1/2"], "png_dpi": 60},
-}
+# the small config shared by the workflow tests, CI and the SLURM stage
+TEST_CONFIG = REPOSITORY / ".test" / "config" / "config.yaml"
+SMALL = yaml.safe_load(TEST_CONFIG.read_text())
 FIGURES = [f"results/figures/fig{n}.{ext}" for n in range(1, 8) for ext in ("pdf", "png")]
 
 

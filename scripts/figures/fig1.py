@@ -1,31 +1,16 @@
-"""Fig. 1: the exponents beta(r), eq. (asym2), and m(r), eqs. (asym3)-(asym6).
-
-Run by Snakemake (rule fig1), or by hand:
-    python scripts/figures/fig1.py results/theory/exponents.parquet --pdf fig1.pdf --png fig1.png
-"""
-
-import argparse
-import logging
+"""Rule fig1: the exponents beta(r), eq. (asym2), and m(r), eqs. (asym3)-(asym6)."""
 
 from bouncing_ball import plotting
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION
 from bouncing_ball.io import read_table
+from bouncing_ball.jobs import job_log
 
-
-def main(exponents_path, pdf, png, dpi):
-    exponents, _ = read_table(exponents_path)
+with job_log(snakemake.log[0]):
+    exponents, _ = read_table(snakemake.input.exponents)
     figure = plotting.exponents_figure(exponents, CRITICAL_RESTITUTION)
-    plotting.save_figure(figure, pdf, png, dpi, {"figure": "fig1", "inputs": [str(exponents_path)]})
-
-
-if "snakemake" in globals():
-    logging.basicConfig(filename=snakemake.log[0], level=logging.INFO, format="%(message)s")  # noqa: F821
-    main(snakemake.input[0], *snakemake.output, snakemake.params.dpi)  # noqa: F821
-elif __name__ == "__main__":
-    parser = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    plotting.save_figure(
+        figure,
+        *snakemake.output,
+        snakemake.params.dpi,
+        {"figure": snakemake.rule, "inputs": list(snakemake.input)},
     )
-    parser.add_argument("exponents", help="results/theory/exponents.parquet")
-    args = plotting.figure_arguments(parser).parse_args()
-    logging.basicConfig(level=logging.INFO, format="%(message)s")
-    main(args.exponents, args.pdf, args.png, args.dpi)

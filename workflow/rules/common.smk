@@ -54,7 +54,8 @@ def restitution_value(wildcards):
 
 
 def settings(wildcards):
-    return shard_settings(config, wildcards.r)
+    """A shard's settings (bouncing_ball.settings.ShardSettings) as the rule's parameter."""
+    return shard_settings(config, wildcards.r).as_mapping()
 
 
 def shard_files(wildcards):

@@ -15,6 +15,7 @@ rule fig1:
         ),
     log:
         "logs/figures/fig1.log",
+    localrule: True
     conda:
         "../envs/bouncing-ball.yaml"
     resources:
@@ -41,6 +42,7 @@ rule fig2:
         ),
     log:
         "logs/figures/fig2.log",
+    localrule: True
     conda:
         "../envs/bouncing-ball.yaml"
     resources:
@@ -67,6 +69,7 @@ rule fig3:
         ),
     log:
         "logs/figures/fig3.log",
+    localrule: True
     conda:
         "../envs/bouncing-ball.yaml"
     resources:
@@ -97,6 +100,7 @@ rule fig4:
         ),
     log:
         "logs/figures/fig4.log",
+    localrule: True
     conda:
         "../envs/bouncing-ball.yaml"
     resources:
@@ -126,6 +130,7 @@ rule fig5:
         ),
     log:
         "logs/figures/fig5.log",
+    localrule: True
     conda:
         "../envs/bouncing-ball.yaml"
     resources:
@@ -154,6 +159,7 @@ rule fig6:
         ),
     log:
         "logs/figures/fig6.log",
+    localrule: True
     conda:
         "../envs/bouncing-ball.yaml"
     resources:
@@ -181,6 +187,7 @@ rule fig7:
         ),
     log:
         "logs/figures/fig7.log",
+    localrule: True
     conda:
         "../envs/bouncing-ball.yaml"
     resources:

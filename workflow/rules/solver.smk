@@ -7,6 +7,7 @@ rule solve:
         summary="results/solver/r{r}/summary.parquet",
     log:
         "logs/solver/r{r}.log",
+    localrule: True
     conda:
         "../envs/bouncing-ball.yaml"
     resources:
@@ -26,6 +27,7 @@ rule solve_grid:
         "results/solver/time_averages.parquet",
     log:
         "logs/solver/time_averages.log",
+    localrule: True
     conda:
         "../envs/bouncing-ball.yaml"
     resources:

@@ -19,6 +19,7 @@ rule moments_table:
         md="results/tables/moments.md",
     log:
         "logs/tables/moments.log",
+    localrule: True
     conda:
         "../envs/bouncing-ball.yaml"
     resources:

@@ -6,6 +6,7 @@ rule theory:
         "results/theory/exponents.parquet",
     log:
         "logs/theory/exponents.log",
+    localrule: True
     conda:
         "../envs/bouncing-ball.yaml"
     resources:

@@ -3,7 +3,7 @@
 import os
 import time
 
-from bouncing_ball import jit, source_digest
+from bouncing_ball import PACKAGE, jit, source_digest, stages
 
 
 def _folder(base, name, age_seconds):
@@ -15,8 +15,10 @@ def _folder(base, name, age_seconds):
     return path
 
 
-def test_the_cache_folder_is_named_after_the_source():
-    assert jit.CACHE.name == f"numba-{source_digest()}"
+def test_the_cache_folder_is_named_after_the_compiled_source_only():
+    """An edit of plotting.py (not compiled) keeps the cache; one of free_flight.py does not."""
+    assert jit.CACHE.name == f"numba-{source_digest(stages.COMPILED)}"
+    assert "plotting" not in stages.COMPILED and "free_flight" in stages.COMPILED
 
 
 def test_old_cache_folders_are_pruned_keeping_the_newest_and_the_recent(tmp_path):
@@ -40,3 +42,14 @@ def test_pruning_keeps_a_recently_used_folder_beyond_the_count(tmp_path):
     folders = [_folder(tmp_path, f"numba-v{k}", 30 + k) for k in range(5)]
     assert jit.prune_caches(tmp_path, current, keep=1, older_than=3600) == []
     assert all(path.is_dir() for path in folders)
+
+
+def test_every_module_with_compiled_code_keys_the_cache():
+    """A module that numba compiles (an @njit function) must be in stages.COMPILED, else an
+    edit of it would be served stale code from the cache."""
+    compiled = {
+        path.stem
+        for path in PACKAGE.glob("*.py")
+        if "@njit" in path.read_text() or "njit(" in path.read_text()
+    }
+    assert compiled - {"jit"} and compiled <= set(stages.COMPILED)

@@ -1,9 +1,11 @@
 """The fitter on data with known truth: exact recovery without noise, honest intervals with noise."""
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from bouncing_ball import fits
+from bouncing_ball.bins import outgoing_speed_bin_average
 from bouncing_ball.histograms import jackknife, outgoing_speed_density
 
 SHARDS = 16
@@ -91,7 +93,9 @@ def test_bin_averages_of_a_curve_match_the_solver():
         speeds, solution.outgoing_speed_density(speeds), lower, upper
     )
     np.testing.assert_allclose(
-        from_curve, solver.outgoing_speed_bin_average(solution, lower, upper), rtol=1e-6
+        from_curve,
+        outgoing_speed_bin_average(solution.outgoing_speed_density, lower, upper),
+        rtol=1e-6,
     )
     with pytest.raises(ValueError, match="beyond the curve"):
         fits.bin_averages_of_curve(speeds, solution.outgoing_speed_density(speeds), [40.0], [60.0])
@@ -131,3 +135,32 @@ def test_bins_without_a_jackknife_error_are_weighted_by_their_poisson_error():
     errors = fits.fit_errors([0.1, 0.0, np.nan, 0.07], reference, expected)
     np.testing.assert_allclose(errors, [0.1, 0.1, 0.1, 0.07])
     assert np.all(errors > 0)
+
+
+def test_fit_bins_are_chosen_by_the_collisions_they_should_hold_not_by_their_counts():
+    """fits.select_fit_bins: finite bins inside the curve, expected count >= minimum_count;
+    a bin's own count does not matter, and populated bins past the curve are counted."""
+    edges = np.array([1e-3, 1e-2, 1e-1, 1.0, 10.0])
+    table = pd.DataFrame(
+        {
+            "v_lo": np.concatenate([[0.0], edges]),
+            "v_hi": np.concatenate([edges, [np.inf]]),
+            "count": [5, 0, 9, 0, 3, 1],  # the underflow, four finite bins, the overflow
+        }
+    )
+    speeds = np.geomspace(1e-3, 5.0, 200)  # the curve ends inside the last finite bin
+    density = np.exp(-speeds)
+    total_time = 1.0e3
+    chosen = fits.select_fit_bins(table, speeds, density, total_time, minimum_count=10)
+    # should hold: [1e-3, 1e-2) 0.05 collisions (out), [1e-2, 1e-1) about 5 (out, though it
+    # holds 9), [1e-1, 1) about 300 (in, though it holds none)
+    np.testing.assert_array_equal(chosen.rows, [3])
+    np.testing.assert_allclose(chosen.lower, [0.1]) and np.testing.assert_allclose(
+        chosen.upper, [1.0]
+    )
+    expected = fits.expected_collisions(chosen.reference, chosen.lower, chosen.upper, total_time)
+    np.testing.assert_allclose(chosen.expected, expected)
+    assert np.all(chosen.expected >= 10)
+    assert chosen.beyond == 1  # [1, 10) reaches past v = 5 and holds 3 collisions
+    exact = outgoing_speed_bin_average(lambda v: np.exp(-v), chosen.lower, chosen.upper)
+    np.testing.assert_allclose(chosen.reference, exact, rtol=1e-6)

@@ -16,8 +16,6 @@ from workflow_support import SMALL, copy_repository, snakemake
 
 from bouncing_ball.io import read_table
 
-pytestmark = pytest.mark.workflow
-
 # three shards of r = 1/2 that each compute for a few seconds, so a job can be killed mid-run
 LONG = yaml.safe_load(yaml.safe_dump(SMALL)) | {"restitution": [0.5]}
 LONG["simulation"]["per_restitution"] = {"0.5": {"shards": 3, "shard_time": 2.5e6}}

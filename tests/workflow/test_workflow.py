@@ -12,12 +12,18 @@ import pytest
 import yaml
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
-from workflow_support import FIGURES, REPOSITORY, SMALL, copy_repository, planned_jobs, snakemake
+from workflow_support import (
+    FIGURES,
+    REPOSITORY,
+    SMALL,
+    TEST_CONFIG,
+    copy_repository,
+    planned_jobs,
+    snakemake,
+)
 
 from bouncing_ball.config import check_config
 from bouncing_ball.io import read_table
-
-pytestmark = pytest.mark.workflow
 
 
 def test_run_produces_the_documented_tables(finished_run):
@@ -536,187 +542,14 @@ def test_a_bad_config_leaves_existing_results_untouched(finished_run, tmp_path):
     assert {path: path.stat().st_mtime_ns for path in (directory / "results").rglob("*")} == before
 
 
-def test_lint_is_clean_and_rule_files_are_formatted():
-    lint = subprocess.run(
-        [sys.executable, "-m", "snakemake", "--lint"],
-        cwd=REPOSITORY,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert lint.returncode == 0, lint.stdout + lint.stderr
-    rule_files = ["Snakefile", *map(str, (REPOSITORY / "workflow").rglob("*.smk"))]
-    formatted = subprocess.run(
-        [sys.executable, "-m", "snakefmt", "--check", *rule_files],
-        cwd=REPOSITORY,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert formatted.returncode == 0, formatted.stderr
-    quick = subprocess.run(
-        [sys.executable, "-m", "snakemake", "--dry-run", "--configfile", "config/quick.yaml"],
-        cwd=REPOSITORY,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert quick.returncode == 0, quick.stderr[-2000:]
-
-
-def test_scripts_run_by_hand(tmp_path):
-    """A failing step can be debugged outside Snakemake: the scripts take paths and values."""
-    config = tmp_path / "config.yaml"
-    config.write_text(yaml.safe_dump(SMALL))
-    shards = []
-    for k in range(2):
-        shards.append(tmp_path / f"shard{k}.parquet")
-        subprocess.run(
-            [
-                sys.executable,
-                "scripts/simulate_shard.py",
-                "--restitution",
-                "1/3",
-                "--shard",
-                str(k),
-                "--config",
-                str(config),
-                "--shard-time",
-                "200",
-                str(shards[-1]),
-            ],
+def test_the_quick_look_and_the_test_config_plan_a_run():
+    """config/quick.yaml (an overlay of config.yaml) and .test/config/config.yaml validate."""
+    for arguments in (["--configfile", "config/quick.yaml"], ["--configfile", str(TEST_CONFIG)]):
+        planned = subprocess.run(
+            [sys.executable, "-m", "snakemake", "--dry-run", *arguments],
             cwd=REPOSITORY,
-            check=True,
             capture_output=True,
-            timeout=300,
+            text=True,
+            timeout=120,
         )
-    outputs = {name: tmp_path / f"{name}.parquet" for name in ("p0v", "position", "summary")}
-    subprocess.run(
-        [
-            sys.executable,
-            "scripts/merge_shards.py",
-            "--restitution",
-            "1/3",
-            *[f"--{name}={path}" for name, path in outputs.items()],
-            *map(str, shards),
-        ],
-        cwd=REPOSITORY,
-        check=True,
-        capture_output=True,
-        timeout=300,
-    )
-    summary, provenance = read_table(outputs["summary"])
-    assert provenance["r"] == "1/3" and summary.shards.iloc[0] == 2
-    assert summary.total_time.iloc[0] == pytest.approx(400.0)
-    # a shard of another r is refused by name
-    wrong = tmp_path / "other.parquet"
-    subprocess.run(
-        [
-            sys.executable,
-            "scripts/simulate_shard.py",
-            "--restitution",
-            "0.5",
-            "--shard",
-            "0",
-            "--config",
-            str(config),
-            "--shard-time",
-            "200",
-            str(wrong),
-        ],
-        cwd=REPOSITORY,
-        check=True,
-        capture_output=True,
-        timeout=300,
-    )
-    refused = subprocess.run(
-        [
-            sys.executable,
-            "scripts/merge_shards.py",
-            "--restitution",
-            "1/3",
-            *[f"--{name}={path}" for name, path in outputs.items()],
-            str(shards[0]),
-            str(wrong),
-        ],
-        cwd=REPOSITORY,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert refused.returncode != 0 and "other.parquet" in refused.stderr
-    solved = {name: tmp_path / f"solver_{name}.parquet" for name in ("p0v", "summary")}
-    subprocess.run(
-        [
-            sys.executable,
-            "scripts/solve.py",
-            "--restitution",
-            "0.6",
-            *[f"--{name}={path}" for name, path in solved.items()],
-        ],
-        cwd=REPOSITORY,
-        check=True,
-        capture_output=True,
-        timeout=300,
-    )
-    summary, provenance = read_table(solved["summary"])
-    assert provenance["r"] == "3/5" and abs(summary.energy_balance_residual.iloc[0]) < 1e-8
-
-
-def test_figure_and_table_scripts_run_by_hand(tmp_path):
-    """Fig. 1 from a theory table, and the moments table from summaries, outside Snakemake."""
-    config = tmp_path / "config.yaml"
-    config.write_text(yaml.safe_dump(SMALL))
-    exponents = tmp_path / "exponents.parquet"
-    for command in (
-        ["scripts/theory.py", str(exponents), "--config", str(config)],
-        [
-            "scripts/figures/fig1.py",
-            str(exponents),
-            "--pdf",
-            str(tmp_path / "fig1.pdf"),
-            "--png",
-            str(tmp_path / "fig1.png"),
-            "--dpi",
-            "50",
-        ],
-        [
-            "scripts/solve.py",
-            "--restitution",
-            "1/2",
-            "--p0v",
-            str(tmp_path / "p0v.parquet"),
-            "--summary",
-            str(tmp_path / "solved.parquet"),
-            "--config",
-            str(config),
-        ],
-    ):
-        subprocess.run(
-            [sys.executable, *command], cwd=REPOSITORY, check=True, capture_output=True, timeout=300
-        )
-    assert (tmp_path / "fig1.pdf").read_bytes().startswith(b"%PDF")
-    # the solver's summary stands in for a simulation's: it has no errors, so it is refused by name
-    result = subprocess.run(
-        [
-            sys.executable,
-            "scripts/moments_table.py",
-            "--simulation",
-            str(tmp_path / "solved.parquet"),
-            "--solver",
-            str(tmp_path / "solved.parquet"),
-            "--csv",
-            str(tmp_path / "m.csv"),
-            "--md",
-            str(tmp_path / "m.md"),
-        ],
-        cwd=REPOSITORY,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert result.returncode != 0 and not (tmp_path / "m.csv").exists()
-    assert (
-        f"{tmp_path / 'solved.parquet'}: not the expected table, it lacks the columns mean_x_err"
-        in result.stderr
-    )
+        assert planned.returncode == 0, planned.stderr[-2000:]

@@ -1,4 +1,4 @@
-"""Benchmarks on the machine it runs on: ``python -m bouncing_ball.benchmark [--json] [--scaling]``.
+"""Benchmarks on the machine it runs on: ``python -m benchmarks [--json] [--scaling]`` (repository root).
 
 Measured here (about 1 minute; ``--scaling`` adds about 2.5 more, outside that budget):
   * simulation throughput on one core at r = 0.25, 0.5, 0.75 with the default
@@ -41,28 +41,23 @@ from pathlib import Path
 SINGLE_THREAD = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 SOLVER_RESTITUTIONS = (0.05, 0.1, 0.25, 1.0 / 3.0, 0.5, 0.75, 0.9, 0.95, 0.99)
-SOLVER_TARGET_SECONDS = 0.050
-SOLVER_TARGET_ERROR = 1e-8
+SOLVER_TARGET_SECONDS = 0.050  # per r, at the solver's accuracy target (solver.ACCURACY_TARGET)
 
 
 REPOSITORY = Path(__file__).resolve().parents[1]
 PAPER_CRITERION_C = 5.0
 
 
-def _default_simulation_settings():
-    """c and the delta divisor of the repository's default config (3 and 500 without one)."""
-    settings = {"criterion_c": 3.0, "min_step_divisor": 500.0}
-    config = REPOSITORY / "config" / "config.yaml"
-    if config.is_file():
-        import yaml
+def _default_shard_settings():
+    """The default config's shard settings (c, the delta rule, the bins), with a short
+    equilibration and no step budget to speak of."""
+    from bouncing_ball.config import read_config, shard_settings
 
-        simulation = yaml.safe_load(config.read_text())["simulation"]
-        settings = {key: float(simulation[key]) for key in settings}
-    return {**settings, "equilibration_time": 100.0}
+    config = read_config(REPOSITORY / "config" / "config.yaml")
+    return shard_settings(config, "0.5").replace(equilibration_time=100.0, max_steps=10**13)
 
 
-# the default config's c and delta rule, and its bins
-SIMULATION_SETTINGS = _default_simulation_settings()
+SHARD_SETTINGS = _default_shard_settings()
 REFERENCE_TARGET = 0.9  # numba's speed at least 90% of the C reference's
 # simulated time per throughput shard: about 2-4 CPU seconds each
 THROUGHPUT_TIMES = {0.25: 6.0e5, 0.5: 2.0e6, 0.75: 6.0e6}
@@ -74,21 +69,15 @@ TARGETS = {
 }
 
 
-def _shard(r, recorded_time, shard=0, seed=1, **settings):
-    from .bins import LogBins
-    from .restitution import restitution_label
-    from .simulation import shard_seed_sequence, simulate_shard
+def _shard(r, recorded_time, shard=0, seed=1, loop=None, **changes):
+    """One shard of r with the default settings, ``changes`` applied (``loop``: another
+    implementation of ``simulation.simulate_shard``, e.g. the C reference)."""
+    from bouncing_ball.restitution import restitution_label
+    from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 
-    options = {**SIMULATION_SETTINGS, **settings}
-    return simulate_shard(
-        restitution=r,
-        seed_sequence=shard_seed_sequence(seed, restitution_label(r), shard),
-        recorded_time=recorded_time,
-        max_steps=10**13,
-        speed_bins=LogBins(1e-4, 1e2, 10),
-        position_bins=LogBins(1e-3, 1e3, 5),
-        **options,
-    )
+    settings = SHARD_SETTINGS.replace(shard_time=recorded_time, **changes)
+    stream = shard_seed_sequence(seed, restitution_label(r), shard)
+    return (loop or simulate_shard)(r, stream, settings)
 
 
 def simulation_benchmark():
@@ -97,7 +86,7 @@ def simulation_benchmark():
     _shard(0.5, 10.0)  # warm-up: compile or load the cache
     rows = []
     for r, recorded_time in THROUGHPUT_TIMES.items():
-        for criterion_c in (SIMULATION_SETTINGS["criterion_c"], PAPER_CRITERION_C):
+        for criterion_c in (SHARD_SETTINGS.criterion_c, PAPER_CRITERION_C):
             seconds = float("inf")
             for _ in range(2):  # the better of two: a one-off stall of the machine does not count
                 started = time.process_time()
@@ -126,26 +115,11 @@ def reference_benchmark(r=0.5, recorded_time=2.0e6, repeats=3):
         reference_loop.build()
     except (RuntimeError, OSError) as error:  # no compiler or headers; a read-only package folder
         return {"skipped": str(error).splitlines()[0]}
-    from .bins import LogBins
-    from .restitution import restitution_label
-    from .simulation import shard_seed_sequence, simulate_shard
-
-    def arguments(recorded, equilibration):
-        return dict(
-            restitution=r,
-            seed_sequence=shard_seed_sequence(1, restitution_label(r), 0),
-            recorded_time=recorded,
-            equilibration_time=equilibration,
-            criterion_c=SIMULATION_SETTINGS["criterion_c"],
-            min_step_divisor=SIMULATION_SETTINGS["min_step_divisor"],
-            max_steps=10**13,
-            speed_bins=LogBins(1e-4, 1e2, 10),
-            position_bins=LogBins(1e-3, 1e3, 5),
-        )
+    from bouncing_ball.simulation import simulate_shard
 
     loops = {"numba": simulate_shard, "c": reference_loop.reference_shard}
     for loop in loops.values():
-        loop(**arguments(10.0, 0.0))  # compile, build or load
+        _shard(r, 10.0, loop=loop, equilibration_time=0.0)  # compile, build or load
     rows = []
     for case, recorded, equilibration in (
         ("with tallies", recorded_time, 100.0),
@@ -156,7 +130,7 @@ def reference_benchmark(r=0.5, recorded_time=2.0e6, repeats=3):
         for _ in range(repeats):  # interleaved, so a change of machine load hits both
             for name, loop in loops.items():
                 started = time.process_time()
-                results[name] = loop(**arguments(recorded, equilibration))
+                results[name] = _shard(r, recorded, loop=loop, equilibration_time=equilibration)
                 best[name] = min(best[name], time.process_time() - started)
         same = not reference_loop.differing_tallies(results["numba"], results["c"])
         rows.append(
@@ -172,7 +146,8 @@ def reference_benchmark(r=0.5, recorded_time=2.0e6, repeats=3):
     return {
         "r": r,
         "simulated_time": recorded_time,
-        **{k: SIMULATION_SETTINGS[k] for k in ("criterion_c", "min_step_divisor")},
+        "criterion_c": SHARD_SETTINGS.criterion_c,
+        "min_step_divisor": SHARD_SETTINGS.min_step_divisor,
         "compiler": " ".join(reference_loop.FLAGS),
         "rows": rows,
         "worst_speed_ratio": ratio,
@@ -181,9 +156,9 @@ def reference_benchmark(r=0.5, recorded_time=2.0e6, repeats=3):
 
 
 def _efficiency_shard(arguments):
-    r, recorded_time, shard, settings = arguments
+    r, recorded_time, shard, changes = arguments
     started = time.process_time()
-    tallies = _shard(r, recorded_time, shard=shard, seed=7, **settings)
+    tallies = _shard(r, recorded_time, shard=shard, seed=7, **changes)
     return (
         tallies.collisions / tallies.time,
         time.process_time() - started,
@@ -208,7 +183,8 @@ def efficiency_benchmark(settings=None, shards=32, recorded_time=1.0e5, r=0.5):
     relative_error = rates.std(ddof=1) / np.sqrt(shards) / rates.mean()
     return {
         "r": r,
-        **SIMULATION_SETTINGS,
+        "criterion_c": SHARD_SETTINGS.criterion_c,
+        "min_step_divisor": SHARD_SETTINGS.min_step_divisor,
         **settings,
         "shards": shards,
         "shard_time": recorded_time,
@@ -224,12 +200,13 @@ _PROBE = """
 import json, resource, sys, time
 started = time.perf_counter()
 from bouncing_ball.bins import LogBins
+from bouncing_ball.settings import ShardSettings
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 imported = time.perf_counter()
 before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 def run(t):
-    return simulate_shard(0.5, shard_seed_sequence(1, "0.5", 0), t, 100.0, 5.0, 500.0, 10**13,
-                          LogBins(1e-4, 1e2, 10), LogBins(1e-3, 1e3, 5))
+    settings = ShardSettings(t, 100.0, 5.0, 500.0, 10**13, LogBins(1e-4, 1e2, 10), LogBins(1e-3, 1e3, 5))
+    return simulate_shard(0.5, shard_seed_sequence(1, "0.5", 0), settings)
 run(10.0)
 first = time.perf_counter()
 run(10.0)
@@ -364,17 +341,19 @@ def _median_seconds(function, repeats):
 def solver_benchmark(repeats=7):
     import numpy as np
 
-    from . import exact, solver
+    from bouncing_ball import exact, solver
 
     solver.solve_outgoing_speed_density(0.5)  # warm-up: numba compile or cache load
     output_speeds = np.geomspace(1e-4, 50.0, 401)
-    checked = np.geomspace(1e-3, 20.0, 400)
+    checked = solver.CHECKED_SPEEDS
     rows = []
     for r in SOLVER_RESTITUTIONS:
         solution = solver.solve_outgoing_speed_density(r)
-        seconds = _median_seconds(lambda: solver.solve_outgoing_speed_density(r), repeats)
+        seconds = _median_seconds(lambda r=r: solver.solve_outgoing_speed_density(r), repeats)
         with_output = _median_seconds(
-            lambda: solver.solve_outgoing_speed_density(r).outgoing_speed_density(output_speeds),
+            lambda r=r: solver.solve_outgoing_speed_density(r).outgoing_speed_density(
+                output_speeds
+            ),
             repeats,
         )
         row = {
@@ -398,11 +377,13 @@ def solver_benchmark(repeats=7):
         "worst_solve_ms": worst_time,
         "worst_error_vs_exact": worst_error,
         "target_met": worst_time <= 1e3 * SOLVER_TARGET_SECONDS
-        and worst_error <= SOLVER_TARGET_ERROR,
+        and worst_error <= solver.ACCURACY_TARGET,
     }
 
 
 def _print_solver(result):
+    from bouncing_ball import solver
+
     print("Solver of eq. (inteq), one core (median of repeats, after warm-up)")
     print(
         f"{'r':>8} {'nodes':>6} {'solve ms':>9} {'+401 outputs ms':>16} {'energy resid':>13} {'err vs exact':>13}"
@@ -415,7 +396,7 @@ def _print_solver(result):
         )
     verdict = "met" if result["target_met"] else "MISSED"
     print(
-        f"target: <= {1e3 * SOLVER_TARGET_SECONDS:.0f} ms per r at <= {SOLVER_TARGET_ERROR:.0e}: {verdict}"
+        f"target: <= {1e3 * SOLVER_TARGET_SECONDS:.0f} ms per r at <= {solver.ACCURACY_TARGET:.0e}: {verdict}"
         f" (worst {result['worst_solve_ms']:.1f} ms, worst error {result['worst_error_vs_exact']:.1e})"
     )
 
@@ -428,8 +409,8 @@ def _verdict(value, target, larger_is_better=False):
 
 def _print_all(results):
     print(
-        f"Simulation, one core, the default c = {SIMULATION_SETTINGS['criterion_c']:g} and the paper's "
-        f"c = {PAPER_CRITERION_C:g}, the 1/{SIMULATION_SETTINGS['min_step_divisor']:g} rule"
+        f"Simulation, one core, the default c = {SHARD_SETTINGS.criterion_c:g} and the paper's "
+        f"c = {PAPER_CRITERION_C:g}, the 1/{SHARD_SETTINGS.min_step_divisor:g} rule"
     )
     print(
         f"{'r':>6} {'c':>3} {'CPU s':>6} {'collisions/CPU s':>17} {'time/CPU s':>11} {'steps/collision':>16} {'ns/step':>8}"
@@ -441,7 +422,7 @@ def _print_all(results):
             f" {row['simulated_time_per_cpu_second']:11.3g} {row['steps_per_collision']:16.1f}"
             f" {row['ns_per_step']:8.0f}"
         )
-    default, paper = SIMULATION_SETTINGS["criterion_c"], PAPER_CRITERION_C
+    default, paper = SHARD_SETTINGS.criterion_c, PAPER_CRITERION_C
     if default != paper:
         rate = {
             (row["r"], row["criterion_c"]): row["simulated_time_per_cpu_second"] for row in rows
@@ -521,7 +502,7 @@ def _print_all(results):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(
-        prog="python -m bouncing_ball.benchmark",
+        prog="python -m benchmarks",
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -1,4 +1,4 @@
-"""The plain C reference of the shard loop (bouncing_ball/reference/shard_loop.c).
+"""The plain C reference of the shard loop (benchmarks/reference/shard_loop.c).
 
 It translates the numba loop operation for operation, is compiled without
 FMA contraction and draws its normals with numpy's C ziggurat from the same
@@ -13,10 +13,12 @@ import sys
 
 import numpy as np
 import pytest
+from workflow_support import REPOSITORY
 
-from bouncing_ball import reference_loop
+from benchmarks import reference_loop
+from benchmarks.reference_loop import build, reference_shard
 from bouncing_ball.bins import LogBins
-from bouncing_ball.reference_loop import build, reference_shard
+from bouncing_ball.settings import ShardSettings
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 
 needs_gcc = pytest.mark.skipif(
@@ -47,8 +49,8 @@ def _both(
     min_step_floor=0.0,
     criterion_c=5.0,
 ):
-    settings = dict(
-        recorded_time=recorded_time,
+    settings = ShardSettings(
+        shard_time=recorded_time,
         equilibration_time=equilibration_time,
         criterion_c=criterion_c,
         min_step_divisor=500.0,
@@ -58,8 +60,8 @@ def _both(
         min_step_floor=min_step_floor,
     )
     stream = shard_seed_sequence(seed, str(r), 0)
-    numba_tallies = simulate_shard(r, stream, **settings)
-    c_tallies = reference_shard(r, stream, **settings, library=library)
+    numba_tallies = simulate_shard(r, stream, settings)
+    c_tallies = reference_shard(r, stream, settings, library=library)
     return numba_tallies, c_tallies
 
 
@@ -129,11 +131,11 @@ def test_edited_source_builds_into_a_new_cache_folder(tmp_path):
     source.write_bytes(source.read_bytes() + b"\n/* edited */\n")
     second = build(cache, source)
     assert second.parent != first.parent and first.is_file() and second.is_file()
-    assert not [p for p in cache.rglob(".build-*")]  # no scratch left behind
+    assert not list(cache.rglob(".build-*"))  # no scratch left behind
     # and the edited library still works
     stream = shard_seed_sequence(1, "0.5", 0)
-    settings = dict(
-        recorded_time=100.0,
+    settings = ShardSettings(
+        shard_time=100.0,
         equilibration_time=10.0,
         criterion_c=5.0,
         min_step_divisor=500.0,
@@ -142,8 +144,8 @@ def test_edited_source_builds_into_a_new_cache_folder(tmp_path):
         position_bins=POSITION_BINS,
     )
     _assert_identical(
-        reference_shard(0.5, stream, **settings, library=first),
-        reference_shard(0.5, stream, **settings, library=second),
+        reference_shard(0.5, stream, settings, library=first),
+        reference_shard(0.5, stream, settings, library=second),
     )
 
 
@@ -162,5 +164,5 @@ def test_missing_compiler_is_named(monkeypatch, tmp_path):
 
 
 def test_module_does_not_import_numba():
-    code = "import sys, bouncing_ball.reference_loop; sys.exit('numba' in sys.modules)"
-    assert subprocess.run([sys.executable, "-c", code]).returncode == 0
+    code = "import sys, benchmarks.reference_loop; sys.exit('numba' in sys.modules)"
+    assert subprocess.run([sys.executable, "-c", code], cwd=REPOSITORY).returncode == 0

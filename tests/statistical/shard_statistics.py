@@ -1,39 +1,29 @@
 """CI-sized simulations and the statistics that hold them against predictions (shared by tests)."""
 
 from concurrent.futures import ProcessPoolExecutor
-from pathlib import Path
 
 import numpy as np
-import yaml
+from workflow_support import REPOSITORY
 
-from bouncing_ball.bins import LogBins
+from bouncing_ball.config import read_config, shard_settings
 from bouncing_ball.histograms import outgoing_speed_density, outgoing_speed_histogram
 from bouncing_ball.restitution import restitution_label
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 
 # the exact-result tests hold the simulation to the settings users run: the default config's
-DEFAULT_SIMULATION = yaml.safe_load(
-    (Path(__file__).resolve().parents[1] / "config" / "config.yaml").read_text()
-)["simulation"]
-CRITERION_C = float(DEFAULT_SIMULATION["criterion_c"])
-MIN_STEP_DIVISOR = float(DEFAULT_SIMULATION["min_step_divisor"])
-SPEED_BINS = LogBins(1e-4, 1e2, 10)
-POSITION_BINS = LogBins(1e-3, 1e3, 5)
+DEFAULT_SETTINGS = shard_settings(
+    read_config(REPOSITORY / "config" / "config.yaml"), "0.5"
+).replace(equilibration_time=200.0, max_steps=10**12)
+CRITERION_C = DEFAULT_SETTINGS.criterion_c
 
 
 def _shard(arguments):
     r, shard, recorded_time, seed, floor, criterion_c = arguments
+    settings = DEFAULT_SETTINGS.replace(
+        shard_time=recorded_time, criterion_c=criterion_c, min_step_floor=floor
+    )
     return simulate_shard(
-        restitution=float(r),
-        seed_sequence=shard_seed_sequence(seed, restitution_label(r), shard),
-        recorded_time=recorded_time,
-        equilibration_time=200.0,
-        criterion_c=criterion_c,
-        min_step_divisor=MIN_STEP_DIVISOR,
-        max_steps=10**12,
-        speed_bins=SPEED_BINS,
-        position_bins=POSITION_BINS,
-        min_step_floor=floor,
+        float(r), shard_seed_sequence(seed, restitution_label(r), shard), settings
     )
 
 

@@ -12,7 +12,7 @@ cross-check of the compiled code; the workflow does not use it.
 numba does not fuse multiply-adds, so the C must not either) into a folder
 keyed on the hash of the C source and the whole compiler command, compiling
 only when that folder lacks the library and writing it atomically.  This
-module imports numpy and the package's light modules only, never numba.
+module imports numpy and the library's light modules only, never numba.
 """
 
 import ctypes
@@ -27,11 +27,11 @@ from pathlib import Path
 
 import numpy as np
 
-from . import PACKAGE
-from .bins import LogBins
-from .tallies import ShardTallies
+from bouncing_ball.settings import ShardSettings
+from bouncing_ball.tallies import ShardTallies
 
-SOURCE = PACKAGE / "reference" / "shard_loop.c"
+HERE = Path(__file__).resolve().parent
+SOURCE = HERE / "reference" / "shard_loop.c"
 COMPILER = "gcc"
 FLAGS = ("-O3", "-march=native", "-ffp-contract=off", "-fPIC", "-shared", "-std=c99")
 LIBRARY_NAME = "shard_loop.so"
@@ -74,12 +74,12 @@ def build(directory=None, source=None) -> Path:
     """Compile the C reference (if not cached yet) and return the shared library's path.
 
     The library goes to ``<directory>/reference-<key>/shard_loop.so``, ``directory``
-    defaulting to the package's __pycache__ and ``<key>`` hashing the source and
+    defaulting to this folder's __pycache__ and ``<key>`` hashing the source and
     the compiler command, so an edit of the C file builds into a new folder.
-    ``source`` defaults to the package's reference/shard_loop.c.
+    ``source`` defaults to reference/shard_loop.c beside this module.
     """
     source = Path(source) if source is not None else SOURCE
-    base = Path(directory) if directory is not None else PACKAGE / "__pycache__"
+    base = Path(directory) if directory is not None else HERE / "__pycache__"
     if shutil.which(COMPILER) is None:
         raise RuntimeError(
             f"the C compiler '{COMPILER}' was not found on PATH; it is needed to build {source.name}"
@@ -138,20 +138,14 @@ def _load(library: str):
 def reference_shard(
     restitution: float,
     seed_sequence: np.random.SeedSequence,
-    recorded_time: float,
-    equilibration_time: float,
-    criterion_c: float,
-    min_step_divisor: float,
-    max_steps: int,
-    speed_bins: LogBins,
-    position_bins: LogBins,
-    min_step_floor: float = 0.0,
+    settings: ShardSettings,
     library=None,
 ) -> ShardTallies:
     """``simulation.simulate_shard``, run by the C reference (``library``: a built
     shared library, by default ``build()``)."""
     if not 0.0 < restitution < 1.0:
         raise ValueError(f"restitution must lie in (0, 1), got {restitution}")
+    speed_bins, position_bins = settings.speed_bins, settings.position_bins
     function = _load(str(library if library is not None else build()))
     bit_generator = np.random.PCG64(seed_sequence)  # kept alive across the call
     v_edges = np.ascontiguousarray(speed_bins.edges, dtype=np.float64)
@@ -162,12 +156,12 @@ def reference_shard(
     status = function(
         bit_generator.ctypes.bit_generator,
         float(restitution),
-        float(criterion_c),
-        float(min_step_divisor),
-        float(min_step_floor),
-        float(equilibration_time),
-        float(recorded_time),
-        int(max_steps),
+        settings.criterion_c,
+        settings.min_step_divisor,
+        settings.min_step_floor,
+        settings.equilibration_time,
+        settings.shard_time,
+        settings.max_steps,
         v_edges,
         speed_bins.n,
         x_edges,

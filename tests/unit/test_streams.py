@@ -3,15 +3,14 @@
 import numpy as np
 
 from bouncing_ball.bins import LogBins
+from bouncing_ball.settings import ShardSettings
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 from bouncing_ball.tallies import tallies_to_frame
 
 
 def _run(label, shard, seed=11):
-    return simulate_shard(
-        restitution=float(label),
-        seed_sequence=shard_seed_sequence(seed, label, shard),
-        recorded_time=500.0,
+    settings = ShardSettings(
+        shard_time=500.0,
         equilibration_time=10.0,
         criterion_c=5.0,
         min_step_divisor=500.0,
@@ -19,6 +18,7 @@ def _run(label, shard, seed=11):
         speed_bins=LogBins(1e-4, 1e2, 10),
         position_bins=LogBins(1e-3, 1e3, 5),
     )
+    return simulate_shard(float(label), shard_seed_sequence(seed, label, shard), settings)
 
 
 def test_same_seed_gives_an_identical_shard():

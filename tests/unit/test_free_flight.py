@@ -146,7 +146,11 @@ def test_level_crossing_time_is_the_root_to_rounding():
                 worst_value = max(worst_value, residual)
                 if 0.01 <= fraction <= 0.99:
                     exact = brentq(
-                        lambda s: cubic_value(*a, s) - level, start, stop, xtol=1e-300, rtol=1e-15
+                        lambda s, a=a, level=level: cubic_value(*a, s) - level,
+                        start,
+                        stop,
+                        xtol=1e-300,
+                        rtol=1e-15,
                     )
                     # the level is known only to rounding of x: that sets how well t can be known
                     conditioning = 4e-16 * max(abs(m_lo), abs(m_hi)) / abs(m_hi - m_lo)

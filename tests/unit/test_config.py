@@ -2,10 +2,10 @@
 
 import copy
 from fractions import Fraction
-from pathlib import Path
 
 import pytest
 import yaml
+from workflow_support import REPOSITORY
 
 from bouncing_ball.config import check_config, simulation_settings
 from bouncing_ball.restitution import parse_restitution, restitution_grid, restitution_label
@@ -51,7 +51,7 @@ def test_repeated_r_refused_also_in_another_spelling():
 
 
 def _default_config():
-    with open(Path(__file__).resolve().parents[1] / "config" / "config.yaml") as handle:
+    with open(REPOSITORY / "config" / "config.yaml") as handle:
         return yaml.safe_load(handle)
 
 

@@ -1,0 +1,70 @@
+"""What one simulation shard is run with: the one home of the shard settings.
+
+The config's ``simulation`` section (with its per-r overrides, see
+``config.shard_settings``), the workflow's rule parameters, a shard's
+provenance, the compiled loop (``simulation.simulate_shard``), its C reference
+(``benchmarks/reference_loop.py``) and the studies all use ``ShardSettings``.
+The number of shards is not a shard setting: adding shards leaves the
+existing ones alone.
+"""
+
+from dataclasses import asdict, dataclass, fields, replace
+
+from .bins import LogBins, log_bins
+
+
+@dataclass(frozen=True)
+class ShardSettings:
+    """The parameters that decide a shard's numbers (with its r, seed and index)."""
+
+    shard_time: float  # simulated time recorded, after equilibration
+    equilibration_time: float  # simulated time run and discarded first
+    criterion_c: float  # c of eq. (criterion)
+    min_step_divisor: float  # sqrt(2 delta) = v_out / min_step_divisor after each collision
+    max_steps: int  # step budget, equilibration included
+    speed_bins: LogBins  # outgoing speeds, P(0, v)
+    position_bins: LogBins  # heights, P(x) and <v^2>_x
+    min_step_floor: float = 0.0  # lower bound on delta (0: the paper's rule alone)
+
+    def __post_init__(self):
+        for name in ("shard_time", "equilibration_time", "criterion_c", "min_step_divisor"):
+            object.__setattr__(self, name, float(getattr(self, name)))
+        object.__setattr__(self, "min_step_floor", float(self.min_step_floor))
+        if isinstance(self.max_steps, float) and not self.max_steps.is_integer():
+            raise ValueError(f"max_steps must be a whole number, got {self.max_steps}")
+        object.__setattr__(self, "max_steps", int(self.max_steps))
+        for name in ("speed_bins", "position_bins"):
+            value = getattr(self, name)
+            if not isinstance(value, LogBins):
+                object.__setattr__(self, name, log_bins(value))
+        problems = [
+            f"{name} = {getattr(self, name)} must be {rule}"
+            for name, rule, holds in (
+                ("shard_time", "positive", self.shard_time > 0.0),
+                ("equilibration_time", "0 or more", self.equilibration_time >= 0.0),
+                ("criterion_c", "positive", self.criterion_c > 0.0),
+                ("min_step_divisor", "positive", self.min_step_divisor > 0.0),
+                ("max_steps", "at least 1", self.max_steps >= 1),
+                ("min_step_floor", "0 or more", self.min_step_floor >= 0.0),
+            )
+            if not holds
+        ]
+        if problems:
+            raise ValueError("shard settings: " + "; ".join(problems))
+
+    @classmethod
+    def names(cls) -> tuple[str, ...]:
+        """The settings' keys, as in the config's ``simulation`` section."""
+        return tuple(field.name for field in fields(cls))
+
+    @classmethod
+    def from_mapping(cls, mapping: dict) -> "ShardSettings":
+        """From the config-shaped dict (bins as ``{lo, hi, per_decade}``); other keys ignored."""
+        return cls(**{name: mapping[name] for name in cls.names() if name in mapping})
+
+    def as_mapping(self) -> dict:
+        """The config-shaped, JSON-ready dict: a rule parameter and a shard's provenance."""
+        return asdict(self)
+
+    def replace(self, **changes) -> "ShardSettings":
+        return replace(self, **changes)

@@ -1,0 +1,36 @@
+"""A shard's work is bounded by its step budget; its tallies add up."""
+
+import pytest
+
+from bouncing_ball.bins import LogBins
+from bouncing_ball.settings import ShardSettings
+from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
+
+
+def _run(recorded_time, equilibration_time, max_steps, r=0.5):
+    settings = ShardSettings(
+        shard_time=recorded_time,
+        equilibration_time=equilibration_time,
+        criterion_c=5.0,
+        min_step_divisor=500.0,
+        max_steps=max_steps,
+        speed_bins=LogBins(1e-4, 1e2, 10),
+        position_bins=LogBins(1e-3, 1e3, 5),
+    )
+    return simulate_shard(r, shard_seed_sequence(2, str(r), 0), settings)
+
+
+def test_budget_stops_a_shard_and_says_so():
+    full = _run(2000.0, 10.0, 10**9)
+    assert full.budget_exhausted == 0 and full.time == pytest.approx(2000.0)
+    cut = _run(2000.0, 10.0, full.steps // 2)
+    assert cut.budget_exhausted == 1
+    assert 0.0 < cut.time < 2000.0
+    assert cut.steps < full.steps // 2  # the budget counts equilibration steps too
+
+
+def test_position_tallies_cover_the_recorded_time():
+    shard = _run(5000.0, 10.0, 10**9, r=0.75)
+    assert shard.position_time.sum() == pytest.approx(shard.time, rel=1e-12)
+    assert shard.position_time.min() >= 0.0 and shard.position_v2_time.min() >= 0.0
+    assert shard.speed_counts.sum() == shard.collisions
