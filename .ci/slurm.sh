@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # CI stage: the workflow through a real SLURM (profiles/slurm, snakemake-executor-plugin-slurm)
-# on a single-node cluster on localhost, against a local run of the same tiny config.
+# on a single-node cluster on localhost, against a local run of the small test config (.test/config/config.yaml).
 #
 #   bash .ci/slurm.sh          (called by .ci/run after pytest; about 2 minutes)
 #
 # It installs Debian's slurmctld, slurmd and munge if they are missing, starts its own
 # munged, slurmctld and slurmd (private socket, ports, state and config under a temporary
-# folder; no accounting), runs .ci/slurm-tiny.yaml with --profile profiles/slurm under a
+# folder; no accounting), runs .test/config/config.yaml with --profile profiles/slurm under a
 # hard timeout, checks that the jobs went through SLURM and that every table equals a local
 # run's, and stops the three daemons it started (by their PIDs) and nothing else.
 # It skips, exit 0 with a message, where it cannot run: not root, or no apt-get / package
@@ -183,12 +183,12 @@ fi
 say "cluster up: munged, slurmctld, slurmd (PIDs ${PIDS[*]}), node $NODE, $CPUS CPUs, $MEMORY MB"
 sinfo -N -o "%N %t %c %m"
 
-# --- the same tiny config, locally and through SLURM ----------------------------------
+# --- the small test config, locally and through SLURM ----------------------------------
 TARGETS=(simulation solver fits tables)
 copy() {
     mkdir -p "$1"
     cp -r "$REPO/Snakefile" "$REPO/workflow" "$REPO/scripts" "$REPO/config" "$REPO/profiles" "$1/"
-    cp "$REPO/.ci/slurm-tiny.yaml" "$1/config/config.yaml"
+    cp "$REPO/.test/config/config.yaml" "$1/config/config.yaml"
 }
 copy "$WORK/local"
 copy "$WORK/cluster"
@@ -199,12 +199,13 @@ say "local run"
 
 say "SLURM run: snakemake --profile profiles/slurm with the settings of a cluster without accounting"
 # Site settings of this cluster on the command line (they win over the profile): no
-# accounting, so squeue for job states and no account; 2 cores, so 2 shards per SLURM job.
+# accounting, so squeue for job states and no account; all 5 shards of the test config in one
+# SLURM job (a group), run one after the other on one core.
 set +e
 (cd "$WORK/cluster" && timeout --kill-after=15 300 "$PYTHON" -m snakemake --profile profiles/slurm \
     --slurm-status-command squeue --slurm-init-seconds-before-status-checks 2 \
     --slurm-no-account --slurm-keep-successful-logs \
-    --group-components shards=2 --jobs 4 --latency-wait 5 \
+    --group-components shards=5 --jobs 4 --latency-wait 5 \
     "${TARGETS[@]}") >"$WORK/log/slurm-run.log" 2>&1
 status=$?
 set -e

@@ -12,17 +12,18 @@ import pandas as pd
 
 from bouncing_ball.io import read_table
 
-# what the tiny config (.ci/slurm-tiny.yaml, one r, 4 shards, 2 per SLURM job) submits
+# what the small test config (.test/config/config.yaml: r = 1/2 with 3 shards, 1/3 with 2;
+# all 5 shards in one SLURM job, .ci/slurm.sh) submits
 SUBMITTED = {
-    "group_shards_simulate_shard": 2,
-    "rule_merge_shards": 1,
-    "rule_fit": 1,
-    "rule_exact_solution": 1,
+    "group_shards_simulate_shard": 1,
+    "rule_merge_shards": 2,
+    "rule_fit": 2,
+    "rule_exact_solution": 2,
 }
 # what each asks SLURM for: the resources of workflow/rules/*.smk (CPUs, minutes, MB); a
-# group of 2 shards runs them one after the other on one core (profiles/slurm: cores 1)
+# group of 5 shards runs them one after the other on one core (profiles/slurm: cores 1)
 REQUESTED = {
-    "group_shards_simulate_shard": (1, 2 * 20, 500),
+    "group_shards_simulate_shard": (1, 5 * 20, 500),
     "rule_merge_shards": (1, 10, 1000),
     "rule_fit": (1, 10, 1000),
     "rule_exact_solution": (1, 10, 500),
