@@ -23,6 +23,7 @@ import shutil
 import subprocess
 import sysconfig
 import tempfile
+from dataclasses import fields
 from pathlib import Path
 
 import numpy as np
@@ -178,16 +179,11 @@ def reference_shard(
     )
 
 
-TALLY_FIELDS = (
-    "speed_counts",
-    "position_time",
-    "position_v2_time",
-    "time",
-    "collisions",
-    "steps",
-    "int_x",
-    "int_x2",
-    "budget_exhausted",
+# what a shard records (its bins aside): every one must agree bit for bit
+TALLY_FIELDS = tuple(
+    field.name
+    for field in fields(ShardTallies)
+    if field.name not in ("speed_bins", "position_bins")
 )
 
 

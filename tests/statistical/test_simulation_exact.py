@@ -10,6 +10,7 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
+from exact_results import TIME_AVERAGES
 from shard_statistics import CRITERION_C, outgoing_speed_bins, sign_flip_p_values, simulate_shards
 
 from bouncing_ball import exact
@@ -18,16 +19,6 @@ from bouncing_ball.histograms import position_histogram, position_moments_summar
 SHARDS = 16
 SHARD_TIME = {Fraction(1, 2): 4.0e5, Fraction(1, 3): 7.0e5}
 SEED = 20061121
-
-# eq. (xandDeltax) in closed form
-PAPER = {
-    Fraction(1, 2): {"mean_x": 6.0, "delta_x": 6.0 * np.sqrt(3.0), "collision_rate": 1.0 / 3.0},
-    Fraction(1, 3): {
-        "mean_x": 35.0 / 9.0,
-        "delta_x": np.sqrt(4781.0) / 9.0,
-        "collision_rate": 0.75,
-    },
-}
 
 
 # the default config's c, and the paper's c = 5 where that differs
@@ -39,27 +30,27 @@ def shards(request):
     return simulate_shards(SHARD_TIME, SHARDS, SEED, criterion_c=request.param)
 
 
-@pytest.mark.parametrize("r", list(PAPER), ids=str)
+@pytest.mark.parametrize("r", list(TIME_AVERAGES), ids=str)
 @pytest.mark.parametrize("quantity", ["mean_x", "delta_x", "collision_rate"])
 def test_moments_match_exact_values(shards, r, quantity):
     summary = position_moments_summary(shards[r], float(r)).iloc[0]
     value, error = summary[quantity], summary[f"{quantity}_err"]
-    expected = PAPER[r][quantity]
+    expected = TIME_AVERAGES[r][quantity]
     assert error / expected <= 0.01, "run too short for a sharp test"
     z = (value - expected) / error
     assert abs(z) < 3.0, f"{quantity} = {value} +- {error}, exact {expected}, z = {z:.2f}"
 
 
-@pytest.mark.parametrize("r", list(PAPER), ids=str)
+@pytest.mark.parametrize("r", list(TIME_AVERAGES), ids=str)
 def test_exact_module_reproduces_paper_closed_forms(r):
     # the comparison values above, recomputed from P(x) of eq. (P(x)2)
     computed = exact.position_moments(r)
     assert computed["normalization"] == pytest.approx(1.0, rel=1e-9)
-    for quantity, expected in PAPER[r].items():
+    for quantity, expected in TIME_AVERAGES[r].items():
         assert computed[quantity] == pytest.approx(expected, rel=1e-9)
 
 
-@pytest.mark.parametrize("r", list(PAPER), ids=str)
+@pytest.mark.parametrize("r", list(TIME_AVERAGES), ids=str)
 def test_outgoing_speed_density_chi_square(shards, r):
     """eq. (P(0,v)) with eq. (constants), no free parameter, for every bin with
     at least 100 collisions: chi^2 per bin and the worst bin, each against its

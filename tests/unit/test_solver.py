@@ -1,27 +1,17 @@
 """The solver of eq. (inteq) against the exact solutions and the exact identities."""
 
-from fractions import Fraction
-
 import numpy as np
 import pytest
+from exact_results import TIME_AVERAGES
 
 from bouncing_ball import exact, solver
 from bouncing_ball.asymptotics import small_speed_exponent
 
-# eq. (xandDeltax) in closed form
-PAPER = {
-    Fraction(1, 2): {"mean_x": 6.0, "delta_x": 6.0 * np.sqrt(3.0), "collision_rate": 1.0 / 3.0},
-    Fraction(1, 3): {
-        "mean_x": 35.0 / 9.0,
-        "delta_x": np.sqrt(4781.0) / 9.0,
-        "collision_rate": 0.75,
-    },
-}
 # the solver is held to ACCURACY_TARGET over CHECKED_SPEEDS
 SPEEDS, TARGET = solver.CHECKED_SPEEDS, solver.ACCURACY_TARGET
 
 
-@pytest.fixture(scope="module", params=list(PAPER), ids=str)
+@pytest.fixture(scope="module", params=list(TIME_AVERAGES), ids=str)
 def exact_case(request):
     r = request.param
     return r, solver.solve_outgoing_speed_density(float(r))
@@ -44,7 +34,9 @@ def test_matches_exact_outgoing_speed_density(exact_case):
 @pytest.mark.parametrize("quantity", ["mean_x", "delta_x", "collision_rate"])
 def test_time_averages_match_paper(exact_case, quantity):
     r, solution = exact_case
-    assert solver.time_averages(solution)[quantity] == pytest.approx(PAPER[r][quantity], rel=TARGET)
+    assert solver.time_averages(solution)[quantity] == pytest.approx(
+        TIME_AVERAGES[r][quantity], rel=TARGET
+    )
 
 
 @pytest.mark.parametrize("r", [0.2, 0.4, 0.6, 0.8])

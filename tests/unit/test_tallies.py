@@ -91,8 +91,9 @@ def test_parquet_round_trip_keeps_provenance(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["shard0.parquet"]  # no temporary left
 
 
-def test_shards_on_other_bins_are_refused():
-    shard = ShardTallies(
+def _empty_shard():
+    """A shard that recorded one time unit and nothing else."""
+    return ShardTallies(
         SPEED_BINS,
         POSITION_BINS,
         np.zeros(SPEED_BINS.n + 2, dtype=np.int64),
@@ -105,6 +106,10 @@ def test_shards_on_other_bins_are_refused():
         0.0,
         0,
     )
+
+
+def test_shards_on_other_bins_are_refused():
+    shard = _empty_shard()
     with pytest.raises(ValueError, match="not on the configured bins"):
         tallies_from_frame(tallies_to_frame(shard), LogBins(1e-2, 1e1, 3), POSITION_BINS)
 
@@ -143,21 +148,7 @@ def test_truncated_file_gives_an_error_that_names_it(tmp_path):
 
     path = tmp_path / "shard3.parquet"
     write_table(
-        tallies_to_frame(
-            ShardTallies(
-                SPEED_BINS,
-                POSITION_BINS,
-                np.zeros(SPEED_BINS.n + 2, dtype=np.int64),
-                np.zeros(POSITION_BINS.n + 2),
-                np.zeros(POSITION_BINS.n + 2),
-                1.0,
-                0,
-                0,
-                0.0,
-                0.0,
-                0,
-            )
-        ),
+        tallies_to_frame(_empty_shard()),
         path,
         {},
     )
