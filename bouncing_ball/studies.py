@@ -135,9 +135,14 @@ def group_statistics(shards, restitution, reference, group_size: int) -> dict:
             "z": [row[quantity]["z"] for row in rows],
             "spread": spread,
             "mean_error": mean_error,
-            "ratio": spread / mean_error if groups >= 2 else np.nan,
+            "ratio": _ratio(spread, mean_error),
         }
     return out
+
+
+def _ratio(numerator, denominator) -> float:
+    """numerator / denominator; NaN where undefined (a zero or NaN denominator)."""
+    return numerator / denominator if denominator > 0 else np.nan
 
 
 def jackknife_error_uncertainty(shards: int) -> float:
@@ -298,7 +303,7 @@ def r075_rows(name: str, run: dict | None, shards, provenances, reference, batch
                 "batches": count,
                 "batch_error": batch_error,
                 "batch_jackknife_error": single_error,
-                "batch_error_ratio": batch_error / single_error,
+                "batch_error_ratio": _ratio(batch_error, single_error),
                 "group_size": group_size,
                 "groups": group["groups"],
                 "group_z": " ".join(f"{z:+.2f}" for z in group["z"]),
