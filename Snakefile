@@ -31,6 +31,7 @@ include: "workflow/rules/exact.smk"
 include: "workflow/rules/theory.smk"
 include: "workflow/rules/figures.smk"
 include: "workflow/rules/tables.smk"
+include: "workflow/rules/studies.smk"
 
 
 rule all:
@@ -88,4 +89,11 @@ rule figures:
 rule tables:
     input:
         table_targets(),
+    localrule: True
+
+
+# stage target: the studies of config/studies.yaml (hours of CPU; not part of `all`)
+rule studies:
+    input:
+        STUDY_TARGETS,
     localrule: True

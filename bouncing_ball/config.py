@@ -4,14 +4,22 @@ The schema (workflow/schemas/config.schema.yaml) fixes keys, types and
 simple ranges; here: r values parsed exactly and unique, bin ranges
 ordered, and the keys of the per-r overrides valid r values.  An override
 may name an r that is not in ``restitution``: it then applies when that r
-is asked for as a target.
+is asked for as a target.  Likewise for the studies' file, config/studies.yaml
+(``study_runs``; schema workflow/schemas/studies.schema.yaml).
 """
 
+from dataclasses import dataclass
 from fractions import Fraction
 
 import yaml
 
-from .restitution import EXACT_RESTITUTIONS, parse_restitution, restitution_grid, restitution_label
+from .restitution import (
+    EXACT_RESTITUTIONS,
+    exact_string,
+    parse_restitution,
+    restitution_grid,
+    restitution_label,
+)
 from .settings import ShardSettings
 
 
@@ -145,3 +153,117 @@ def solver_settings(config: dict) -> dict:
 def exact_settings(config: dict) -> dict:
     """What the exact-solution stage is run with: its section plus the solver's output speeds."""
     return {"output_speeds": config["solver"]["output_speeds"], **config["exact"]}
+
+
+# ---- the studies (config/studies.yaml; workflow/rules/studies.smk) ----
+
+
+@dataclass(frozen=True)
+class StudyRun:
+    """One run of a study: shards of one r with one c and seed, filed under
+    results/studies/{study}/{run}/shard{k}.parquet."""
+
+    study: str
+    run: str
+    restitution: Fraction
+    seed: int
+    shards: int
+    settings: ShardSettings
+
+    @property
+    def label(self) -> str:
+        return restitution_label(self.restitution)
+
+    def as_mapping(self) -> dict:
+        """JSON-ready: what a report's rule is told about the run (params)."""
+        return {
+            "run": self.run,
+            "r": exact_string(self.restitution),
+            "r_label": self.label,
+            "criterion_c": self.settings.criterion_c,
+            "seed": self.seed,
+            "shards": self.shards,
+        }
+
+
+def _study_settings(config: dict, label: str, study: dict, where: str, **changes) -> ShardSettings:
+    """The main config's shard settings of r = ``label``, with the study's ``simulation``
+    overrides and ``changes`` (shard_time, criterion_c) applied."""
+    overrides = dict(study.get("simulation", {}))
+    for name in ("speed_bins", "position_bins"):
+        bins = overrides.get(name)
+        if bins is not None and not bins["lo"] < bins["hi"]:
+            raise ValueError(
+                f"{where}.simulation.{name}: lo = {bins['lo']} must be smaller than hi = {bins['hi']}"
+            )
+    try:
+        return shard_settings(config, label).replace(**overrides, **changes)
+    except ValueError as error:
+        raise ValueError(f"{where}: {error}") from None
+
+
+def study_runs(studies: dict, config: dict) -> dict[str, dict[str, StudyRun]]:
+    """{study: {run: StudyRun}} of config/studies.yaml (already checked against its schema),
+    with the checks a schema cannot express; ValueError naming the key otherwise.
+
+    criterion_bias: one run per (r, c), named r{label}_c{c}; every r must have an exact
+    solution and a shard_time.  The seed is shared, so the runs at one r with different c
+    draw the same streams (shard k of r: ``(seed, r label, k)``).
+    r075: the runs as named in the file; their seeds must differ (the report pools them).
+    Settings not in the study come from the main config's ``simulation`` section.
+    """
+    runs: dict[str, dict[str, StudyRun]] = {}
+    where = "criterion_bias"
+    study = studies["criterion_bias"]
+    grid = restitution_grid(study["restitution"], f"{where}.restitution")
+    for value in grid.values():
+        if value not in EXACT_RESTITUTIONS:
+            raise ValueError(
+                f"{where}.restitution: r = {value} has no exact solution (only 1/2 and 1/3)"
+            )
+    times = {}
+    for key, shard_time in study["shard_time"].items():
+        label = restitution_label(parse_restitution(key, f"{where}.shard_time.{key}"))
+        if label not in grid:
+            raise ValueError(f"{where}.shard_time.{key}: r = {key} is not in {where}.restitution")
+        if label in times:
+            raise ValueError(f"{where}.shard_time.{key}: the same r as another key")
+        times[label] = shard_time
+    missing = [str(value) for label, value in grid.items() if label not in times]
+    if missing:
+        raise ValueError(f"{where}.shard_time: no shard_time for r = {', '.join(missing)}")
+    runs[where] = {}
+    for label, value in grid.items():
+        for c in study["criterion_c"]:
+            name = f"r{label}_c{float(c):g}"
+            if name in runs[where]:
+                raise ValueError(f"{where}.criterion_c: c = {c} repeats another value")
+            settings = _study_settings(
+                config, label, study, where, shard_time=times[label], criterion_c=c
+            )
+            runs[where][name] = StudyRun(
+                where, name, value, study["seed"], study["shards"], settings
+            )
+    where = "r075"
+    study = studies["r075"]
+    value = parse_restitution(study["restitution"], f"{where}.restitution")
+    label = restitution_label(value)
+    runs[where] = {}
+    seeds = {}
+    for name, run in study["runs"].items():
+        if run["seed"] in seeds:
+            raise ValueError(
+                f"{where}.runs.{name}: seed {run['seed']} is also the seed of run {seeds[run['seed']]}; "
+                "the report pools the runs, which must be independent"
+            )
+        seeds[run["seed"]] = name
+        settings = _study_settings(
+            config,
+            label,
+            study,
+            f"{where}.runs.{name}",
+            shard_time=study["shard_time"],
+            criterion_c=run["criterion_c"],
+        )
+        runs[where][name] = StudyRun(where, name, value, run["seed"], run["shards"], settings)
+    return runs

@@ -26,6 +26,20 @@ FITS = (
 )
 PLOTTING = ("io", "plotting", "restitution")
 COMPARISON = ("comparison", "fits", "io")
+# the studies' reports (workflow/rules/studies.smk); their shards are SIMULATION's
+STUDIES = (
+    "bins",
+    "comparison",
+    "exact",
+    "fits",
+    "histograms",
+    "io",
+    "restitution",
+    "settings",
+    "shards",
+    "studies",
+    "tallies",
+)
 
 # what numba compiles: the modules with compiled functions and what those call into (the
 # key of numba's cache folder, bouncing_ball.jit); an edit elsewhere does not recompile

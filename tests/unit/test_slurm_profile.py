@@ -45,7 +45,7 @@ def test_shards_are_grouped_and_a_group_asks_for_one_core():
     assert int(groups["shards"]) >= 2
     blocks = rule_blocks()
     grouped = [name for name, body in blocks.items() if re.search(r'group:\n\s+"shards"', body)]
-    assert grouped == ["simulate_shard"]
+    assert grouped == ["simulate_shard", "study_shard"]
     # the plugin runs a group's jobs one after the other: one core per SLURM job
     assert profile["cores"] == 1
 

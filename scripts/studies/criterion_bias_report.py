@@ -1,0 +1,41 @@
+"""Rule criterion_bias_report: each (r, c) run of the criterion_bias study against the exact
+r = 1/2 and 1/3 results, with its cost -> results/studies/criterion_bias.{csv,md}."""
+
+import logging
+from pathlib import Path
+
+from bouncing_ball.io import atomic_path
+from bouncing_ball.jobs import job_log
+from bouncing_ball.studies import (
+    criterion_bias_markdown,
+    criterion_bias_row,
+    criterion_bias_table,
+    read_runs,
+)
+
+with job_log(snakemake.log[0]):
+    runs = snakemake.params.runs
+    shards = read_runs(snakemake.input.shards, runs)
+    table = criterion_bias_table(
+        [
+            criterion_bias_row(run, *shards[run["run"]], snakemake.params.minimum_count)
+            for run in runs
+        ]
+    )
+    with atomic_path(snakemake.output.csv) as path:
+        table.to_csv(path, index=False, float_format="%.12g")
+    with atomic_path(snakemake.output.md) as path:
+        Path(path).write_text(criterion_bias_markdown(table))
+    for row in table.itertuples():
+        logging.info(
+            "r=%s c=%g, %d shards: <x> z = %+.2f, Delta x z = %+.2f, I z = %+.2f; "
+            "P(0,v) chi^2/n = %.2f over %d bins",
+            row.r_label,
+            row.criterion_c,
+            row.shards,
+            row.mean_x_z,
+            row.delta_x_z,
+            row.collision_rate_z,
+            row.p0v_chi2_per_bin,
+            row.p0v_bins,
+        )

@@ -1,0 +1,56 @@
+"""Rule r075_report: <x>, Delta x, I of the r075 study's runs, alone and pooled, against the
+solver, and checks of their errors -> results/studies/r075.{csv,md}."""
+
+import logging
+from pathlib import Path
+
+import pandas as pd
+
+from bouncing_ball.comparison import QUANTITIES
+from bouncing_ball.io import UnreadableFileError, atomic_path, read_table, require_columns
+from bouncing_ball.jobs import job_log
+from bouncing_ball.studies import r075_markdown, r075_rows, read_runs
+
+with job_log(snakemake.log[0]):
+    runs = snakemake.params.runs
+    solved, provenance = read_table(snakemake.input.solver)
+    require_columns(solved, snakemake.input.solver, QUANTITIES)
+    label = runs[0]["r_label"]
+    if provenance.get("r_label") != label:
+        raise UnreadableFileError(
+            f"{snakemake.input.solver}: solved for r = {provenance.get('r_label')}, not r = {label}"
+        )
+    reference = solved.iloc[0]
+    shards = read_runs(snakemake.input.shards, runs)
+    sizes = snakemake.params.batch_size, snakemake.params.group_size
+    rows = []
+    for run in runs:
+        rows += r075_rows(run["run"], run, *shards[run["run"]], reference, *sizes)
+    if len(runs) > 1:
+        pooled = [shards[run["run"]] for run in runs]
+        rows += r075_rows(
+            "all",
+            None,
+            [shard for tallies, _ in pooled for shard in tallies],
+            [p for _, provenances in pooled for p in provenances],
+            reference,
+            *sizes,
+        )
+    table = pd.DataFrame(rows)
+    with atomic_path(snakemake.output.csv) as path:
+        table.to_csv(path, index=False, float_format="%.12g")
+    with atomic_path(snakemake.output.md) as path:
+        Path(path).write_text(r075_markdown(table, label))
+    for row in table.itertuples():
+        logging.info(
+            "%s (%d shards) %s: %.8g +- %.2g, solver %.10g, %+.4f +- %.4f%%, z = %+.2f",
+            row.run,
+            row.shards,
+            row.quantity,
+            row.value,
+            row.error,
+            row.solver,
+            100 * row.rel_deviation,
+            100 * row.rel_error,
+            row.z,
+        )

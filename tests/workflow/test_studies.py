@@ -1,0 +1,132 @@
+"""The studies (workflow/rules/studies.smk) as a user runs them: `snakemake studies` in a
+temporary copy of the repository, with a tiny config/studies.yaml (seconds, not hours)."""
+
+import math
+
+import pandas as pd
+import pytest
+import yaml
+from workflow_support import SMALL, copy_repository, planned_jobs, snakemake
+
+from bouncing_ball.io import read_table
+
+# 2-4 shards per run of 1e3-2e3 time units; batches and groups of 2 shards so that every
+# column of the r075 report has a number for run c3 and the pooled runs
+TINY = {
+    "criterion_bias": {
+        "restitution": ["1/2", "1/3"],
+        "criterion_c": [3.0, 5.0],
+        "seed": 7,
+        "shards": 2,
+        "shard_time": {"1/2": 2.0e3, "1/3": 1.0e3},
+        "minimum_count": 5,
+    },
+    "r075": {
+        "restitution": 0.75,
+        "shard_time": 2.0e3,
+        "batch_size": 2,
+        "group_size": 2,
+        "runs": {
+            "c3": {"criterion_c": 3.0, "seed": 1, "shards": 4},
+            "c5": {"criterion_c": 5.0, "seed": 2, "shards": 2},
+        },
+    },
+}
+
+
+def copy_with_studies(directory, studies):
+    copy_repository(directory, SMALL)
+    (directory / "config" / "studies.yaml").write_text(yaml.safe_dump(studies))
+    return directory
+
+
+@pytest.fixture(scope="module")
+def studies_run(tmp_path_factory):
+    directory = copy_with_studies(tmp_path_factory.mktemp("studies"), TINY)
+    result = snakemake(directory, "studies")
+    assert result.returncode == 0, result.stderr[-3000:]
+    return directory
+
+
+def finite(table, columns):
+    return all(math.isfinite(value) for value in table[columns].to_numpy().ravel())
+
+
+def test_criterion_bias_report_has_every_r_and_c(studies_run):
+    table = pd.read_csv(studies_run / "results/studies/criterion_bias.csv")
+    assert sorted(zip(table.r, table.criterion_c)) == [
+        ("1/2", 3.0),
+        ("1/2", 5.0),
+        ("1/3", 3.0),
+        ("1/3", 5.0),
+    ]
+    assert (table.shards == 2).all()
+    columns = ["cpu_seconds", "steps_per_collision", "rel_error_I_squared_cpu"]
+    for quantity in ("mean_x", "delta_x", "collision_rate"):
+        columns += [quantity, f"{quantity}_err", f"{quantity}_rel_deviation", f"{quantity}_z"]
+    columns += ["p0v_chi2_per_bin", "p0v_max_abs_z"]
+    assert finite(table, columns)
+    assert (table.p0v_bins > 0).all()
+    # the exact values, not the solver's
+    assert table.set_index("r").loc["1/2", "collision_rate_exact"].tolist() == pytest.approx(
+        [1 / 3, 1 / 3]
+    )
+    markdown = (studies_run / "results/studies/criterion_bias.md").read_text()
+    assert markdown.count("\n| 1/") == 4
+    _, provenance = read_table(
+        studies_run / "results/studies/criterion_bias/r0.5_c5/shard1.parquet"
+    )
+    assert provenance["rule"] == "study_shard" and provenance["seed"] == 7
+    assert provenance["criterion_c"] == 5.0 and provenance["shard_time"] == 2.0e3
+    assert provenance["equilibration_time"] == SMALL["simulation"]["equilibration_time"]
+    assert provenance["cpu_seconds"] > 0
+
+
+def test_r075_report_compares_every_run_and_all_with_the_solver(studies_run):
+    table = pd.read_csv(studies_run / "results/studies/r075.csv")
+    assert sorted(set(table.run)) == ["all", "c3", "c5"]
+    assert table.groupby("run").size().tolist() == [3, 3, 3]
+    assert table.set_index("run").shards.to_dict() == {"all": 6, "c3": 4, "c5": 2}
+    assert finite(table, ["value", "error", "rel_deviation", "z", "shard_rel_spread"])
+    pooled = table[table.run.isin(["c3", "all"])]
+    assert finite(
+        pooled,
+        ["batch_error_ratio", "group_spread_ratio", "skewness", "excess_kurtosis", "cpu_seconds"],
+    )
+    solver, provenance = read_table(studies_run / "results/solver/r0.75/summary.parquet")
+    assert provenance["r_label"] == "0.75"
+    for row in table.itertuples():
+        assert row.solver == pytest.approx(float(solver[row.quantity].iloc[0]), rel=1e-11)
+    assert "r = 0.75" in (studies_run / "results/studies/r075.md").read_text()
+
+
+def test_the_studies_are_not_part_of_the_default_target(tmp_path):
+    directory = copy_with_studies(tmp_path, TINY)
+    jobs = planned_jobs(directory)
+    assert "simulate_shard" in jobs
+    assert not {"study_shard", "criterion_bias_report", "r075_report", "studies"} & set(jobs)
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        (("criterion_bias", "seeed", 7), "'seeed' was unexpected"),
+        (("r075", "batch_size", 0), "batch_size"),
+        (
+            ("r075", "runs", {"c3": {"criterion_c": 3.0, "seed": 1, "shard": 2}}),
+            "'shard' was unexpected",
+        ),
+        (("criterion_bias", "restitution", ["1/2", 0.25]), "r = 1/4 has no exact solution"),
+    ],
+    ids=["typo", "range", "typo-in-a-run", "beyond-the-schema"],
+)
+def test_a_bad_studies_file_is_refused_naming_the_key(tmp_path, change, message):
+    study, key, value = change
+    bad = yaml.safe_load(yaml.safe_dump(TINY))
+    bad[study][key] = value
+    directory = copy_with_studies(tmp_path, bad)
+    result = snakemake(directory, "--dry-run", "studies")
+    assert result.returncode != 0
+    output = result.stderr + result.stdout
+    assert message in output and "config/studies.yaml" in output, output[-2000:]
+    assert not (directory / "results").exists()

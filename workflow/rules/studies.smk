@@ -1,0 +1,115 @@
+# The studies: accuracy checks behind README numbers (c = 3 against c = 5 at the exact r,
+# r = 3/4 against the solver), set in config/studies.yaml. Hours of CPU: not part of `all`;
+# run with  snakemake --cores 2 studies
+import yaml
+from snakemake.exceptions import WorkflowError
+
+from bouncing_ball.config import study_runs
+
+STUDIES_FILE = "config/studies.yaml"
+with open(STUDIES_FILE) as handle:
+    STUDIES = yaml.safe_load(handle)
+try:
+    validate(STUDIES, "../schemas/studies.schema.yaml")
+except WorkflowError as error:
+    raise WorkflowError(f"{STUDIES_FILE}: {error}") from None
+try:
+    STUDY_RUNS = study_runs(STUDIES, config)  # {study: {run: StudyRun}}
+except ValueError as error:
+    raise ValueError(f"invalid {STUDIES_FILE}: {error}") from None
+STUDY_CODE = source_digest(stages.STUDIES)
+R075_LABEL = restitution_label(parse_restitution(STUDIES["r075"]["restitution"]))
+
+
+# per study: every shard of every run, run by run, and what its report is told about the
+# runs, in the same order
+STUDY_SHARDS = {
+    study: [
+        f"results/studies/{study}/{name}/shard{shard}.parquet"
+        for name, run in runs.items()
+        for shard in range(run.shards)
+    ]
+    for study, runs in STUDY_RUNS.items()
+}
+STUDY_RUN_TABLES = {
+    study: [run.as_mapping() for run in runs.values()]
+    for study, runs in STUDY_RUNS.items()
+}
+STUDY_TARGETS = expand(
+    "results/studies/{study}.{ext}", study=STUDY_RUNS, ext=("md", "csv")
+)
+
+
+rule study_shard:
+    output:
+        "results/studies/{study}/{run}/shard{shard}.parquet",
+    log:
+        "logs/studies/{study}/{run}/shard{shard}.log",
+    wildcard_constraints:
+        study="|".join(STUDY_RUNS),
+        run=r"[^/]+",
+    # as rule simulate_shard: several shards per SLURM job (profiles/slurm)
+    group:
+        "shards"
+    conda:
+        "../envs/bouncing-ball.yaml"
+    # minutes: a study shard takes 10-30 CPU s (config/studies.yaml)
+    resources:
+        runtime=20,
+        mem_mb=500,
+        cpus_per_task=1,
+    params:
+        restitution=lambda w: exact_string(STUDY_RUNS[w.study][w.run].restitution),
+        seed=lambda w: STUDY_RUNS[w.study][w.run].seed,
+        settings=lambda w: STUDY_RUNS[w.study][w.run].settings.as_mapping(),
+        code=SIMULATION_CODE,
+    script:
+        "../../scripts/studies/study_shard.py"
+
+
+rule criterion_bias_report:
+    input:
+        shards=STUDY_SHARDS["criterion_bias"],
+    output:
+        md="results/studies/criterion_bias.md",
+        csv="results/studies/criterion_bias.csv",
+    log:
+        "logs/studies/criterion_bias.log",
+    localrule: True
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=1000,
+        cpus_per_task=1,
+    params:
+        runs=STUDY_RUN_TABLES["criterion_bias"],
+        minimum_count=STUDIES["criterion_bias"]["minimum_count"],
+        code=STUDY_CODE,
+    script:
+        "../../scripts/studies/criterion_bias_report.py"
+
+
+rule r075_report:
+    input:
+        shards=STUDY_SHARDS["r075"],
+        solver=f"results/solver/r{R075_LABEL}/summary.parquet",
+    output:
+        md="results/studies/r075.md",
+        csv="results/studies/r075.csv",
+    log:
+        "logs/studies/r075.log",
+    localrule: True
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=1000,
+        cpus_per_task=1,
+    params:
+        runs=STUDY_RUN_TABLES["r075"],
+        batch_size=STUDIES["r075"]["batch_size"],
+        group_size=STUDIES["r075"]["group_size"],
+        code=STUDY_CODE,
+    script:
+        "../../scripts/studies/r075_report.py"
