@@ -1,4 +1,4 @@
-# The studies: accuracy checks behind README numbers (c = 3 against c = 5 at the exact r,
+# The studies: accuracy checks behind docs/validation.md (c = 3 against c = 5 at the exact r,
 # r = 3/4 against the solver), set in config/studies.yaml. Hours of CPU: not part of `all`;
 # run with  snakemake --cores 2 studies
 import yaml
