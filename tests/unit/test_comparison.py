@@ -341,4 +341,18 @@ def test_validation_fit_rows_and_markdown():
     assert np.isnan(table.set_index("check").loc["p0v_chi2_per_bin", "expected"])
     markdown = validation_markdown(table)
     assert markdown.count("\n") == len(table) + 2
-    assert "P(0,v): largest relative error, 0.01 <= v <= 5" in markdown and "1%" in markdown
+    assert "P(0,v): largest relative error, 0.01 <= v <= 5" in markdown and "| 1%" in markdown
+    # one column separator per column and edge on every line: no '|' inside a cell
+    assert {line.count("|") for line in markdown.splitlines()} == {9}
+
+
+def test_validation_fit_rows_say_why_a_joint_p_value_is_missing():
+    fits = _fits_table()
+    fits.loc[fits.window == "large_speed", "joint_p_value"] = np.nan  # 2 shards, 2 exponents
+    fits.loc[fits.window == "small_speed", ["joint_p_value", "chi2_per_dof", "dof"]] = np.nan
+    fits.loc[fits.window == "small_speed", ["v_min", "v_max"]] = np.nan  # no usable window
+    rows = _by_check(fit_checks(fits))
+    assert "too few shards" in rows.loc["large_speed_fit_joint_p_value", "detail"]
+    assert rows.loc["small_speed_fit_joint_p_value", "detail"].startswith("no usable window")
+    assert rows.loc["small_speed_fit_chi2_per_dof", "bins"] == 0
+    assert np.isnan(rows.loc["small_speed_fit_chi2_per_dof", "value"])
