@@ -85,7 +85,7 @@ rule figures:
     localrule: True
 
 
-# stage target: the moments table, CSV and Markdown
+# stage target: the moments and validation tables, CSV and Markdown
 rule tables:
     input:
         table_targets(),

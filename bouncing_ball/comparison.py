@@ -1,7 +1,8 @@
 """The simulation held against the exact solutions and the solver: z-scores and residuals.
 
-Pure functions on the tables the workflow writes; the figures (Figs. 5-7)
-and results/tables/moments.{csv,md} are drawn from them.
+Pure functions on the tables the workflow writes; the figures (Figs. 5-7),
+results/tables/moments.{csv,md} and results/tables/validation.{csv,md} are
+drawn from them.
 """
 
 from fractions import Fraction
@@ -9,7 +10,7 @@ from fractions import Fraction
 import numpy as np
 import pandas as pd
 
-from . import stages
+from . import exact, stages
 from .fits import bin_averages_of_curve, usable_curve
 
 SOURCES = stages.COMPARISON
@@ -137,3 +138,273 @@ def outgoing_speed_residuals(simulated: pd.DataFrame, solver_curve: pd.DataFrame
             "count": bins["count"].to_numpy(),
         }
     )
+
+
+# results/tables/validation.{csv,md}: one row per r and check (long format)
+VALIDATION_COLUMNS = (
+    "r_label",
+    "r",
+    "check",
+    "reference",
+    "bins",
+    "value",
+    "bin_centre",
+    "expected",
+    "detail",
+)
+
+# the checks, in the order of the table, and how the Markdown names them
+VALIDATION_CHECKS = {
+    "p0v_chi2_per_bin": "P(0,v): chi^2/n",
+    "p0v_worst_bin": "P(0,v): worst bin, z",
+    "p0v_largest_relative_error": "P(0,v): largest relative error, 0.01 <= v <= 5",
+    "px_chi2_per_bin": "P(x): chi^2/n",
+    "px_worst_bin": "P(x): worst bin, z",
+    "v2_given_x_chi2_per_bin": "<v^2>_x: chi^2/n",
+    "v2_given_x_worst_bin": "<v^2>_x: worst bin, z",
+    "small_speed_fit_joint_p_value": "small-v fit: joint p-value of the theory's exponents",
+    "small_speed_fit_chi2_per_dof": "small-v fit: chi^2/dof",
+    "large_speed_fit_joint_p_value": "large-v fit: joint p-value of the theory's exponents",
+    "large_speed_fit_chi2_per_dof": "large-v fit: chi^2/dof",
+}
+
+# "paper quality": the speeds over which the relative error of P(0, v) is reported
+QUALITY_SPEEDS = (0.01, 5.0)
+# the heights over which P(x) and <v^2>_x are held against eqs. (P(x)2), (moment2)
+POSITION_RANGE = (1.0e-3, 50.0)
+FIT_SIDES = ("small_speed", "large_speed")
+
+
+def expected_chi2_per_bin(shards):
+    """E[z^2] for z = (mean - truth) / jackknife error over ``shards`` equal shards: z is
+    Student t with shards - 1 degrees of freedom, of variance (shards - 1) / (shards - 3);
+    NaN (infinite or undefined) for 3 shards or fewer."""
+    return (shards - 1.0) / (shards - 3.0) if shards > 3 else np.nan
+
+
+def _z_rows(quantity, reference, where, z, shards, symbol):
+    """The chi^2/n and worst-bin rows of one set of residuals ``z`` at bin centres ``where``."""
+    n = len(z)
+    if n == 0:
+        worst, at, chi2 = np.nan, np.nan, np.nan
+    else:
+        k = int(np.argmax(np.abs(z)))
+        worst, at, chi2 = float(z[k]), float(where[k]), float(np.mean(np.square(z)))
+    note = f"{shards} shards" + ("" if shards > 3 else ": chi^2/n has no finite expectation")
+    return [
+        {
+            "check": f"{quantity}_chi2_per_bin",
+            "reference": reference,
+            "bins": n,
+            "value": chi2,
+            "bin_centre": np.nan,
+            "expected": expected_chi2_per_bin(shards),
+            "detail": f"mean of z^2, z = (simulation - {reference}) / error; {note}",
+        },
+        {
+            "check": f"{quantity}_worst_bin",
+            "reference": reference,
+            "bins": n,
+            "value": worst,
+            "bin_centre": at,
+            "expected": np.nan,
+            "detail": f"z of the bin with the largest abs(z), at {symbol} = {_number(at, 3)}",
+        },
+    ]
+
+
+def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None):
+    """The simulated P(0, v) (a merged p0v table) against eq. (P(0,v)) at r = 1/2 and 1/3
+    (bin averages in closed form, ``exact.outgoing_speed_bin_average``), else against the
+    solver's P(0, v) of eq. (inteq) (``solver_curve``: v, p0v), averaged over each bin like
+    the data (eq. (collrate), ``outgoing_speed_residuals``, as in Fig. 7).
+
+    Rows (without r): chi^2/n and the worst z of z = (simulation - reference) / p0v_err over
+    the bins with an error (not the under- and overflow bins, nor bins beyond the solver's
+    grid), and the largest relative error p0v_err / p0v over the bins with
+    0.01 <= v <= 5 (an empty bin there counts as an infinite relative error).
+    """
+    if Fraction(restitution) in exact.EXACT_RESTITUTIONS:
+        reference = "exact"
+        usable = (
+            (simulated.v_lo > 0.0)
+            & np.isfinite(simulated.v_hi)
+            & np.isfinite(simulated.p0v_err)
+            & (simulated.p0v_err > 0.0)
+        )
+        bins = simulated[usable]
+        truth = exact.outgoing_speed_bin_average(
+            bins.v_lo.to_numpy(), bins.v_hi.to_numpy(), restitution
+        )
+        where = bins.v.to_numpy()
+        z = (bins.p0v.to_numpy() - truth) / bins.p0v_err.to_numpy()
+    else:
+        if solver_curve is None:
+            raise ValueError(f"r = {restitution}: no exact P(0, v), and no solver curve given")
+        reference = "solver"
+        residuals = outgoing_speed_residuals(simulated, solver_curve)
+        where, z = residuals.v.to_numpy(), residuals.residual.to_numpy()
+    rows = _z_rows("p0v", reference, where, z, shards, "v")
+    low, high = QUALITY_SPEEDS
+    quality = simulated[(simulated.v >= low) & (simulated.v <= high)]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        relative = np.where(
+            (quality.p0v > 0.0) & np.isfinite(quality.p0v_err),
+            quality.p0v_err / quality.p0v,
+            np.inf,
+        )
+    if len(relative):
+        k = int(np.argmax(relative))
+        largest, at = float(relative[k]), float(quality.v.iloc[k])
+    else:
+        largest, at = np.nan, np.nan
+    rows.append(
+        {
+            "check": "p0v_largest_relative_error",
+            "reference": "none",
+            "bins": len(relative),
+            "value": largest,
+            "bin_centre": at,
+            "expected": np.nan,
+            "detail": f"max of p0v_err / p0v over the bins with {low:g} <= v <= {high:g}, "
+            f"at v = {_number(at, 3)}",
+        }
+    )
+    return rows
+
+
+def position_checks(position, restitution, shards):
+    """The simulated P(x) and <v^2>_x (a merged position table) against the exact bin
+    averages of eq. (P(x)2) and eq. (moment2) (``exact.position_bin_average``,
+    ``exact.speed_squared_given_position_bin_average``) at r = 1/2 and 1/3; no rows
+    for another r (no exact P(x) there).
+
+    Rows (without r): chi^2/n and the worst z over the bins inside 1e-3 <= x <= 50 that
+    have an error, for P(x) and for <v^2>_x.
+    """
+    if Fraction(restitution) not in exact.EXACT_RESTITUTIONS:
+        return []
+    low, high = POSITION_RANGE
+    inside = (
+        (position.x_lo >= low * (1.0 - 1e-9))
+        & (position.x_hi <= high * (1.0 + 1e-9))
+        & np.isfinite(position.x_hi)
+    )
+    rows = []
+    for quantity, bin_average in (
+        ("px", exact.position_bin_average),
+        ("v2_given_x", exact.speed_squared_given_position_bin_average),
+    ):
+        error = position[f"{quantity}_err"]
+        bins = position[inside & np.isfinite(error) & (error > 0.0)]
+        truth = np.asarray(
+            bin_average(bins.x_lo.to_numpy(), bins.x_hi.to_numpy(), restitution), dtype=float
+        )
+        z = (bins[quantity].to_numpy() - truth) / bins[f"{quantity}_err"].to_numpy()
+        for row in _z_rows(quantity, "exact", bins.x.to_numpy(), z, shards, "x"):
+            row["detail"] += f"; bins in {low:g} <= x <= {high:g}"
+            rows.append(row)
+    return rows
+
+
+def fit_checks(fits):
+    """The free-exponent fits of the asymptotic forms to the simulated P(0, v) (a fits
+    table, ``fits.asymptotic_fits``): per window (small v, eqs. (asym1), (asym2); large v,
+    eqs. (asym3)-(asym6)) the joint p-value of the theory's exponents (Hotelling's T^2 on
+    the jackknife covariance) and the fit's chi^2 per degree of freedom (per-bin errors
+    only: indicative, it ignores the correlations between bins).  A window without a
+    usable fit gives NaN values."""
+    chosen = fits[(fits.source == "simulation") & (fits.fit == "free_exponents")]
+    rows = []
+    for side in FIT_SIDES:
+        window = chosen[chosen.window == side]
+        if window.empty:
+            continue
+        first = window.iloc[0]
+        exponents = window[window.parameter != "prefactor"]
+        fitted = ", ".join(
+            f"{row.parameter} = {value_with_error(row.value, row.error)} "
+            f"(theory {_number(row.theory, 4)})"
+            for row in exponents.itertuples()
+        )
+        dof = int(first.dof) if np.isfinite(first.dof) else 0
+        bins = dof + len(window) if dof > 0 else 0
+        where = (
+            f"v in [{_number(first.v_min, 3)}, {_number(first.v_max, 3)}]"
+            if np.isfinite(first.v_min)
+            else "no usable window"
+        )
+        joint = float(first.joint_p_value)
+        if np.isfinite(first.v_min) and not np.isfinite(joint):
+            # Hotelling's T^2 needs more shards than free exponents (fits.fit_shards)
+            fitted += "; no joint test: too few shards for the exponents"
+        rows += [
+            {
+                "check": f"{side}_fit_joint_p_value",
+                "reference": "theory",
+                "bins": bins,
+                "value": joint,
+                "bin_centre": np.nan,
+                "expected": np.nan,
+                "detail": f"{where}; {fitted}",
+            },
+            {
+                "check": f"{side}_fit_chi2_per_dof",
+                "reference": "fit",
+                "bins": bins,
+                "value": float(first.chi2_per_dof),
+                "bin_centre": np.nan,
+                "expected": 1.0,
+                "detail": f"{where}; {dof} degrees of freedom; bins are correlated",
+            },
+        ]
+    return rows
+
+
+def validation_rows(
+    label, restitution, p0v, position, fits, shards, solver_curve=None
+) -> list[dict]:
+    """Every check of one r: ``outgoing_speed_checks``, ``position_checks`` and
+    ``fit_checks`` of the merged p0v and position tables and the fits table, each row
+    with the r label and r.  ``shards`` is the number of shards the errors come from."""
+    rows = [
+        *outgoing_speed_checks(p0v, restitution, shards, solver_curve),
+        *position_checks(position, restitution, shards),
+        *fit_checks(fits),
+    ]
+    return [{"r_label": label, "r": float(restitution), **row} for row in rows]
+
+
+def validation_table(rows) -> pd.DataFrame:
+    """The rows of ``validation_rows`` as a table of VALIDATION_COLUMNS."""
+    table = pd.DataFrame(rows, columns=list(VALIDATION_COLUMNS))
+    return table.astype({"bins": "int64"}) if len(table) else table
+
+
+def _shown_value(check, value):
+    if not np.isfinite(value):
+        return "inf" if value == np.inf else ""
+    if check.endswith("relative_error"):
+        percent = 100.0 * value
+        return f"{percent:.0f}%" if percent >= 10.0 else f"{percent:.2g}%"
+    if check.endswith("worst_bin"):
+        return f"{value:+.2f}"
+    return f"{value:.3g}"
+
+
+def validation_markdown(table: pd.DataFrame) -> str:
+    """The validation table for a reader: one line per r and check, values to 2-3 digits
+    (z to 2 decimals, relative errors in percent); no '|' in a cell."""
+    shown = pd.DataFrame(
+        {
+            "r": table.r_label.astype(str),
+            "check": table.check.map(VALIDATION_CHECKS),
+            "reference": table.reference,
+            "bins": table.bins.astype(str),
+            "value": [_shown_value(c, v) for c, v in zip(table.check, table.value)],
+            "at v or x": table.bin_centre.map(lambda value: _number(value, 3)),
+            "expected": table.expected.map(lambda value: _number(value, 3)),
+            "detail": table.detail,
+        }
+    )
+    return shown.to_markdown(index=False, disable_numparse=True) + "\n"

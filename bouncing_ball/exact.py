@@ -102,7 +102,9 @@ def speed_squared_given_position_bin_average(lo, hi, restitution):
 
     That is int_bin dx int_x^inf P(x') dx' / int_bin P(x) dx, the quantity a
     simulation bin measures.  For r = 1/2, int_x^inf P = u K1(u) with
-    u = sqrt(2x/3), and int u K1(u) dx = -3 u^2 K2(u).
+    u = sqrt(2x/3), and int u K1(u) dx = -3 u^2 K2(u).  For r = 1/3 both
+    integrals over x are done under the integral over F of eq. (P(x)2):
+    int_lo^hi dx int_x^inf e^{-F x'} dx' = (e^{-F lo} - e^{-F hi}) / F^2.
     """
     lo = np.asarray(lo, dtype=float)
     hi = np.asarray(hi, dtype=float)
@@ -115,17 +117,25 @@ def speed_squared_given_position_bin_average(lo, hi, restitution):
 
         numerator = primitive(hi) - primitive(lo)
     else:
-
-        def tail(x):
-            return integrate.quad(_position_density_third, x, np.inf, epsrel=1e-10, limit=200)[0]
-
         numerator = np.asarray(
-            [
-                integrate.quad(tail, a, b, epsrel=1e-9)[0]
-                for a, b in zip(np.atleast_1d(lo), np.atleast_1d(hi))
-            ]
+            [_tail_integral_third(a, b) for a, b in zip(np.atleast_1d(lo), np.atleast_1d(hi))]
         ).reshape(np.shape(lo))
     return numerator / (position_bin_average(lo, hi, restitution) * (hi - lo))
+
+
+def _tail_integral_third(lo, hi):
+    # int_lo^hi dx int_x^inf P(x') dx' at r = 1/3: (1/4 pi) int dF F^-1 K_{1/6}(z) e^{-z}
+    # (e^{-F lo} - e^{-F hi}) / F^2, z = 1/(12 F), in ln F as in _position_density_third
+    def integrand(log_f):
+        f = np.exp(log_f)
+        z = 1.0 / (12.0 * f)
+        difference = np.exp(-f * lo) * -np.expm1(-f * (hi - lo))
+        return special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z) * difference / (f * f)
+
+    # e^{-F lo} cuts off large F; at lo = 0 the integrand decays only as F^{-5/6} in ln F
+    upper = np.log(60.0 / lo) if lo > 0.0 else np.log(1.0e16 / hi)
+    value, _ = integrate.quad(integrand, -8.0, max(upper, 8.0), limit=400, epsabs=0.0, epsrel=1e-11)
+    return value / (4.0 * np.pi)
 
 
 def position_moments(restitution) -> dict:

@@ -40,6 +40,8 @@ STUDIES = (
     "studies",
     "tallies",
 )
+# results/tables/validation: the comparison, the exact bin averages, the solver curve's bin averages
+VALIDATION = ("bins", "comparison", "exact", "fits", "io")
 
 # what numba compiles: the modules with compiled functions and what those call into (the
 # key of numba's cache folder, bouncing_ball.jit); an edit elsewhere does not recompile

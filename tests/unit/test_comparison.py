@@ -9,10 +9,16 @@ import pytest
 from bouncing_ball import exact
 from bouncing_ball.comparison import (
     PAPER_VALUES,
+    VALIDATION_CHECKS,
+    fit_checks,
     moment_rows,
     moments_markdown,
     moments_table,
+    outgoing_speed_checks,
     outgoing_speed_residuals,
+    validation_markdown,
+    validation_rows,
+    validation_table,
     value_with_error,
 )
 
@@ -177,3 +183,176 @@ def test_a_curve_that_underflows_is_used_up_to_its_last_positive_value():
     last_positive = speeds[density > 0][-1]
     assert len(table) > 0 and table.v_hi.max() <= last_positive < edges[-1]
     assert np.isfinite(table.residual).all()
+
+
+def _position_bins(restitution, sigma, rng, lo=1e-3, hi=1e3, per_decade=5):
+    """A merged position table: exact bin averages of P(x) and <v^2>_x plus Gaussian noise
+    of relative size ``sigma``, with under- and overflow bins."""
+    edges = np.geomspace(lo, hi, int(round(per_decade * np.log10(hi / lo))) + 1)
+    px = exact.position_bin_average(edges[:-1], edges[1:], restitution)
+    v2 = exact.speed_squared_given_position_bin_average(edges[:-1], edges[1:], restitution)
+    n = len(px)
+    frame = pd.DataFrame(
+        {
+            "x_lo": np.r_[0.0, edges[:-1], hi],
+            "x_hi": np.r_[lo, edges[1:], np.inf],
+            "x": np.r_[lo / 2, np.sqrt(edges[:-1] * edges[1:]), np.inf],
+            "px": np.r_[1.0, px * (1.0 + sigma * rng.standard_normal(n)), np.nan],
+            "px_err": np.r_[0.1, sigma * px, np.nan],
+            "v2_given_x": np.r_[1.0, v2 * (1.0 + sigma * rng.standard_normal(n)), np.nan],
+            "v2_given_x_err": np.r_[0.1, sigma * v2, np.nan],
+        }
+    )
+    return frame
+
+
+def _fits_table(joint_p=0.4, chi2=1.1):
+    rows = []
+    for side, names in (
+        ("small_speed", ["prefactor", "beta"]),
+        ("large_speed", ["prefactor", "m", "q"]),
+    ):
+        for source in ("simulation", "solver"):
+            for fit in ("fixed_exponents", "free_exponents"):
+                for name in names:
+                    rows.append(
+                        {
+                            "source": source,
+                            "window": side,
+                            "fit": fit,
+                            "parameter": name,
+                            "value": 1.02,
+                            "error": 0.03,
+                            "theory": np.nan if name == "prefactor" else 1.0,
+                            "joint_p_value": joint_p if fit == "free_exponents" else np.nan,
+                            "chi2_per_dof": chi2 if source == "simulation" else 0.0,
+                            "dof": 10,
+                            "v_min": 1e-4 if side == "small_speed" else 2.0,
+                            "v_max": 1e-2 if side == "small_speed" else 10.0,
+                        }
+                    )
+    return pd.DataFrame(rows)
+
+
+def _by_check(rows):
+    return validation_table(rows).set_index("check")
+
+
+@pytest.mark.parametrize("restitution", exact.EXACT_RESTITUTIONS)
+def test_validation_of_noisy_exact_bins_gives_chi2_near_one(restitution):
+    """Bins of P(0, v) and P(x), <v^2>_x with Gaussian errors about the exact bin averages of
+    eqs. (P(0,v)), (P(x)2), (moment2): chi^2/n within 4 standard errors of 1, every
+    z within 5, reference 'exact', and the under-, overflow and empty bins left out."""
+    rng = np.random.default_rng(11)
+    p0v, _ = _simulated_bins(restitution, 0.01, rng, lo=1e-4, hi=100.0)
+    position = _position_bins(restitution, 0.01, rng)
+    rows = _by_check(validation_rows("label", restitution, p0v, position, _fits_table(), shards=16))
+    assert list(rows.index) == list(VALIDATION_CHECKS)
+    assert (rows.r_label == "label").all() and (rows.r == float(restitution)).all()
+    speeds = rows.loc["p0v_chi2_per_bin"]
+    assert speeds.reference == "exact" and speeds.bins == len(p0v) - 3
+    assert speeds.expected == pytest.approx(15.0 / 13.0)
+    assert abs(speeds.value - 1.0) < 4.0 * np.sqrt(2.0 / speeds.bins)
+    assert abs(rows.loc["p0v_worst_bin", "value"]) < 5.0
+    assert rows.loc["p0v_largest_relative_error", "value"] == pytest.approx(0.01, rel=0.05)
+    for quantity in ("px", "v2_given_x"):
+        row = rows.loc[f"{quantity}_chi2_per_bin"]
+        assert row.reference == "exact"
+        assert row.bins == 23  # x from 1e-3 to 10^1.6 <= 50 at 5 bins per decade
+        assert abs(row.value - 1.0) < 4.0 * np.sqrt(2.0 / row.bins)
+
+
+def test_validation_reports_a_planted_five_sigma_bin_as_the_worst_with_its_place():
+    rng = np.random.default_rng(12)
+    restitution = Fraction(1, 3)
+    p0v, _ = _simulated_bins(restitution, 0.01, rng, lo=1e-4, hi=100.0)
+    p0v.loc[20, "p0v"] += 5.0 * p0v.loc[20, "p0v_err"] - (
+        p0v.loc[20, "p0v"]
+        - exact.outgoing_speed_bin_average(p0v.loc[20, "v_lo"], p0v.loc[20, "v_hi"], restitution)
+    )
+    position = _position_bins(restitution, 0.01, rng)
+    position.loc[10, "v2_given_x"] -= 6.0 * position.loc[10, "v2_given_x_err"]
+    rows = _by_check(validation_rows("0.333333", restitution, p0v, position, _fits_table(), 16))
+    assert rows.loc["p0v_worst_bin", "value"] == pytest.approx(5.0)
+    assert rows.loc["p0v_worst_bin", "bin_centre"] == p0v.loc[20, "v"]
+    assert rows.loc["v2_given_x_worst_bin", "value"] < -5.0
+    assert rows.loc["v2_given_x_worst_bin", "bin_centre"] == position.loc[10, "x"]
+    assert rows.loc["p0v_chi2_per_bin", "value"] > 25.0 / rows.loc["p0v_chi2_per_bin", "bins"]
+
+
+def test_validation_relative_error_names_the_worst_bin_and_counts_empty_bins_as_infinite():
+    rng = np.random.default_rng(13)
+    p0v, _ = _simulated_bins(Fraction(1, 2), 0.01, rng)  # bins 1e-3 .. 10, row 5 empty
+    inside = p0v[(p0v.v >= 0.01) & (p0v.v <= 5.0)].index
+    p0v.loc[inside[3], "p0v_err"] = 0.2 * p0v.loc[inside[3], "p0v"]
+    rows = _by_check(outgoing_speed_checks(p0v, Fraction(1, 2), shards=8))
+    row = rows.loc["p0v_largest_relative_error"]
+    assert row.value == pytest.approx(0.2) and row.bin_centre == p0v.loc[inside[3], "v"]
+    assert row.bins == len(inside)
+    p0v.loc[inside[5], ["p0v", "p0v_err"]] = [0.0, np.nan]
+    assert (
+        _by_check(outgoing_speed_checks(p0v, Fraction(1, 2), 8)).loc[
+            "p0v_largest_relative_error", "value"
+        ]
+        == np.inf
+    )
+
+
+def test_validation_at_an_r_without_exact_solution_uses_the_solver_and_skips_p_x():
+    """At r = 0.6 the reference of P(0, v) is the solver's curve (here a curve 1% high, which
+    the residuals must show); there is no P(x) row."""
+    rng = np.random.default_rng(14)
+    restitution = Fraction(1, 2)
+    p0v, _ = _simulated_bins(restitution, 0.01, rng, lo=1e-4, hi=100.0)
+    speeds = np.geomspace(1e-4, 50.0, 401)
+    curve = pd.DataFrame(
+        {"v": speeds, "p0v": 1.01 * exact.outgoing_speed_density(speeds, restitution)}
+    )
+    rows = _by_check(
+        validation_rows("0.6", Fraction(3, 5), p0v, None, _fits_table(), 4, solver_curve=curve)
+    )
+    assert not any(check.startswith(("px", "v2")) for check in rows.index)
+    speeds_row = rows.loc["p0v_chi2_per_bin"]
+    assert speeds_row.reference == "solver" and speeds_row.expected == pytest.approx(3.0)
+    assert speeds_row.value > 1.5  # a 1-sigma shift doubles chi^2/n
+    with pytest.raises(ValueError, match="no exact"):
+        outgoing_speed_checks(p0v, Fraction(3, 5), 4)
+
+
+def test_validation_fit_rows_and_markdown():
+    rows = _by_check(fit_checks(_fits_table(joint_p=0.37, chi2=1.25)))
+    assert list(rows.index) == [
+        "small_speed_fit_joint_p_value",
+        "small_speed_fit_chi2_per_dof",
+        "large_speed_fit_joint_p_value",
+        "large_speed_fit_chi2_per_dof",
+    ]
+    assert rows.loc["large_speed_fit_joint_p_value", "value"] == 0.37
+    assert rows.loc["large_speed_fit_chi2_per_dof", "value"] == 1.25
+    assert rows.loc["large_speed_fit_chi2_per_dof", "bins"] == 13  # 10 dof + 3 parameters
+    assert "m = 1.020 ± 0.030 (theory 1)" in rows.loc["large_speed_fit_joint_p_value", "detail"]
+    rng = np.random.default_rng(15)
+    p0v, _ = _simulated_bins(Fraction(1, 2), 0.01, rng)
+    table = validation_table(
+        validation_rows(
+            "0.5", Fraction(1, 2), p0v, _position_bins(Fraction(1, 2), 0.01, rng), _fits_table(), 3
+        )
+    )
+    assert np.isnan(table.set_index("check").loc["p0v_chi2_per_bin", "expected"])
+    markdown = validation_markdown(table)
+    assert markdown.count("\n") == len(table) + 2
+    assert "P(0,v): largest relative error, 0.01 <= v <= 5" in markdown and "| 1%" in markdown
+    # one column separator per column and edge on every line: no '|' inside a cell
+    assert {line.count("|") for line in markdown.splitlines()} == {9}
+
+
+def test_validation_fit_rows_say_why_a_joint_p_value_is_missing():
+    fits = _fits_table()
+    fits.loc[fits.window == "large_speed", "joint_p_value"] = np.nan  # 2 shards, 2 exponents
+    fits.loc[fits.window == "small_speed", ["joint_p_value", "chi2_per_dof", "dof"]] = np.nan
+    fits.loc[fits.window == "small_speed", ["v_min", "v_max"]] = np.nan  # no usable window
+    rows = _by_check(fit_checks(fits))
+    assert "too few shards" in rows.loc["large_speed_fit_joint_p_value", "detail"]
+    assert rows.loc["small_speed_fit_joint_p_value", "detail"].startswith("no usable window")
+    assert rows.loc["small_speed_fit_chi2_per_dof", "bins"] == 0
+    assert np.isnan(rows.loc["small_speed_fit_chi2_per_dof", "value"])

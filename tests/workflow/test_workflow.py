@@ -7,6 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 import yaml
@@ -22,7 +23,7 @@ from workflow_support import (
     snakemake,
 )
 
-from bouncing_ball.comparison import MOMENT_COLUMNS
+from bouncing_ball.comparison import MOMENT_COLUMNS, VALIDATION_CHECKS
 from bouncing_ball.config import check_config
 from bouncing_ball.io import read_table
 
@@ -112,6 +113,19 @@ def test_run_produces_the_documented_tables(finished_run):
         assert len(fitted) == 20 and provenance["shards"] == {"0.5": 3, "0.333333": 2}[label]
 
 
+VALIDATION_COLUMNS = [
+    "r_label",
+    "r",
+    "check",
+    "reference",
+    "bins",
+    "value",
+    "bin_centre",
+    "expected",
+    "detail",
+]
+
+
 def test_run_draws_every_figure_and_writes_the_moments_table(finished_run):
     for name in FIGURES:
         content = (finished_run / name).read_bytes()
@@ -148,12 +162,31 @@ def test_run_draws_every_figure_and_writes_the_moments_table(finished_run):
     assert grid.collision_rate.iloc[2] == pytest.approx(1.0 / 3.0, rel=1e-8)
 
 
+def test_run_writes_the_validation_table(finished_run):
+    table = pd.read_csv(finished_run / "results/tables/validation.csv")
+    assert list(table.columns) == VALIDATION_COLUMNS
+    assert sorted(table.r_label.astype(str).unique()) == ["0.333333", "0.5"]
+    for label in ("0.5", "0.333333"):
+        rows = table[table.r_label.astype(str) == label].set_index("check")
+        assert list(rows.index) == list(VALIDATION_CHECKS), label  # every check, in order
+        for check in ("p0v", "px", "v2_given_x"):
+            row = rows.loc[f"{check}_chi2_per_bin"]
+            assert row.reference == "exact" and row.bins > 5, (label, check)
+            assert np.isfinite(row.value) and row.value > 0.0, (label, check)
+            assert np.isfinite(rows.loc[f"{check}_worst_bin", "bin_centre"]), (label, check)
+        assert np.isnan(rows.loc["p0v_chi2_per_bin", "expected"])  # 3 and 2 shards
+        assert rows.loc["p0v_largest_relative_error", "value"] > 0.0
+    markdown = (finished_run / "results/tables/validation.md").read_text()
+    assert markdown.count("\n") == len(table) + 2 and "P(0,v): chi^2/n" in markdown
+    assert (finished_run / "logs/tables/validation.log").exists()
+
+
 def test_the_report_has_every_figure_and_table_with_its_caption(finished_run, tmp_path):
     report = tmp_path / "report.html"
     result = snakemake(finished_run, "--report", str(report))
     assert result.returncode == 0, result.stderr[-3000:]
     text = report.read_text()
-    for name in [*(f"fig{n}.png" for n in range(1, 8)), "moments.csv"]:
+    for name in [*(f"fig{n}.png" for n in range(1, 8)), "moments.csv", "validation.csv"]:
         assert name in text, name
     for phrase in (
         "The exponents beta(r)",
@@ -164,6 +197,7 @@ def test_the_report_has_every_figure_and_table_with_its_caption(finished_run, tm
         "The mean height",
         "Residuals (simulation - solver) / sigma",
         "The time averages of eq. (xandDeltax)",
+        "The run held against the exact solutions",
     ):
         assert phrase in text, phrase
 
@@ -229,7 +263,7 @@ def test_adding_a_shard_runs_only_that_shard(finished_run, tmp_path):
     }
 
 
-AGGREGATES = {"fig6": 1, "fig7": 1, "moments_table": 1, "all": 1}
+AGGREGATES = {"fig6": 1, "fig7": 1, "moments_table": 1, "validation_table": 1, "all": 1}
 
 
 def test_adding_an_r_runs_only_its_jobs_and_the_aggregates(finished_run, tmp_path):
@@ -270,9 +304,15 @@ def test_adding_an_r_runs_only_its_jobs_and_the_aggregates(finished_run, tmp_pat
             *(f"results/figures/fig{n}.{ext}" for n in (6, 7) for ext in ("pdf", "png")),
             "results/tables/moments.csv",
             "results/tables/moments.md",
+            "results/tables/validation.csv",
+            "results/tables/validation.md",
         ]
     )
     assert len(pd.read_csv(directory / "results/tables/moments.csv")) == 9
+    validation = pd.read_csv(directory / "results/tables/validation.csv")
+    added = validation[validation.r_label.astype(str) == "0.6"]
+    assert "px_chi2_per_bin" not in set(added.check)  # no exact P(x) at r = 0.6
+    assert (added[added.check.str.startswith("p0v_chi2")].reference == "solver").all()
 
 
 def test_editing_a_plotting_script_reruns_only_figures(finished_run, tmp_path):
@@ -299,8 +339,10 @@ def test_one_target_builds_only_what_it_needs(tmp_path):
         "simulate_shard": 5,
         "merge_shards": 2,
         "solve": 2,
+        "fit": 2,
         "exact_solution": 2,
         "moments_table": 1,
+        "validation_table": 1,
         "tables": 1,
     }
     result = snakemake(directory, "results/figures/fig1.png")
@@ -350,14 +392,26 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
         "fig6": 1,
         "fig7": 1,
         "moments_table": 1,
+        "validation_table": 1,
     }
     for module, expected in (
         ("kernel", solved),
         ("solver", solved),
-        ("exact", {"exact_solution": 2, "fig3": 1, "fig5": 1, "fig6": 1, "moments_table": 1}),
-        ("fits", {"fit": 2, "fig4": 1, "fig7": 1, "moments_table": 1}),  # comparison uses fits
+        (
+            "exact",
+            {
+                "exact_solution": 2,
+                "fig3": 1,
+                "fig5": 1,
+                "fig6": 1,
+                "moments_table": 1,
+                "validation_table": 1,  # the exact bin averages
+            },
+        ),
+        # comparison uses fits
+        ("fits", {"fit": 2, "fig4": 1, "fig7": 1, "moments_table": 1, "validation_table": 1}),
         ("asymptotics", {**solved, "theory": 1, "fig1": 1, "fig2": 1}),
-        ("comparison", {"fig7": 1, "moments_table": 1}),
+        ("comparison", {"fig7": 1, "moments_table": 1, "validation_table": 1}),
     ):
         shutil.rmtree(package.parent)
         package, env = _packagecopy_repository(tmp_path)

@@ -34,6 +34,7 @@ FIT_CODE = source_digest(stages.FITS)
 FIGURE_CODE = source_digest(stages.PLOTTING)
 RESIDUALS_CODE = source_digest(stages.PLOTTING + stages.COMPARISON)
 TABLE_CODE = source_digest(stages.COMPARISON)
+VALIDATION_CODE = source_digest(stages.VALIDATION)
 
 # the r values with an exact solution, eq. (P(0,v)): always computed (Figs. 3 and 5)
 EXACT_BY_LABEL = {restitution_label(value): value for value in EXACT_RESTITUTIONS}
@@ -115,4 +116,9 @@ def figure_targets():
 
 
 def table_targets():
-    return ["results/tables/moments.csv", "results/tables/moments.md"]
+    return [
+        "results/tables/moments.csv",
+        "results/tables/moments.md",
+        "results/tables/validation.csv",
+        "results/tables/validation.md",
+    ]

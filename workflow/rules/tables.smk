@@ -1,5 +1,5 @@
 # The tables: the time averages of eq. (xandDeltax) at every simulated r, against the
-# paper, the exact solutions and the solver.
+# paper, the exact solutions and the solver (moments); the run's validation checks.
 
 
 rule moments_table:
@@ -30,3 +30,33 @@ rule moments_table:
         code=TABLE_CODE,
     script:
         "../../scripts/moments_table.py"
+
+
+# The run's own validation: the simulated P(0,v), P(x) and <v^2>_x against the exact
+# solutions (r = 1/2, 1/3) or the solver, and the free-exponent fits against the theory.
+rule validation_table:
+    input:
+        p0v=expand("results/simulation/r{r}/p0v.parquet", r=RESTITUTION),
+        position=expand("results/simulation/r{r}/position.parquet", r=RESTITUTION),
+        solver=expand("results/solver/r{r}/p0v.parquet", r=RESTITUTION),
+        fits=expand("results/fits/r{r}.parquet", r=RESTITUTION),
+    output:
+        csv=report(
+            "results/tables/validation.csv",
+            caption="../report/validation.rst",
+            category="Tables",
+        ),
+        md="results/tables/validation.md",
+    log:
+        "logs/tables/validation.log",
+    localrule: True
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=500,
+        cpus_per_task=1,
+    params:
+        code=VALIDATION_CODE,
+    script:
+        "../../scripts/validation_table.py"

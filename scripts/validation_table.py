@@ -1,0 +1,76 @@
+"""Rule validation_table: the run held against the exact solutions, the solver and the theory
+for every simulated r: P(0, v) against eq. (P(0,v)) (r = 1/2, 1/3) or the solver's curve,
+P(x) and <v^2>_x against eqs. (P(x)2), (moment2) (r = 1/2, 1/3), and the free-exponent fits
+of the asymptotic forms -> results/tables/validation.csv (one row per r and check) and
+validation.md."""
+
+import logging
+from pathlib import Path
+
+from bouncing_ball.comparison import validation_markdown, validation_rows, validation_table
+from bouncing_ball.io import atomic_path, read_tables_of_one_restitution, require_columns
+from bouncing_ball.jobs import job_log
+from bouncing_ball.restitution import parse_restitution
+
+P0V_COLUMNS = ["v_lo", "v_hi", "v", "p0v", "p0v_err", "count"]
+POSITION_COLUMNS = ["x_lo", "x_hi", "x", "px", "px_err", "v2_given_x", "v2_given_x_err"]
+FIT_COLUMNS = [
+    "source",
+    "window",
+    "fit",
+    "parameter",
+    "value",
+    "error",
+    "theory",
+    "joint_p_value",
+    "chi2_per_dof",
+    "dof",
+    "v_min",
+    "v_max",
+]
+
+with job_log(snakemake.log[0]):
+    rows = []
+    inputs = zip(
+        snakemake.input.p0v,
+        snakemake.input.position,
+        snakemake.input.solver,
+        snakemake.input.fits,
+        strict=True,
+    )
+    for paths in inputs:
+        (p0v, provenance), (position, _), (curve, _), (fits, _) = read_tables_of_one_restitution(
+            *paths
+        )
+        for table, path, columns in zip(
+            (p0v, position, curve, fits),
+            paths,
+            (P0V_COLUMNS, POSITION_COLUMNS, ["v", "p0v"], FIT_COLUMNS),
+            strict=True,
+        ):
+            require_columns(table, path, columns)
+        rows += validation_rows(
+            provenance["r_label"],
+            parse_restitution(provenance["r"]),
+            p0v,
+            position,
+            fits,
+            int(provenance["shards"]),
+            solver_curve=curve,
+        )
+    table = validation_table(rows)
+    with atomic_path(snakemake.output.csv) as path:
+        table.to_csv(path, index=False, float_format="%.12g")
+    with atomic_path(snakemake.output.md) as path:
+        Path(path).write_text(validation_markdown(table))
+    for row in table.itertuples():
+        logging.info(
+            "r=%s %s (vs %s, %d bins): %.4g (expected %.4g) at %.3g",
+            row.r_label,
+            row.check,
+            row.reference,
+            row.bins,
+            row.value,
+            row.expected,
+            row.bin_centre,
+        )
