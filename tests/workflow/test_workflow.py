@@ -23,7 +23,7 @@ from workflow_support import (
     snakemake,
 )
 
-from bouncing_ball.comparison import MOMENT_COLUMNS, VALIDATION_CHECKS
+from bouncing_ball.comparison import MOMENT_COLUMNS, VALIDATION_CHECKS, VALIDATION_COLUMNS
 from bouncing_ball.config import check_config
 from bouncing_ball.io import read_table
 
@@ -111,19 +111,6 @@ def test_run_produces_the_documented_tables(finished_run):
             "v_max",
         ]
         assert len(fitted) == 20 and provenance["shards"] == {"0.5": 3, "0.333333": 2}[label]
-
-
-VALIDATION_COLUMNS = [
-    "r_label",
-    "r",
-    "check",
-    "reference",
-    "bins",
-    "value",
-    "bin_centre",
-    "expected",
-    "detail",
-]
 
 
 def test_run_draws_every_figure_and_writes_the_moments_table(finished_run):
