@@ -151,7 +151,7 @@ def test_run_draws_every_figure_and_writes_the_moments_table(finished_run):
 
 def test_run_writes_the_validation_table(finished_run):
     table = pd.read_csv(finished_run / "results/tables/validation.csv")
-    assert list(table.columns) == VALIDATION_COLUMNS
+    assert list(table.columns) == list(VALIDATION_COLUMNS)
     assert sorted(table.r_label.astype(str).unique()) == ["0.333333", "0.5"]
     for label in ("0.5", "0.333333"):
         rows = table[table.r_label.astype(str) == label].set_index("check")
