@@ -1,6 +1,7 @@
 """A failing job says why in its rule's log, with its traceback, and leaves no half output."""
 
 import copy
+import re
 
 from workflow_support import SMALL, copy_repository, snakemake
 
@@ -22,10 +23,10 @@ def test_a_shard_that_recorded_nothing_is_refused_by_the_merge_with_the_reason_i
     targets = [f"results/simulation/r{label}/summary.parquet" for label in ("0.5", "0.05")]
     result = snakemake(directory, "--keep-going", *targets)
     assert result.returncode != 0
-    shard_log = (directory / "logs/simulation/r0.5/shard0.log").read_text()
-    assert "STEP BUDGET EXHAUSTED" in shard_log
+    shard_logs = [(directory / f"logs/simulation/r0.5/shard{k}.log").read_text() for k in (0, 1)]
+    assert any("STEP BUDGET EXHAUSTED" in log for log in shard_logs)
     budget = (directory / "logs/simulation/r0.5/merge.log").read_text()
-    assert "shard0.parquet: recorded no time" in budget and "Raise the budget" in budget
+    assert re.search(r"shard\d\.parquet: recorded no time", budget) and "Raise the budget" in budget
     collapse = (directory / "logs/simulation/r0.05/merge.log").read_text()
     assert "below r_c" in collapse and "simulation.min_step_floor" in collapse
     for log in (budget, collapse):

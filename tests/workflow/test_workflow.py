@@ -119,7 +119,7 @@ def test_run_draws_every_figure_and_writes_the_moments_table(finished_run):
         assert content.startswith(b"%PDF" if name.endswith(".pdf") else b"\x89PNG"), name
         assert (finished_run / "logs/figures" / (Path(name).stem + ".log")).exists()
     table = pd.read_csv(finished_run / "results/tables/moments.csv")
-    assert list(table.columns) == MOMENT_COLUMNS and len(table) == 6
+    assert list(table.columns) == list(MOMENT_COLUMNS) and len(table) == 6
     assert sorted(table.r_label.astype(str).unique()) == ["0.333333", "0.5"]
     assert (table.reference == "exact").all()
     for label, paper in (
