@@ -101,3 +101,11 @@ def read_tables_of_one_restitution(*paths) -> list[tuple[pd.DataFrame, dict]]:
         )
         raise UnreadableFileError(f"not the same r: {which}")
     return tables
+
+
+def write_csv_and_markdown(table: pd.DataFrame, csv_path, markdown_path, markdown: str) -> None:
+    """A results table as CSV (12 significant digits) and its Markdown rendering, each atomic."""
+    with atomic_path(csv_path) as path:
+        table.to_csv(path, index=False, float_format="%.12g")
+    with atomic_path(markdown_path) as path:
+        Path(path).write_text(markdown)

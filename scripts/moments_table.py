@@ -4,14 +4,13 @@ simulation's with its error, and the z-score against the exact value (or the sol
 there is none) -> results/tables/moments.csv (one row per r and quantity) and moments.md."""
 
 import logging
-from pathlib import Path
 
 from bouncing_ball.comparison import QUANTITIES, moment_rows, moments_markdown, moments_table
 from bouncing_ball.io import (
-    atomic_path,
     read_table,
     read_tables_of_one_restitution,
     require_columns,
+    write_csv_and_markdown,
 )
 from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import parse_restitution
@@ -39,10 +38,9 @@ with job_log(snakemake.log[0]):
             exact.get(restitution),
         )
     table = moments_table(rows)
-    with atomic_path(snakemake.output.csv) as path:
-        table.to_csv(path, index=False, float_format="%.12g")
-    with atomic_path(snakemake.output.md) as path:
-        Path(path).write_text(moments_markdown(table))
+    write_csv_and_markdown(
+        table, snakemake.output.csv, snakemake.output.md, moments_markdown(table)
+    )
     for row in table.itertuples():
         logging.info(
             "r=%s %s: simulation %.6g +- %.2g, %s %.10g, z = %+.2f",

@@ -5,10 +5,9 @@ of the asymptotic forms -> results/tables/validation.csv (one row per r and chec
 validation.md."""
 
 import logging
-from pathlib import Path
 
 from bouncing_ball.comparison import validation_markdown, validation_rows, validation_table
-from bouncing_ball.io import atomic_path, read_tables_of_one_restitution, require_columns
+from bouncing_ball.io import read_tables_of_one_restitution, require_columns, write_csv_and_markdown
 from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import parse_restitution
 
@@ -59,10 +58,9 @@ with job_log(snakemake.log[0]):
             solver_curve=curve,
         )
     table = validation_table(rows)
-    with atomic_path(snakemake.output.csv) as path:
-        table.to_csv(path, index=False, float_format="%.12g")
-    with atomic_path(snakemake.output.md) as path:
-        Path(path).write_text(validation_markdown(table))
+    write_csv_and_markdown(
+        table, snakemake.output.csv, snakemake.output.md, validation_markdown(table)
+    )
     for row in table.itertuples():
         logging.info(
             "r=%s %s (vs %s, %d bins): %.4g (expected %.4g) at %.3g",

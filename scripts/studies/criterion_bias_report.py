@@ -2,9 +2,8 @@
 r = 1/2 and 1/3 results, with its cost -> results/studies/criterion_bias.{csv,md}."""
 
 import logging
-from pathlib import Path
 
-from bouncing_ball.io import atomic_path
+from bouncing_ball.io import write_csv_and_markdown
 from bouncing_ball.jobs import job_log
 from bouncing_ball.studies import (
     criterion_bias_markdown,
@@ -22,10 +21,9 @@ with job_log(snakemake.log[0]):
             for run in runs
         ]
     )
-    with atomic_path(snakemake.output.csv) as path:
-        table.to_csv(path, index=False, float_format="%.12g")
-    with atomic_path(snakemake.output.md) as path:
-        Path(path).write_text(criterion_bias_markdown(table))
+    write_csv_and_markdown(
+        table, snakemake.output.csv, snakemake.output.md, criterion_bias_markdown(table)
+    )
     for row in table.itertuples():
         logging.info(
             "r=%s c=%g, %d shards: <x> z = %+.2f, Delta x z = %+.2f, I z = %+.2f; "

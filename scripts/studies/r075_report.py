@@ -2,12 +2,16 @@
 solver, and checks of their errors -> results/studies/r075.{csv,md}."""
 
 import logging
-from pathlib import Path
 
 import pandas as pd
 
 from bouncing_ball.comparison import QUANTITIES
-from bouncing_ball.io import UnreadableFileError, atomic_path, read_table, require_columns
+from bouncing_ball.io import (
+    UnreadableFileError,
+    read_table,
+    require_columns,
+    write_csv_and_markdown,
+)
 from bouncing_ball.jobs import job_log
 from bouncing_ball.studies import r075_markdown, r075_rows, read_runs
 
@@ -37,10 +41,8 @@ with job_log(snakemake.log[0]):
             *sizes,
         )
     table = pd.DataFrame(rows)
-    with atomic_path(snakemake.output.csv) as path:
-        table.to_csv(path, index=False, float_format="%.12g")
-    with atomic_path(snakemake.output.md) as path:
-        Path(path).write_text(r075_markdown(table, label))
+    markdown = r075_markdown(table, label)
+    write_csv_and_markdown(table, snakemake.output.csv, snakemake.output.md, markdown)
     for row in table.itertuples():
         logging.info(
             "%s (%d shards) %s: %.8g +- %.2g, solver %.10g, %+.4f +- %.4f%%, z = %+.2f",
