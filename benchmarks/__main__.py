@@ -1,5 +1,5 @@
 """python -m benchmarks [--json] [--scaling]: see benchmarks/benchmark.py."""
 
-from .benchmark import main
+from .benchmark import run_single_threaded
 
-main()
+run_single_threaded("benchmarks")

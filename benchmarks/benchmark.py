@@ -535,9 +535,14 @@ def main(argv=None):
     return 0
 
 
-if __name__ == "__main__":
+def run_single_threaded(module="benchmarks"):
+    """``main()`` with BLAS pinned to one thread, as Snakemake does in every job: the
+    variables are read when numpy is first imported, so start again with them set."""
     if any(os.environ.get(name) != "1" for name in SINGLE_THREAD):
-        # BLAS reads these when numpy is first imported: start again with them set
         os.environ.update(dict.fromkeys(SINGLE_THREAD, "1"))
-        os.execv(sys.executable, [sys.executable, "-m", "bouncing_ball.benchmark", *sys.argv[1:]])
+        os.execv(sys.executable, [sys.executable, "-m", module, *sys.argv[1:]])
     sys.exit(main())
+
+
+if __name__ == "__main__":
+    run_single_threaded("benchmarks.benchmark")

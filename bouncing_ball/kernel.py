@@ -41,7 +41,7 @@ import numpy as np
 
 from .jit import njit, prange
 
-# Gauss-Legendre order of the tau integral: 2e-13 of a 64-node rule (``tests/test_kernel.py``)
+# Gauss-Legendre order of the tau integral: 2e-13 of a 64-node rule (``tests/unit/test_kernel.py``)
 TAU_NODES = 20
 # exp(-TAIL^2) ~ 1e-18: the cut of the tau integral for large z0
 TAIL = 6.4

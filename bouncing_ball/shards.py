@@ -47,7 +47,7 @@ def read_shards(paths, label):
                 f"r = {provenance['r']} is below r_c = {CRITICAL_RESTITUTION:.4f}: the particle collapses onto "
                 "the floor (infinitely many collisions in a finite time) and a larger budget cannot help. "
                 "Set simulation.min_step_floor (e.g. 1.0e-10, per r under simulation.per_restitution) "
-                "to regularise the collapse (README, 'Below r_c')."
+                "to regularise the collapse (docs/methods.md, 'Below r_c')."
                 if below and not provenance.get("min_step_floor", 0.0) > 0.0
                 else "Raise the budget or shorten equilibration_time, then rerun this shard."
             )

@@ -46,7 +46,7 @@ v_out falls below about (2 min_step_floor)^(1/2) a single step's noise
 exceeds the speed and lifts the particle off the floor: the collapse is
 cut off at speeds of order (2 min_step_floor)^(1/2).
 What the regularised process gives above that speed scale, and how I grows
-as the floor goes to zero, is measured, not assumed (README).
+as the floor goes to zero, is measured, not assumed (docs/methods.md, 'Below r_c').
 """
 
 import math
