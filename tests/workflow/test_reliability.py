@@ -58,6 +58,9 @@ def _start(directory):
         stderr=subprocess.STDOUT,
         text=True,
         start_new_session=True,
+        # as in a terminal: a background job of a non-interactive shell (a CI script, nohup
+        # ... &) inherits SIGINT ignored, and Python then never raises KeyboardInterrupt
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
 
 
@@ -79,8 +82,8 @@ def _press_ctrl_c(run, presses=5, patience=1.0):
     """SIGINT to the whole process group, as Ctrl-C in a terminal sends, again after
     ``patience`` seconds while Snakemake still runs, as a user would press it again.
     Snakemake 9.27 swallows a KeyboardInterrupt that arrives while its log handler writes
-    a line (logging.py: ``except (KeyboardInterrupt, SystemExit): pass``), and its jobs do
-    not see SIGINT, so now and then the first press is lost."""
+    a line (logging.py: ``except (KeyboardInterrupt, SystemExit): pass``), so a first
+    press can be lost."""
     for _ in range(presses):
         os.killpg(run.pid, signal.SIGINT)
         try:
