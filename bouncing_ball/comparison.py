@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from . import exact, stages
-from .fits import bin_averages_of_curve, usable_curve
+from .fits import LARGE_SPEED, SMALL_SPEED, bin_averages_of_curve, usable_curve
 
 SOURCES = stages.COMPARISON
 
@@ -140,6 +140,28 @@ def outgoing_speed_residuals(simulated: pd.DataFrame, solver_curve: pd.DataFrame
     )
 
 
+def exact_outgoing_speed_residuals(simulated: pd.DataFrame, restitution) -> pd.DataFrame:
+    """(simulation - exact) / sigma per finite bin with an error of a merged p0v table at
+    r = 1/2 or 1/3, the exact bin averages of eq. (P(0,v)) in closed form
+    (``exact.outgoing_speed_bin_average``); columns v, residual."""
+    usable = (
+        (simulated.v_lo > 0.0)
+        & np.isfinite(simulated.v_hi)
+        & np.isfinite(simulated.p0v_err)
+        & (simulated.p0v_err > 0.0)
+    )
+    bins = simulated[usable]
+    truth = exact.outgoing_speed_bin_average(
+        bins.v_lo.to_numpy(), bins.v_hi.to_numpy(), restitution
+    )
+    return pd.DataFrame(
+        {
+            "v": bins.v.to_numpy(),
+            "residual": (bins.p0v.to_numpy() - truth) / bins.p0v_err.to_numpy(),
+        }
+    )
+
+
 # results/tables/validation.{csv,md}: one row per r and check (long format)
 VALIDATION_COLUMNS = (
     "r_label",
@@ -172,7 +194,7 @@ VALIDATION_CHECKS = {
 QUALITY_SPEEDS = (0.01, 5.0)
 # the heights over which P(x) and <v^2>_x are held against eqs. (P(x)2), (moment2)
 POSITION_RANGE = (1.0e-3, 50.0)
-FIT_SIDES = ("small_speed", "large_speed")
+FIT_SIDES = (SMALL_SPEED, LARGE_SPEED)
 
 
 def expected_chi2_per_bin(shards):
@@ -226,24 +248,13 @@ def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None):
     """
     if Fraction(restitution) in exact.EXACT_RESTITUTIONS:
         reference = "exact"
-        usable = (
-            (simulated.v_lo > 0.0)
-            & np.isfinite(simulated.v_hi)
-            & np.isfinite(simulated.p0v_err)
-            & (simulated.p0v_err > 0.0)
-        )
-        bins = simulated[usable]
-        truth = exact.outgoing_speed_bin_average(
-            bins.v_lo.to_numpy(), bins.v_hi.to_numpy(), restitution
-        )
-        where = bins.v.to_numpy()
-        z = (bins.p0v.to_numpy() - truth) / bins.p0v_err.to_numpy()
+        residuals = exact_outgoing_speed_residuals(simulated, restitution)
     else:
         if solver_curve is None:
             raise ValueError(f"r = {restitution}: no exact P(0, v), and no solver curve given")
         reference = "solver"
         residuals = outgoing_speed_residuals(simulated, solver_curve)
-        where, z = residuals.v.to_numpy(), residuals.residual.to_numpy()
+    where, z = residuals.v.to_numpy(), residuals.residual.to_numpy()
     rows = _z_rows("p0v", reference, where, z, shards, "v")
     low, high = QUALITY_SPEEDS
     quality = simulated[(simulated.v >= low) & (simulated.v <= high)]

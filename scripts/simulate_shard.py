@@ -1,4 +1,5 @@
-"""Rule simulate_shard: one shard of one r, the paper's Sec. IV -> results/simulation/r{r}/shard{k}.parquet."""
+"""Rules simulate_shard and study_shard: one shard of one r, the paper's Sec. IV
+-> results/simulation/r{r}/shard{k}.parquet (or results/studies/{study}/{run}/shard{k}.parquet)."""
 
 import logging
 import time
@@ -15,27 +16,31 @@ with job_log(snakemake.log[0]):
     label = restitution_label(exact)
     shard, seed = int(snakemake.wildcards.shard), snakemake.params.seed
     settings = ShardSettings.from_mapping(snakemake.params.settings)
-    started = time.perf_counter()
+    started, started_cpu = time.perf_counter(), time.process_time()
     tallies = simulate_shard(float(exact), shard_seed_sequence(seed, label, shard), settings)
-    elapsed = time.perf_counter() - started
+    elapsed, cpu_seconds = time.perf_counter() - started, time.process_time() - started_cpu
     provenance = {
-        "rule": "simulate_shard",
+        "rule": snakemake.rule,
         "r": exact_string(exact),
         "r_label": label,
         "shard": shard,
         "seed": seed,
         "code": snakemake.params.code,
+        # the cost of the shard (the studies' efficiency figures); not compared between shards
+        "cpu_seconds": cpu_seconds,
         **settings.as_mapping(),
     }
     write_table(tallies_to_frame(tallies), snakemake.output[0], provenance)
     logging.info(
-        "r=%s shard %d: time %.6g, %d collisions, %d steps, %.1f s%s",
+        "r=%s c=%g shard %d: time %.6g, %d collisions, %d steps, %.1f s (%.1f CPU s)%s",
         label,
+        settings.criterion_c,
         shard,
         tallies.time,
         tallies.collisions,
         tallies.steps,
         elapsed,
+        cpu_seconds,
         " -- STOPPED EARLY: STEP BUDGET EXHAUSTED (simulation.max_steps) or the speed collapsed "
         "towards 0 (below or near r_c; see simulation.min_step_floor)"
         if tallies.budget_exhausted

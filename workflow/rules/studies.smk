@@ -64,7 +64,7 @@ rule study_shard:
         settings=lambda w: STUDY_RUNS[w.study][w.run].settings.as_mapping(),
         code=SIMULATION_CODE,
     script:
-        "../../scripts/studies/study_shard.py"
+        "../../scripts/simulate_shard.py"
 
 
 rule criterion_bias_report:
