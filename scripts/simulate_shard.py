@@ -26,10 +26,12 @@ with job_log(snakemake.log[0]):
         "shard": shard,
         "seed": seed,
         "code": snakemake.params.code,
-        # the cost of the shard (the studies' efficiency figures); not compared between shards
-        "cpu_seconds": cpu_seconds,
         **settings.as_mapping(),
     }
+    # a study shard records its cost (the studies' efficiency figures); the pipeline's shards
+    # do not, so that the same config makes the same files, provenance included
+    if getattr(snakemake.params, "record_cpu_seconds", False):
+        provenance["cpu_seconds"] = cpu_seconds
     write_table(tallies_to_frame(tallies), snakemake.output[0], provenance)
     logging.info(
         "r=%s c=%g shard %d: time %.6g, %d collisions, %d steps, %.1f s (%.1f CPU s)%s",

@@ -65,6 +65,8 @@ def test_run_produces_the_documented_tables(finished_run):
         assert p0v["count"].sum() == summary.collisions.iloc[0]
     _, provenance = read_table(finished_run / "results/simulation/r0.333333/shard0.parquet")
     assert provenance["r"] == "1/3" and provenance["seed"] == 5
+    # no measured cost in a pipeline shard's provenance: the same config, the same file
+    assert "cpu_seconds" not in provenance
     assert (finished_run / "logs/simulation/r0.5/merge.log").read_text().startswith("r=0.5")
     for label in ("0.5", "0.333333"):
         p0v, provenance = read_table(finished_run / f"results/solver/r{label}/p0v.parquet")

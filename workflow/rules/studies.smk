@@ -63,6 +63,7 @@ rule study_shard:
         seed=lambda w: STUDY_RUNS[w.study][w.run].seed,
         settings=lambda w: STUDY_RUNS[w.study][w.run].settings.as_mapping(),
         code=SIMULATION_CODE,
+        record_cpu_seconds=True,
     script:
         "../../scripts/simulate_shard.py"
 
