@@ -24,39 +24,74 @@ class UnreadableFileError(RuntimeError):
 
 
 @contextmanager
-def atomic_path(path):
-    """A temporary name next to ``path`` to write to; renamed to ``path`` only if the
-    block finishes, removed otherwise, so a reader never sees a half-written file."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    for stale in path.parent.glob(f".{path.stem}.*{path.suffix}"):
-        stale.unlink(
-            missing_ok=True
-        )  # left by a writer that was killed (SIGKILL skips the cleanup below)
-    handle, temporary = tempfile.mkstemp(
-        prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent
-    )
-    os.close(handle)
+def atomic_paths(*paths):
+    """Temporary names next to ``paths`` to write to; all are renamed to ``paths`` only
+    if the block finishes, all removed otherwise: a reader never sees a half-written
+    file, and a rule's outputs appear together or not at all."""
+    paths = [Path(path) for path in paths]
+    temporaries = []
     try:
-        yield temporary
-        os.replace(temporary, path)
+        for path in paths:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            for stale in path.parent.glob(f".{path.stem}.*{path.suffix}"):
+                # left by a writer that was killed (SIGKILL skips the cleanup below)
+                stale.unlink(missing_ok=True)
+            handle, temporary = tempfile.mkstemp(
+                prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent
+            )
+            os.close(handle)
+            temporaries.append(temporary)
+            # mkstemp makes the file private (0600); a result gets the mode the user's
+            # umask gives any new file (0644 under umask 022), so colleagues can read it
+            os.chmod(temporary, 0o666 & ~_umask())
+        yield temporaries
     except BaseException:
-        Path(temporary).unlink(missing_ok=True)
+        for temporary in temporaries:
+            Path(temporary).unlink(missing_ok=True)
+        raise
+    renamed = []
+    try:
+        for temporary, path in zip(temporaries, paths, strict=True):
+            os.replace(temporary, path)
+            renamed.append(path)
+    except BaseException:
+        # a rename failed (e.g. a directory where a file should go): take back the new
+        # files already in place, so that none of the set is left without the others
+        for path in renamed:
+            path.unlink(missing_ok=True)
+        for temporary in temporaries:
+            Path(temporary).unlink(missing_ok=True)
         raise
 
 
-def write_table(frame: pd.DataFrame, path, provenance: dict) -> None:
-    """Write ``frame`` to ``path`` with ``provenance``; atomic (temp file, then rename)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+def _umask() -> int:
+    """The process's umask (reading it means setting it; set straight back)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _with_provenance(frame: pd.DataFrame, provenance: dict) -> pa.Table:
     table = pa.Table.from_pandas(frame, preserve_index=False)
     metadata = dict(table.schema.metadata or {})
     metadata[METADATA_KEY] = json.dumps(
         {"package_version": __version__, **provenance}, sort_keys=True, default=str
     ).encode()
-    table = table.replace_schema_metadata(metadata)
-    with atomic_path(path) as temporary:
-        pq.write_table(table, temporary)
+    return table.replace_schema_metadata(metadata)
+
+
+def write_tables(frames: dict, provenance: dict) -> None:
+    """Write each frame of ``{path: frame}`` with ``provenance``; all or none of them
+    appear (``atomic_paths``), as a rule's outputs should."""
+    tables = [_with_provenance(frame, provenance) for frame in frames.values()]
+    with atomic_paths(*frames) as temporaries:
+        for table, temporary in zip(tables, temporaries, strict=True):
+            pq.write_table(table, temporary)
+
+
+def write_table(frame: pd.DataFrame, path, provenance: dict) -> None:
+    """Write ``frame`` to ``path`` with ``provenance``; atomic (temp file, then rename)."""
+    write_tables({path: frame}, provenance)
 
 
 def read_table(path) -> tuple[pd.DataFrame, dict]:
@@ -105,7 +140,6 @@ def read_tables_of_one_restitution(*paths) -> list[tuple[pd.DataFrame, dict]]:
 
 def write_csv_and_markdown(table: pd.DataFrame, csv_path, markdown_path, markdown: str) -> None:
     """A results table as CSV (12 significant digits) and its Markdown rendering, each atomic."""
-    with atomic_path(csv_path) as path:
-        table.to_csv(path, index=False, float_format="%.12g")
-    with atomic_path(markdown_path) as path:
-        Path(path).write_text(markdown)
+    with atomic_paths(csv_path, markdown_path) as (csv_temporary, markdown_temporary):
+        table.to_csv(csv_temporary, index=False, float_format="%.12g")
+        Path(markdown_temporary).write_text(markdown)

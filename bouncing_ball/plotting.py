@@ -16,7 +16,7 @@ import numpy as np  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
 from . import __version__, stages  # noqa: E402
-from .io import atomic_path  # noqa: E402
+from .io import atomic_paths  # noqa: E402
 from .restitution import exact_string  # noqa: E402
 
 SOURCES = stages.PLOTTING
@@ -68,7 +68,8 @@ def _styled(function):
 
 
 def save_figure(figure, pdf, png, dpi, provenance: dict) -> None:
-    """Write the figure as PDF and PNG, each atomically (temporary name, then rename).
+    """Write the figure as PDF and PNG, atomically and together (temporary names, renamed
+    when both are complete: ``io.atomic_paths``).
 
     The provenance goes into the files' metadata; the PDF carries no creation
     date, so the same tables give the same file.
@@ -76,25 +77,18 @@ def save_figure(figure, pdf, png, dpi, provenance: dict) -> None:
     description = json.dumps(
         {"package_version": __version__, **provenance}, sort_keys=True, default=str
     )
-    for path, metadata, options in (
-        (
-            pdf,
-            {
-                "Creator": f"bouncing_ball {__version__}",
-                "Subject": description,
-                "CreationDate": None,
-            },
-            {},
-        ),
-        (
-            png,
-            {"Software": f"bouncing_ball {__version__}", "Description": description},
-            {"dpi": dpi},
-        ),
-    ):
-        with atomic_path(path) as temporary, matplotlib.rc_context(STYLE):
-            figure.savefig(temporary, metadata=metadata, **options)
-        logging.info("wrote %s", path)
+    pdf_metadata, png_metadata = (
+        {
+            "Creator": f"bouncing_ball {__version__}",
+            "Subject": description,
+            "CreationDate": None,
+        },
+        {"Software": f"bouncing_ball {__version__}", "Description": description},
+    )
+    with atomic_paths(pdf, png) as (pdf_temporary, png_temporary), matplotlib.rc_context(STYLE):
+        figure.savefig(pdf_temporary, metadata=pdf_metadata)
+        figure.savefig(png_temporary, metadata=png_metadata, dpi=dpi)
+    logging.info("wrote %s and %s", pdf, png)
 
 
 def simulated_bins(p0v):

@@ -7,7 +7,7 @@ import pandas as pd
 
 from bouncing_ball import exact
 from bouncing_ball.bins import linear_grid, log_grid
-from bouncing_ball.io import write_table
+from bouncing_ball.io import write_tables
 from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 
@@ -26,41 +26,31 @@ with job_log(snakemake.log[0]):
         "settings": settings,
         "code": snakemake.params.code,
     }
-    write_table(
-        pd.DataFrame({"v": output_speeds, "p0v": exact.outgoing_speed_density(output_speeds, r)}),
-        outputs.p0v,
-        provenance,
-    )
-    write_table(
-        pd.DataFrame(
-            {
-                "x": heights,
-                "px": exact.position_density(heights, r),
-                "v2_given_x": exact.mean_speed_squared_given_position(heights, r),
-            }
-        ),
-        outputs.position,
-        provenance,
-    )
-    write_table(
-        pd.DataFrame(
-            [
-                {
-                    "r": r,
-                    "normalization_constant": exact.normalization_constant(r),
-                    "mean_x": moments["mean_x"],
-                    "delta_x": moments["delta_x"],
-                    "collision_rate": moments["collision_rate"],
-                }
-            ]
-        ),
-        outputs.summary,
-        provenance,
-    )
     table, worst = exact.distribution_table(
         settings["positions"], linear_grid(settings["speeds"]), r
     )
-    write_table(table, outputs.distribution, provenance)
+    position = {
+        "x": heights,
+        "px": exact.position_density(heights, r),
+        "v2_given_x": exact.mean_speed_squared_given_position(heights, r),
+    }
+    summary = {
+        "r": r,
+        "normalization_constant": exact.normalization_constant(r),
+        "mean_x": moments["mean_x"],
+        "delta_x": moments["delta_x"],
+        "collision_rate": moments["collision_rate"],
+    }
+    p0v = {"v": output_speeds, "p0v": exact.outgoing_speed_density(output_speeds, r)}
+    write_tables(
+        {
+            outputs.p0v: pd.DataFrame(p0v),
+            outputs.position: pd.DataFrame(position),
+            outputs.summary: pd.DataFrame([summary]),
+            outputs.distribution: table,
+        },
+        provenance,
+    )
     logging.info(
         "r=%s: P(x,v) at %d points, largest estimated relative error %.1e", label, len(table), worst
     )

@@ -8,7 +8,7 @@ from bouncing_ball.histograms import (
     position_histogram,
     position_moments_summary,
 )
-from bouncing_ball.io import write_table
+from bouncing_ball.io import write_tables
 from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 from bouncing_ball.settings import ShardSettings
@@ -29,9 +29,14 @@ with job_log(snakemake.log[0]):
         **{key: first[key] for key in ("seed", *ShardSettings.names())},
     }
     summary = position_moments_summary(shards, float(exact))
-    write_table(outgoing_speed_histogram(shards), snakemake.output.p0v, provenance)
-    write_table(position_histogram(shards), snakemake.output.position, provenance)
-    write_table(summary, snakemake.output.summary, provenance)
+    write_tables(
+        {
+            snakemake.output.p0v: outgoing_speed_histogram(shards),
+            snakemake.output.position: position_histogram(shards),
+            snakemake.output.summary: summary,
+        },
+        provenance,
+    )
     row = summary.iloc[0]
     logging.info(
         "r=%s: %d shards, time %.6g, <x> = %.5g +- %.2g, Delta x = %.5g +- %.2g, I = %.5g +- %.2g",

@@ -8,7 +8,7 @@ import pandas as pd
 
 from bouncing_ball import solver
 from bouncing_ball.bins import log_grid
-from bouncing_ball.io import write_table
+from bouncing_ball.io import write_tables
 from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 
@@ -30,8 +30,9 @@ with job_log(snakemake.log[0]):
         "normalisation": "momentum balance M_2 = r / (1 + r)",
     }
     p0v = pd.DataFrame({"v": speeds, "p0v": solution.outgoing_speed_density(speeds)})
-    write_table(p0v, snakemake.output.p0v, provenance)
-    write_table(pd.DataFrame([row]), snakemake.output.summary, provenance)
+    write_tables(
+        {snakemake.output.p0v: p0v, snakemake.output.summary: pd.DataFrame([row])}, provenance
+    )
     logging.info(
         "r=%s: %d nodes, solved in %.1f ms (first call: includes loading the compiled kernel); "
         "<x> = %.10g, Delta x = %.10g, I = %.10g; energy balance residual %.1e, "

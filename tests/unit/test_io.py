@@ -1,0 +1,62 @@
+"""Tables and files: written atomically, readable by colleagues, refused with the file named."""
+
+import os
+import stat
+
+import pandas as pd
+import pytest
+
+from bouncing_ball.io import (
+    atomic_paths,
+    read_table,
+    write_csv_and_markdown,
+    write_table,
+    write_tables,
+)
+
+
+@pytest.fixture
+def umask_022():
+    previous = os.umask(0o022)
+    yield
+    os.umask(previous)
+
+
+def _mode(path):
+    return stat.S_IMODE(os.stat(path).st_mode)
+
+
+def test_results_get_the_mode_the_umask_gives_not_a_private_one(tmp_path, umask_022):
+    table = tmp_path / "table.parquet"
+    write_table(pd.DataFrame({"v": [1.0]}), table, {"r": "1/2"})
+    assert _mode(table) == 0o644
+    with atomic_paths(tmp_path / "figure.pdf") as (temporary,), open(temporary, "w") as handle:
+        handle.write("%PDF")
+    assert _mode(tmp_path / "figure.pdf") == 0o644
+    os.umask(0o077)
+    write_table(pd.DataFrame({"v": [1.0]}), tmp_path / "private.parquet", {})
+    assert _mode(tmp_path / "private.parquet") == 0o600
+    assert read_table(table)[1]["r"] == "1/2"
+
+
+def test_a_rules_outputs_appear_together_or_not_at_all(tmp_path):
+    """A solve whose summary cannot be written leaves no P(0,v) table either."""
+    (tmp_path / "summary.parquet").mkdir()  # a directory where the summary should go
+    frames = {
+        tmp_path / "p0v.parquet": pd.DataFrame({"v": [1.0], "p0v": [0.5]}),
+        tmp_path / "summary.parquet": pd.DataFrame({"r": [0.5]}),
+    }
+    with pytest.raises(OSError):
+        write_tables(frames, {"r": "1/2"})
+    assert not (tmp_path / "p0v.parquet").exists()
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["summary.parquet"]
+
+
+def test_a_failed_csv_and_markdown_pair_leaves_neither(tmp_path):
+    (tmp_path / "table.md").mkdir()
+    with pytest.raises(OSError):
+        write_csv_and_markdown(
+            pd.DataFrame({"r": [0.5]}), tmp_path / "table.csv", tmp_path / "table.md", "| r |"
+        )
+    assert not (tmp_path / "table.csv").exists()
+
