@@ -11,28 +11,98 @@ is asked for as a target.  Likewise for the studies' file, config/studies.yaml
 from dataclasses import dataclass
 from fractions import Fraction
 
+import jsonschema
 import yaml
 
 from .restitution import (
     EXACT_RESTITUTIONS,
+    SOLVER_RESTITUTION_RANGE,
+    check_solver_restitution,
     exact_string,
     parse_restitution,
     restitution_grid,
     restitution_label,
+    shared_label_message,
 )
 from .settings import ShardSettings
 
 
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """YAML's safe loader, refusing a key repeated in one mapping (PyYAML keeps the last)."""
+
+    def construct_mapping(self, node, deep=False):
+        seen = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=deep)
+            if key in seen:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"the key {key!r} appears twice", key_node.start_mark
+                )
+            seen.add(key)
+        return super().construct_mapping(node, deep=deep)
+
+
+def read_yaml(path):
+    """A YAML file's content; ValueError naming the file and line of a repeated key."""
+    with open(path) as handle:
+        try:
+            return yaml.load(handle, Loader=_UniqueKeyLoader)  # noqa: S506 (a safe loader)
+        except yaml.YAMLError as error:
+            raise ValueError(f"{path}: {error}") from None
+
+
 def read_config(path) -> dict:
     """A config file, checked as the workflow checks it (for scripts run by hand)."""
-    with open(path) as handle:
-        config = yaml.safe_load(handle)
+    config = read_yaml(path)
     check_config(config)
     return config
 
 
-def check_config(config: dict) -> dict[str, Fraction]:
-    """Raise ValueError naming the key if the config is inconsistent; return the r grid."""
+def overlay_per_restitution(config: dict, paths) -> None:
+    """Give ``config`` the per-r overrides of the last of ``paths`` (base file first, then
+    the overlays) that sets ``simulation.per_restitution``, whole: Snakemake merges the
+    files' mappings key by key, so an overlay could add overrides but never remove one.
+    Also refuses a key repeated within any of the files (``read_yaml``)."""
+    found, chosen = False, None
+    for path in paths:
+        content = read_yaml(path)
+        simulation = content.get("simulation") if isinstance(content, dict) else None
+        if isinstance(simulation, dict) and "per_restitution" in simulation:
+            found, chosen = True, simulation["per_restitution"]
+    if found:
+        config["simulation"]["per_restitution"] = chosen or {}
+
+
+def _is_integer(checker, instance) -> bool:
+    return isinstance(instance, int) and not isinstance(instance, bool)
+
+
+def check_types(instance, schema: dict, source: str) -> None:
+    """``instance`` against ``schema`` with integers that are integers: JSON Schema (and
+    Snakemake's ``validate``) counts 1.0 or 1.0e+20 as one, and a seed of 1.0 or a step
+    budget of 1.0e+20 would then fail in every job.  ValueError naming the key."""
+    base = jsonschema.validators.validator_for(schema)
+    strict = jsonschema.validators.extend(
+        base, type_checker=base.TYPE_CHECKER.redefine("integer", _is_integer)
+    )
+    for error in strict(schema).iter_errors(instance):
+        where = ".".join(str(part) for part in error.absolute_path) or "the top level"
+        hint = (
+            " (write a whole number without a decimal point or exponent, e.g. 1000000000)"
+            if isinstance(error.instance, float) and error.validator == "type"
+            else ""
+        )
+        raise ValueError(f"{source}: {where}: {error.message}{hint}")
+
+
+def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction]:
+    """Raise ValueError naming the key if the config is inconsistent; return the r grid.
+
+    With ``schema`` (workflow/schemas/config.schema.yaml, read), first ``check_types``:
+    the workflow passes it, after Snakemake's own ``validate``.
+    """
+    if schema is not None:
+        check_types(config, schema, "config")
     grid = restitution_grid(config["restitution"])
     simulation = config["simulation"]
     for name in ("speed_bins", "position_bins"):
@@ -69,7 +139,9 @@ def check_config(config: dict) -> dict[str, Fraction]:
             f"solver.restitution_grid: need {low} <= min < max <= {high} (the solver's accurate range), "
             f"got min = {solver_grid['min']}, max = {solver_grid['max']}"
         )
-    figure_restitutions(config, grid)
+    for index, value in enumerate(config["restitution"]):
+        check_solver_restitution(value, f"restitution[{index}]")  # every r of the run is solved
+    known = {**figure_restitutions(config, grid), **grid}
     for side in ("small_speed_window", "large_speed_window"):
         window = config["fits"][side]
         if window != "auto" and not window["min"] < window["max"]:
@@ -77,18 +149,28 @@ def check_config(config: dict) -> dict[str, Fraction]:
                 f"fits.{side}: min = {window['min']} must be smaller than max = {window['max']}"
             )
     seen = {}
-    for key in simulation.get("per_restitution", {}):
+    for key in per_restitution(config):
         where = f"simulation.per_restitution.{key}"
-        label = restitution_label(parse_restitution(key, where))
+        value = parse_restitution(key, where)
+        label = restitution_label(value)
         if label in seen:
             raise ValueError(f"{where}: the same r as simulation.per_restitution.{seen[label]}")
         seen[label] = key
+        if label in known and known[label] != value:
+            raise ValueError(shared_label_message(where, value, known[label]))
+        if label not in known and parse_restitution(label) != value:
+            raise ValueError(
+                f"{where}: r = {key} is not an r of the config (restitution, figures), and "
+                f"as a target it would be asked for by its label {label}, which is another r "
+                f"({label}); add r = {key} to restitution, or key the override by {label}"
+            )
     return grid
 
 
-# where the solver meets its 1e-8 target at the default step (below 0.02, P(0, v)
-# ~ exp(-v / (2r)) leaves the range of doubles; above 0.999 the grid gets large)
-SOLVER_RESTITUTION_RANGE = (0.02, 0.999)
+def per_restitution(config: dict) -> dict:
+    """The per-r overrides, {r as written: {setting: value}}; none if the section is
+    absent or null (an overlay clears the base file's with ``per_restitution: null``)."""
+    return config["simulation"].get("per_restitution") or {}
 
 
 def figure_restitutions(config: dict, grid: dict | None = None) -> dict[str, Fraction]:
@@ -110,11 +192,11 @@ def figure_restitutions(config: dict, grid: dict | None = None) -> dict[str, Fra
                 raise ValueError(
                     f"{where}: r = {values[index]!r} has no exact solution (only 1/2 and 1/3)"
                 )
+            if figure == "fig4":  # drawn with the solver's P(0, v)
+                check_solver_restitution(values[index], where)
             for other in (grid, shown):
                 if label in other and other[label] != value:
-                    raise ValueError(
-                        f"{where}: r = {value} and r = {other[label]} share the label {label}"
-                    )
+                    raise ValueError(shared_label_message(where, value, other[label]))
             shown[label] = value
     return shown
 
@@ -130,7 +212,7 @@ def simulation_settings(config: dict, label: str) -> dict:
     simulation = config["simulation"]
     settings = {"min_step_floor": 0.0}  # optional key: the paper's rule alone
     settings.update({k: v for k, v in simulation.items() if k != "per_restitution"})
-    for key, override in simulation.get("per_restitution", {}).items():
+    for key, override in per_restitution(config).items():
         if restitution_label(parse_restitution(key)) == label:
             settings.update(override)
     return settings

@@ -11,6 +11,12 @@ from fractions import Fraction
 # the r with an exact solution, eq. (P(0,v)) (bouncing_ball.exact)
 EXACT_RESTITUTIONS = (Fraction(1, 2), Fraction(1, 3))
 
+# the r for which the solver (bouncing_ball.solver) meets its 1e-8 accuracy target: below
+# 0.02 P(0, v) ~ exp(-v / (2r)) leaves the range of doubles within the speeds that matter
+# (the answer is wrong by 2% at 0.015, by 50% at 0.01); above 0.9999 the dense grid,
+# ~ (1 - r)^(-1/2) nodes, outgrows a job
+SOLVER_RESTITUTION_RANGE = (0.02, 0.9999)
+
 
 def parse_restitution(value, where: str = "restitution") -> Fraction:
     """The exact value of r from a config entry or a label; ``where`` names it in errors."""
@@ -28,6 +34,26 @@ def parse_restitution(value, where: str = "restitution") -> Fraction:
         ) from None
     if not 0 < exact < 1:
         raise ValueError(f"{where}: r = {value!r} is outside the allowed range 0 < r < 1")
+    label = restitution_label(exact)
+    if not 0 < float(label) < 1:
+        raise ValueError(
+            f"{where}: r = {value!r} rounds to {label} at the 6 significant digits of the "
+            "labels its outputs are filed under, which is not an r in (0, 1); give an r whose "
+            + ("label stays below 1 (at most 0.9999994)" if exact > 0.5 else "label is not 0")
+        )
+    return exact
+
+
+def check_solver_restitution(value, where: str = "restitution") -> Fraction:
+    """``value`` parsed, if the solver answers it to its accuracy target; ValueError
+    naming ``where`` and the range otherwise."""
+    exact = parse_restitution(value, where)
+    low, high = SOLVER_RESTITUTION_RANGE
+    if not low <= exact <= high:
+        raise ValueError(
+            f"{where}: r = {value!r} is outside the solver's range {low} <= r <= {high}, "
+            "where it meets its 1e-8 accuracy target (docs/methods.md#the-solver)"
+        )
     return exact
 
 
@@ -48,13 +74,23 @@ def restitution_grid(values, where: str = "restitution") -> dict[str, Fraction]:
     for index, value in enumerate(values):
         exact = parse_restitution(value, f"{where}[{index}]")
         label = restitution_label(exact)
-        if label in grid:
+        if label in grid and grid[label] == exact:
             raise ValueError(
                 f"{where}[{index}]: r = {value!r} repeats r = {grid[label]} (label {label}); "
                 "each r may appear once"
             )
+        if label in grid:
+            raise ValueError(shared_label_message(f"{where}[{index}]", exact, grid[label]))
         grid[label] = exact
     return grid
+
+
+def shared_label_message(where: str, value: Fraction, other: Fraction) -> str:
+    """Why two different r cannot both be asked for: their outputs would share a folder."""
+    return (
+        f"{where}: r = {value} and r = {other} share the label {restitution_label(value)} "
+        "(6 significant digits) under which outputs are filed; keep one of them"
+    )
 
 
 def exact_string(value: Fraction) -> str:

@@ -13,6 +13,11 @@ from dataclasses import asdict, dataclass, fields, replace
 from .bins import LogBins, log_bins
 
 
+# the largest step budget: far beyond any shard (10^15 steps are years of CPU), far inside
+# the compiled loop's 64-bit step counter (9.2e18); the config schema repeats it
+MAX_STEPS_LIMIT = 10**15
+
+
 @dataclass(frozen=True)
 class ShardSettings:
     """The parameters that decide a shard's numbers (with its r, seed and index)."""
@@ -44,7 +49,11 @@ class ShardSettings:
                 ("equilibration_time", "0 or more", self.equilibration_time >= 0.0),
                 ("criterion_c", "positive", self.criterion_c > 0.0),
                 ("min_step_divisor", "positive", self.min_step_divisor > 0.0),
-                ("max_steps", "at least 1", self.max_steps >= 1),
+                (
+                    "max_steps",
+                    f"between 1 and {MAX_STEPS_LIMIT:.0e}",
+                    1 <= self.max_steps <= MAX_STEPS_LIMIT,
+                ),
                 ("min_step_floor", "0 or more", self.min_step_floor >= 0.0),
             )
             if not holds

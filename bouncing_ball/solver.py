@@ -58,11 +58,11 @@ from scipy import linalg, special
 from . import stages
 from .asymptotics import large_speed_decay_rate, small_speed_exponent
 from .kernel import kernel_small_u_limit, return_speed_kernel_matrix
+from .restitution import SOLVER_RESTITUTION_RANGE
 
 # the modules whose code decides the solver's numbers
 SOURCES = stages.SOLVER
 
-HIGHEST_RESTITUTION = 0.9999  # above, the grid (~ (1 - r)^(-1/2) nodes, dense) outgrows a job
 DEFAULT_STEP = 0.25  # trapezoidal step in s; ~1e-11 relative error at r = 1/2, 1/3
 SQRT_WEIGHT = 1.0  # b in s = ln u + b u^(1/2)
 TAIL_EFOLDS = 25.0  # lower tail summed node by node over this many e-folds of u
@@ -168,10 +168,16 @@ def solve_outgoing_speed_density(
     r = float(restitution)
     if not 0.0 < r < 1.0:
         raise ValueError(f"restitution must lie in (0, 1), got {restitution}")
-    if r > HIGHEST_RESTITUTION:
+    low, high = SOLVER_RESTITUTION_RANGE
+    if r > high:
         raise ValueError(
             f"restitution {restitution} is too close to 1 for the solver: its dense grid grows like "
-            f"(1 - r)^(-1/2) nodes; r <= {HIGHEST_RESTITUTION} is supported"
+            f"(1 - r)^(-1/2) nodes; {low} <= r <= {high} is supported"
+        )
+    if r < low:
+        raise ValueError(
+            f"restitution {restitution} is too small for the solver: P(0, v) ~ exp(-v / (2r)) "
+            f"leaves the range of doubles; {low} <= r <= {high} is supported"
         )
     if not step > 0.0:
         raise ValueError(f"quadrature step must be positive, got {step}")

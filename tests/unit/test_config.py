@@ -7,8 +7,16 @@ import pytest
 import yaml
 from workflow_support import REPOSITORY
 
-from bouncing_ball.config import check_config, simulation_settings
+from bouncing_ball.config import (
+    check_config,
+    overlay_per_restitution,
+    read_yaml,
+    shard_count,
+    shard_settings,
+    simulation_settings,
+)
 from bouncing_ball.restitution import parse_restitution, restitution_grid, restitution_label
+from bouncing_ball.settings import MAX_STEPS_LIMIT
 
 
 def test_labels_follow_the_design():
@@ -78,3 +86,111 @@ def test_bad_bins_and_overrides_named():
     bad["simulation"]["per_restitution"] = {"1.5": {"shards": 2}}
     with pytest.raises(ValueError, match="per_restitution.1.5"):
         check_config(bad)
+
+
+# ---- issue 15: what a real user's config got through before ----
+
+
+@pytest.mark.parametrize("value", [0.9999995, 0.9999999, "9999999/10000000"])
+def test_an_r_whose_label_rounds_to_one_is_refused(value):
+    with pytest.raises(ValueError, match=r"restitution\[0\]: .*rounds to 1 .*at most 0.9999994"):
+        restitution_grid([value])
+    assert restitution_label(parse_restitution(0.9999994)) == "0.999999"
+
+
+def test_two_different_r_with_one_label_are_said_to_share_it_not_to_repeat():
+    with pytest.raises(ValueError, match="share the label 0.5") as error:
+        restitution_grid([0.5000001, 0.5])
+    assert "repeats" not in str(error.value)
+
+
+def test_an_override_applies_only_to_its_own_r():
+    config = _default_config()
+    config["simulation"]["per_restitution"] = {"0.5000001": {"shards": 3}}
+    config["restitution"] = [0.5]
+    with pytest.raises(ValueError, match="per_restitution.0.5000001: .* share the label 0.5"):
+        check_config(config)
+    # not an r of the config: a target r0.6 would be 3/5, not 0.6000001
+    config["simulation"]["per_restitution"] = {"0.6000001": {"shards": 3}}
+    with pytest.raises(ValueError, match="not an r of the config"):
+        check_config(config)
+    config["simulation"]["per_restitution"] = {"0.6": {"shards": 3}}  # a target-only r: fine
+    check_config(config)
+    assert simulation_settings(config, "0.6")["shards"] == 3
+
+
+@pytest.mark.parametrize("value", [0.99995, 0.01, "1/1000"])
+def test_an_r_outside_the_solvers_range_is_refused_before_any_job(value):
+    config = _default_config()
+    config["restitution"] = [0.5, value]
+    with pytest.raises(ValueError, match=r"restitution\[1\]: .*outside the solver's range"):
+        check_config(config)
+    config["restitution"] = [0.5]
+    config["figures"]["fig4"] = [value]
+    with pytest.raises(ValueError, match=r"figures.fig4\[0\]: .*outside the solver's range"):
+        check_config(config)
+
+
+def _schema():
+    return read_yaml(REPOSITORY / "workflow/schemas/config.schema.yaml")
+
+
+@pytest.mark.parametrize(
+    "section, key, value",
+    [
+        (None, "seed", 1.0),
+        ("simulation", "max_steps", 1.0e20),
+        ("simulation", "max_steps", 1.0e9),
+        ("simulation", "shards", 4.0),
+        ("figures", "png_dpi", 200.0),
+    ],
+)
+def test_a_float_where_an_integer_belongs_is_refused_naming_the_key(section, key, value):
+    config = _default_config()
+    (config if section is None else config[section])[key] = value
+    check_config(config)  # the consistency checks alone let it through
+    where = key if section is None else f"{section}.{key}"
+    with pytest.raises(ValueError, match=f"config: {where}: .*integer"):
+        check_config(config, _schema())
+    check_config(_default_config(), _schema())
+
+
+def test_the_step_budget_is_bounded_where_the_compiled_loop_counts_it():
+    schema = _schema()
+    assert schema["$defs"]["step_budget"]["maximum"] == MAX_STEPS_LIMIT < 2**63
+    config = _default_config()
+    config["simulation"]["max_steps"] = MAX_STEPS_LIMIT + 1
+    with pytest.raises(ValueError, match="max_steps"):
+        check_config(config, schema)
+    with pytest.raises(ValueError, match="max_steps"):
+        shard_settings(config, "0.5")
+
+
+def test_a_key_written_twice_in_a_yaml_file_is_refused_with_its_line(tmp_path):
+    path = tmp_path / "overlay.yaml"
+    path.write_text("restitution: [0.5]\nseed: 3\nrestitution: [0.25]\n")
+    with pytest.raises(ValueError, match=r"(?s)overlay.yaml: .*'restitution' appears twice.*line 3"):
+        read_yaml(path)
+    path.write_text("simulation:\n  per_restitution:\n    '0.5': {shards: 2, shards: 3}\n")
+    with pytest.raises(ValueError, match="'shards' appears twice"):
+        read_yaml(path)
+
+
+@pytest.mark.parametrize("cleared", ["{}", "null"])
+def test_an_overlay_clears_the_per_r_overrides(tmp_path, cleared):
+    base = REPOSITORY / "config" / "config.yaml"
+    overlay = tmp_path / "overlay.yaml"
+    overlay.write_text(f"simulation:\n  shards: 2\n  per_restitution: {cleared}\n")
+    config = _default_config()  # as Snakemake merges the two files: {} adds nothing
+    config["simulation"]["shards"] = 2
+    if cleared == "null":
+        config["simulation"]["per_restitution"] = None
+    overlay_per_restitution(config, [base, overlay])
+    check_config(config, _schema())
+    assert config["simulation"]["per_restitution"] == {}
+    assert shard_count(config, "0.25") == 2
+    # an overlay that does not name per_restitution keeps the base file's
+    overlay.write_text("simulation:\n  shards: 2\n")
+    config = _default_config()
+    overlay_per_restitution(config, [base, overlay])
+    assert shard_count(config, "0.25") == 32

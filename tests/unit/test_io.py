@@ -59,4 +59,3 @@ def test_a_failed_csv_and_markdown_pair_leaves_neither(tmp_path):
             pd.DataFrame({"r": [0.5]}), tmp_path / "table.csv", tmp_path / "table.md", "| r |"
         )
     assert not (tmp_path / "table.csv").exists()
-

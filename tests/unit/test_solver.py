@@ -110,6 +110,14 @@ def test_refuses_restitution_too_close_to_one():
         solver.solve_outgoing_speed_density(0.99999)
 
 
+@pytest.mark.parametrize("small", [0.015, 1e-3, 1e-7])
+def test_refuses_restitution_below_its_accurate_range(small):
+    """Below 0.02 the answer was wrong by percents (0.015) to factors (1e-3), or it crashed
+    (1e-7): refused, with the range, instead."""
+    with pytest.raises(ValueError, match=r"too small for the solver.*0.02 <= r <= 0.9999"):
+        solver.solve_outgoing_speed_density(small)
+
+
 def test_accuracy_estimate_is_small_and_reported_in_the_summary():
     """The estimate of rule solve's summary (a finer solve) meets the target at r = 0.3."""
     row = solver.solution_summary(solver.solve_outgoing_speed_density(0.3))

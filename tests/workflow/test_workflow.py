@@ -24,7 +24,7 @@ from workflow_support import (
 )
 
 from bouncing_ball.comparison import MOMENT_COLUMNS, VALIDATION_CHECKS, VALIDATION_COLUMNS
-from bouncing_ball.config import check_config
+from bouncing_ball.config import check_config, read_yaml
 from bouncing_ball.io import read_table
 
 
@@ -514,6 +514,38 @@ BAD = [
     (_with(["figures", "fig5"], [0.25]), "figures.fig5[0]: r = 0.25 has no exact solution"),
     (_with(["figures", "png_dpi"], 10), "png_dpi"),
     (_with(["figures", "fig6"], [0.5]), "'fig6' was unexpected"),
+    # issue 15: integers that are floats, a step budget beyond the loop's counter
+    (_with(["seed"], 1.0), "config: seed: 1.0 is not of type 'integer'"),
+    (_with(["simulation", "max_steps"], 1.0e20), "greater than the maximum of 1000000000000000"),
+    (
+        _with(["simulation", "max_steps"], 1.0e9),
+        "simulation.max_steps: 1000000000.0 is not of type",
+    ),
+    (
+        _with(["simulation", "per_restitution"], {"0.5": {"shards": 3.0}}),
+        "config: simulation.per_restitution.0.5.shards: 3.0 is not of type 'integer'",
+    ),
+    # r the solver cannot answer to its accuracy, r whose label is not an r
+    (
+        _with(["restitution"], [0.99995]),
+        "restitution[0]: r = 0.99995 is outside the solver's range 0.02 <= r <= 0.9999",
+    ),
+    (_with(["restitution"], [0.001]), "restitution[0]: r = 0.001 is outside the solver's range"),
+    (_with(["figures", "fig4"], [0.01]), "figures.fig4[0]: r = 0.01 is outside the solver's range"),
+    (_with(["restitution"], [0.9999999]), "restitution[0]: r = 0.9999999 rounds to 1"),
+    # different r with one label
+    (
+        _with(["restitution"], [0.5000001, 0.5]),
+        "restitution[1]: r = 1/2 and r = 5000001/10000000 share the label 0.5",
+    ),
+    (
+        _with(["simulation", "per_restitution"], {"0.5000001": {"shards": 3}}),
+        "simulation.per_restitution.0.5000001: r = 5000001/10000000 and r = 1/2 share the label",
+    ),
+    (
+        _with(["simulation", "per_restitution"], {"0.6000001": {"shards": 3}}),
+        "simulation.per_restitution.0.6000001: r = 0.6000001 is not an r of the config",
+    ),
 ]
 
 
@@ -522,7 +554,7 @@ def refusal(config):
     validation, then common.smk's check_config; None if it is accepted."""
     try:
         validate(copy.deepcopy(config), str(REPOSITORY / "workflow/schemas/config.schema.yaml"))
-        check_config(config)
+        check_config(config, read_yaml(REPOSITORY / "workflow/schemas/config.schema.yaml"))
     except (WorkflowError, ValueError) as error:
         return str(error)
     return None
@@ -542,7 +574,16 @@ def test_bad_config_is_refused_with_a_message_naming_the_key(config, key):
 END_TO_END = [BAD[i] for i in (0, 4, 5, 8, 16, 19, 20)] + [
     (config, key)
     for config, key in BAD
-    if key.startswith(("figures.fig5", "solver.restitution_grid"))
+    if key.startswith(
+        (
+            "figures.fig5",
+            "solver.restitution_grid",
+            "config: seed",
+            "restitution[0]: r = 0.99995",
+            "restitution[0]: r = 0.9999999",
+            "simulation.per_restitution.0.5000001",
+        )
+    )
 ]
 
 

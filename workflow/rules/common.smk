@@ -4,20 +4,33 @@ from bouncing_ball.config import (
     check_config,
     exact_settings,
     known_restitutions,
+    overlay_per_restitution,
+    read_yaml,
     solver_settings,
     shard_count,
     shard_settings,
 )
 from bouncing_ball.restitution import (
     EXACT_RESTITUTIONS,
+    check_solver_restitution,
     exact_string,
     parse_restitution,
     restitution_grid,
     restitution_label,
 )
 
+# the config files as Snakemake layered them: the Snakefile's, then --configfile overlays
+OVERLAYS = [str(path) for path in workflow.overwrite_configfiles]
+CONFIG_FILES = [
+    str(path) for path in workflow.configfiles if str(path) not in OVERLAYS
+] + OVERLAYS
 try:
-    RESTITUTION = check_config(config)  # {label: exact r}, refused before any job runs
+    # refused before any job runs: a key repeated in a file, a float where an integer
+    # belongs (the schema check above counts 1.0 as one), what a schema cannot express
+    overlay_per_restitution(config, CONFIG_FILES)
+    RESTITUTION = check_config(  # {label: exact r}
+        config, read_yaml(f"{workflow.basedir}/workflow/schemas/config.schema.yaml")
+    )
 except ValueError as error:
     raise ValueError(f"invalid config: {error}") from None
 # with the r shown in Figs. 4 and 5, which need not be in `restitution`
@@ -52,6 +65,13 @@ def restitution_value(wildcards):
             "(6 significant digits, trailing zeros dropped)"
         )
     return exact_string(exact)
+
+
+def solver_restitution_value(wildcards):
+    """``restitution_value``, refused (before any job runs) outside the solver's range."""
+    value = restitution_value(wildcards)
+    check_solver_restitution(wildcards.r, f"target results/solver/r{wildcards.r}")
+    return value
 
 
 def settings(wildcards):

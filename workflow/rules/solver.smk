@@ -15,7 +15,7 @@ rule solve:
         mem_mb=1000,
         cpus_per_task=1,
     params:
-        restitution=restitution_value,
+        restitution=solver_restitution_value,
         settings=solver_settings(config),
         code=SOLVER_CODE,
     script:

@@ -1,19 +1,22 @@
 # The studies: accuracy checks behind docs/validation.md (c = 3 against c = 5 at the exact r,
 # r = 3/4 against the solver), set in config/studies.yaml. Hours of CPU: not part of `all`;
 # run with  snakemake --cores 2 studies
-import yaml
 from snakemake.exceptions import WorkflowError
 
-from bouncing_ball.config import study_runs
+from bouncing_ball.config import check_types, read_yaml, study_runs
 
 STUDIES_FILE = "config/studies.yaml"
-with open(STUDIES_FILE) as handle:
-    STUDIES = yaml.safe_load(handle)
 try:
+    STUDIES = read_yaml(STUDIES_FILE)  # a repeated key refused
     validate(STUDIES, "../schemas/studies.schema.yaml")
-except WorkflowError as error:
+except (ValueError, WorkflowError) as error:
     raise WorkflowError(f"{STUDIES_FILE}: {error}") from None
 try:
+    check_types(
+        STUDIES,
+        read_yaml(f"{workflow.basedir}/workflow/schemas/studies.schema.yaml"),
+        STUDIES_FILE,
+    )
     STUDY_RUNS = study_runs(STUDIES, config)  # {study: {run: StudyRun}}
 except ValueError as error:
     raise ValueError(f"invalid {STUDIES_FILE}: {error}") from None
