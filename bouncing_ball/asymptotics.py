@@ -29,11 +29,17 @@ def _log_restitution_of_beta(beta):
     return np.log(2.0 * np.sin((2.0 * beta + 1.0) * np.pi / 6.0)) / (beta - 2.0)
 
 
-def small_speed_exponent(restitution) -> float:
-    """beta(r) of eq. (asym2): the physical root in (0, 5/2), P(0, v) ~ v^-beta at small v."""
+def _restitution(restitution) -> float:
+    """r as a float, refused unless 0 < r < 1 (the exponents are defined there only)."""
     r = float(restitution)
     if not 0.0 < r < 1.0:
         raise ValueError(f"restitution must lie in (0, 1), got {restitution}")
+    return r
+
+
+def small_speed_exponent(restitution) -> float:
+    """beta(r) of eq. (asym2): the physical root in (0, 5/2), P(0, v) ~ v^-beta at small v."""
+    r = _restitution(restitution)
     target = np.log(r)
     # ln r(beta) decreases from 0 at beta = 0 to -infinity at beta = 5/2
     return optimize.brentq(
@@ -43,7 +49,7 @@ def small_speed_exponent(restitution) -> float:
 
 def large_speed_decay_rate(restitution) -> float:
     """q(r) of eqs. (asym4), (asym6): P(0, v) ~ v^-m e^(-q v) at large v."""
-    r = float(restitution)
+    r = _restitution(restitution)
     if r >= 0.5:
         return 1.5 * (1.0 - r) / (1.0 - r + r * r)
     return 0.5 / r
@@ -51,7 +57,7 @@ def large_speed_decay_rate(restitution) -> float:
 
 def large_speed_exponent(restitution) -> float:
     """m(r) of eqs. (asym4)-(asym6)."""
-    r = float(restitution)
+    r = _restitution(restitution)
     if r < 0.5:
         return 1.5
     if r == 0.5:

@@ -13,16 +13,26 @@ Every edit of compiled code makes a new folder; the old ones are pruned here,
 keeping the ``KEEP_CACHES`` most recently used besides the current one (so
 switching between two versions does not recompile) and never one used in the
 last ``PRUNE_AFTER_SECONDS`` (a job of another version may still be running).
+
+Two faults are survived rather than passed on to every job: a checkout that
+cannot be written to (a shared read-only install) caches under the user's
+cache folder instead (``$XDG_CACHE_HOME/bouncing_ball``, else
+``~/.cache/bouncing_ball``), where numba would otherwise recompile in every
+process; and a damaged cache file (a truncated write, a full disk) is a cache
+miss, reported with its folder, removed and recompiled, where numba would raise
+``UnpicklingError`` in every job.
 """
 
 import contextlib
-import functools
+import logging
 import os
 import shutil
+import tempfile
 import time
 from pathlib import Path
 
 import numba
+from numba.core.caching import FunctionCache
 
 from . import PACKAGE, source_digest, stages
 
@@ -56,14 +66,66 @@ def prune_caches(
     return removed
 
 
-_base = Path(numba.config.CACHE_DIR) if numba.config.CACHE_DIR else PACKAGE / "__pycache__"
+def user_cache_folder() -> Path:
+    """Where the cache goes when the checkout cannot be written to."""
+    root = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(root) / "bouncing_ball"
+
+
+def writable_cache_base(preferred: Path, fallback: Path) -> Path:
+    """``preferred`` if a cache folder can be made and written in it, else ``fallback``."""
+    try:
+        preferred.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=preferred):
+            pass
+        return preferred
+    except OSError:
+        return fallback
+
+
+class RecoveringFunctionCache(FunctionCache):
+    """numba's cache of one function, with a damaged cache file taken as a cache miss."""
+
+    def load_overload(self, sig, target_context):
+        try:
+            return super().load_overload(sig, target_context)
+        except Exception as error:  # a damaged pickle raises almost anything
+            index = Path(self._cache_file._index_path)
+            logging.getLogger(__name__).warning(
+                "numba's cache of %s in %s is damaged (%s: %s): removing its index and "
+                "recompiling (if this repeats, delete that folder)",
+                f"{self._py_func.__module__}.{self._py_func.__qualname__}",
+                self._cache_path,
+                type(error).__name__,
+                error,
+            )
+            index.unlink(missing_ok=True)
+            return None
+
+
+def njit(*args, **options):
+    """``numba.njit`` with IEEE division (inf or NaN instead of a Python ZeroDivisionError
+    check on every division: the compiled code tests its own denominators, as the C
+    reference of the loop does) and a cache that survives a damaged file."""
+
+    def compile_lazily(function):
+        dispatcher = numba.njit(error_model="numpy", **options)(function)
+        if isinstance(getattr(dispatcher, "_cache", None), FunctionCache):
+            dispatcher._cache.__class__ = RecoveringFunctionCache
+        return dispatcher
+
+    if len(args) == 1 and callable(args[0]):
+        return compile_lazily(args[0])
+    if args:
+        raise TypeError("bouncing_ball.jit.njit takes keyword options only")
+    return compile_lazily
+
+
+_preferred = Path(numba.config.CACHE_DIR) if numba.config.CACHE_DIR else PACKAGE / "__pycache__"
+_base = writable_cache_base(_preferred, user_cache_folder())
 CACHE = _base / f"numba-{source_digest(stages.COMPILED)}"
 numba.config.CACHE_DIR = str(CACHE)
 with contextlib.suppress(OSError):  # not there yet, or not ours to touch (a read-only cache)
     os.utime(CACHE)  # in use: the newest to keep
 prune_caches(_base, CACHE)
-
-# IEEE division (inf or NaN) instead of a Python ZeroDivisionError check on every division:
-# the compiled code tests its own denominators, and the C reference of the loop does the same
-njit = functools.partial(numba.njit, error_model="numpy")
 prange = numba.prange

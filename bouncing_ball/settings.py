@@ -12,7 +12,6 @@ from dataclasses import asdict, dataclass, fields, replace
 
 from .bins import LogBins, log_bins
 
-
 # the largest step budget: far beyond any shard (10^15 steps are years of CPU), far inside
 # the compiled loop's 64-bit step counter (9.2e18); the config schema repeats it
 MAX_STEPS_LIMIT = 10**15

@@ -10,7 +10,15 @@ from .tallies import tallies_from_frame
 
 def read_shards(paths, label):
     """The tallies of every shard, checked to belong to r = ``label``, to share
-    settings, to be distinct shards, and to have recorded some time."""
+    settings, to be distinct shards, and to have recorded some time; and two of them at
+    least, since every error bar is the scatter between shards (a jackknife)."""
+    paths = list(paths)
+    if len(paths) < 2:
+        raise UnreadableFileError(
+            f"r = {label}: {len(paths)} shard ({', '.join(map(str, paths)) or 'none'}); error "
+            "bars come from the scatter between shards and need two or more "
+            "(simulation.shards >= 2)"
+        )
     shards, provenances = [], []
     for path in paths:
         frame, provenance = read_table(path)

@@ -94,3 +94,13 @@ def test_solver_large_speed_decay(r):
     assert np.all(np.diff(np.abs(approach)) < 0.0) and abs(approach[-1]) < 0.01
     # the remainder is O(1 / v^2): approach * v settles
     assert approach[-1] * v[-1] == pytest.approx(approach[-2] * v[-2], rel=0.05)
+
+
+@pytest.mark.parametrize(
+    "function", [small_speed_exponent, large_speed_decay_rate, large_speed_exponent]
+)
+@pytest.mark.parametrize("bad", [1.5, -0.5, 0.0, 1.0])
+def test_every_exponent_refuses_an_r_outside_the_unit_interval(function, bad):
+    """m(1.5) was 0.295, q(-0.5) was -1 and q(0) a ZeroDivisionError."""
+    with pytest.raises(ValueError, match=r"restitution must lie in \(0, 1\)"):
+        function(bad)

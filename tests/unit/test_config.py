@@ -169,7 +169,9 @@ def test_the_step_budget_is_bounded_where_the_compiled_loop_counts_it():
 def test_a_key_written_twice_in_a_yaml_file_is_refused_with_its_line(tmp_path):
     path = tmp_path / "overlay.yaml"
     path.write_text("restitution: [0.5]\nseed: 3\nrestitution: [0.25]\n")
-    with pytest.raises(ValueError, match=r"(?s)overlay.yaml: .*'restitution' appears twice.*line 3"):
+    with pytest.raises(
+        ValueError, match=r"(?s)overlay.yaml: .*'restitution' appears twice.*line 3"
+    ):
         read_yaml(path)
     path.write_text("simulation:\n  per_restitution:\n    '0.5': {shards: 2, shards: 3}\n")
     with pytest.raises(ValueError, match="'shards' appears twice"):

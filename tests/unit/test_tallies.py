@@ -7,7 +7,8 @@ from hypothesis import strategies as st
 
 from bouncing_ball.bins import LogBins
 from bouncing_ball.histograms import jackknife, outgoing_speed_histogram
-from bouncing_ball.io import read_table, write_table
+from bouncing_ball.io import UnreadableFileError, read_table, write_table
+from bouncing_ball.shards import read_shards
 from bouncing_ball.tallies import (
     ShardTallies,
     merge_shards,
@@ -177,3 +178,11 @@ def test_the_compiled_loop_fills_its_scalars_in_the_order_of_SCALARS():
         "int_x2",
         "budget_exhausted",
     ]
+
+
+def test_a_single_shard_is_refused_by_every_reader_of_shards(tmp_path):
+    """merge_shards wrote NaN errors from one shard: refused, saying errors need two."""
+    path = tmp_path / "shard0.parquet"
+    write_table(tallies_to_frame(_empty_shard()), path, {"r": "1/2", "r_label": "0.5"})
+    with pytest.raises(UnreadableFileError, match=r"r = 0.5: 1 shard .*need two or more"):
+        read_shards([path], "0.5")
