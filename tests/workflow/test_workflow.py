@@ -304,6 +304,20 @@ def test_adding_an_r_runs_only_its_jobs_and_the_aggregates(finished_run, tmp_pat
     assert (added[added.check.str.startswith("p0v_chi2")].reference == "solver").all()
 
 
+def test_touching_every_script_reruns_nothing(finished_run, tmp_path):
+    """A checkout or branch switch rewrites scripts unchanged: it re-ran every shard."""
+    directory = tmp_path / "copy"
+    shutil.copytree(finished_run, directory)
+    for script in (directory / "scripts").rglob("*.py"):
+        script.touch()
+    assert planned_jobs(directory) == {}
+    with open(directory / "scripts/simulate_shard.py", "a") as handle:
+        handle.write("\n# an edit\n")
+    planned = planned_jobs(directory)
+    assert planned["simulate_shard"] == 5, planned  # 3 shards of r = 1/2, 2 of 1/3
+    assert not {"solve", "solve_grid", "exact_solution", "theory"} & set(planned)
+
+
 def test_editing_a_plotting_script_reruns_only_figures(finished_run, tmp_path):
     directory = tmp_path / "copy"
     shutil.copytree(finished_run, directory)

@@ -36,18 +36,17 @@ except ValueError as error:
 # with the r shown in Figs. 4 and 5, which need not be in `restitution`
 KNOWN_RESTITUTION = known_restitutions(config)
 
-# passed as params: an edit of a stage's library code re-runs that stage only
-# (bouncing_ball.stages names the modules without importing them)
-SIMULATION_CODE = source_digest(stages.SIMULATION)
-MERGE_CODE = source_digest(stages.MERGE)
-SOLVER_CODE = source_digest(stages.SOLVER)
-EXACT_CODE = source_digest(stages.EXACT)
-THEORY_CODE = source_digest(stages.THEORY)
-FIT_CODE = source_digest(stages.FITS)
-FIGURE_CODE = source_digest(stages.PLOTTING)
-RESIDUALS_CODE = source_digest(stages.PLOTTING + stages.COMPARISON)
-TABLE_CODE = source_digest(stages.COMPARISON)
-VALIDATION_CODE = source_digest(stages.VALIDATION)
+
+def code(modules, script):
+    """A rule's `code` parameter: a digest of its stage's library modules
+    (bouncing_ball.stages names them without importing them) and of its script, so that
+    an edit of either re-runs that rule and what depends on it, and a touch (a checkout,
+    a branch switch) re-runs nothing: the default profile turns off Snakemake's
+    script-mtime trigger."""
+    return source_digest(modules, [f"{workflow.basedir}/scripts/{script}"])
+
+
+SHARD_CODE = code(stages.SIMULATION, "simulate_shard.py")  # pipeline and study shards
 
 # the r values with an exact solution, eq. (P(0,v)): always computed (Figs. 3 and 5)
 EXACT_BY_LABEL = {restitution_label(value): value for value in EXACT_RESTITUTIONS}

@@ -18,6 +18,6 @@ rule exact_solution:
     params:
         restitution=exact_value,
         settings=exact_settings(config),
-        code=EXACT_CODE,
+        code=code(stages.EXACT, "exact_solution.py"),
     script:
         "../../scripts/exact_solution.py"

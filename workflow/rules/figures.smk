@@ -24,7 +24,7 @@ rule fig1:
         cpus_per_task=1,
     params:
         dpi=config["figures"]["png_dpi"],
-        code=FIGURE_CODE,
+        code=code(stages.PLOTTING, "figures/fig1.py"),
     script:
         "../../scripts/figures/fig1.py"
 
@@ -51,7 +51,7 @@ rule fig2:
         cpus_per_task=1,
     params:
         dpi=config["figures"]["png_dpi"],
-        code=FIGURE_CODE,
+        code=code(stages.PLOTTING, "figures/fig2.py"),
     script:
         "../../scripts/figures/fig2.py"
 
@@ -78,7 +78,7 @@ rule fig3:
         cpus_per_task=1,
     params:
         dpi=config["figures"]["png_dpi"],
-        code=FIGURE_CODE,
+        code=code(stages.PLOTTING, "figures/fig3.py"),
     script:
         "../../scripts/figures/fig3.py"
 
@@ -109,7 +109,7 @@ rule fig4:
         cpus_per_task=1,
     params:
         dpi=config["figures"]["png_dpi"],
-        code=FIGURE_CODE,
+        code=code(stages.PLOTTING, "figures/fig4.py"),
     script:
         "../../scripts/figures/fig4.py"
 
@@ -139,7 +139,7 @@ rule fig5:
         cpus_per_task=1,
     params:
         dpi=config["figures"]["png_dpi"],
-        code=FIGURE_CODE,
+        code=code(stages.PLOTTING, "figures/fig5.py"),
     script:
         "../../scripts/figures/fig5.py"
 
@@ -168,7 +168,7 @@ rule fig6:
         cpus_per_task=1,
     params:
         dpi=config["figures"]["png_dpi"],
-        code=FIGURE_CODE,
+        code=code(stages.PLOTTING, "figures/fig6.py"),
     script:
         "../../scripts/figures/fig6.py"
 
@@ -196,6 +196,6 @@ rule fig7:
         cpus_per_task=1,
     params:
         dpi=config["figures"]["png_dpi"],
-        code=RESIDUALS_CODE,
+        code=code(stages.PLOTTING + stages.COMPARISON, "figures/fig7.py"),
     script:
         "../../scripts/figures/fig7.py"

@@ -22,7 +22,7 @@ rule simulate_shard:
         restitution=restitution_value,
         seed=config["seed"],
         settings=settings,
-        code=SIMULATION_CODE,
+        code=SHARD_CODE,
     script:
         "../../scripts/simulate_shard.py"
 
@@ -44,6 +44,6 @@ rule merge_shards:
         cpus_per_task=1,
     params:
         restitution=restitution_value,
-        code=MERGE_CODE,
+        code=code(stages.MERGE, "merge_shards.py"),
     script:
         "../../scripts/merge_shards.py"

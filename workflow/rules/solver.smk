@@ -17,7 +17,7 @@ rule solve:
     params:
         restitution=solver_restitution_value,
         settings=solver_settings(config),
-        code=SOLVER_CODE,
+        code=code(stages.SOLVER, "solve.py"),
     script:
         "../../scripts/solve.py"
 
@@ -37,6 +37,6 @@ rule solve_grid:
     params:
         grid=config["solver"]["restitution_grid"],
         step=config["solver"]["quadrature_step"],
-        code=SOLVER_CODE,
+        code=code(stages.SOLVER, "solve_grid.py"),
     script:
         "../../scripts/solve_grid.py"

@@ -20,7 +20,6 @@ try:
     STUDY_RUNS = study_runs(STUDIES, config)  # {study: {run: StudyRun}}
 except ValueError as error:
     raise ValueError(f"invalid {STUDIES_FILE}: {error}") from None
-STUDY_CODE = source_digest(stages.STUDIES)
 R075_LABEL = restitution_label(parse_restitution(STUDIES["r075"]["restitution"]))
 
 
@@ -65,7 +64,7 @@ rule study_shard:
         restitution=lambda w: exact_string(STUDY_RUNS[w.study][w.run].restitution),
         seed=lambda w: STUDY_RUNS[w.study][w.run].seed,
         settings=lambda w: STUDY_RUNS[w.study][w.run].settings.as_mapping(),
-        code=SIMULATION_CODE,
+        code=SHARD_CODE,
         record_cpu_seconds=True,
     script:
         "../../scripts/simulate_shard.py"
@@ -89,7 +88,7 @@ rule criterion_bias_report:
     params:
         runs=STUDY_RUN_TABLES["criterion_bias"],
         minimum_count=STUDIES["criterion_bias"]["minimum_count"],
-        code=STUDY_CODE,
+        code=code(stages.STUDIES, "studies/criterion_bias_report.py"),
     script:
         "../../scripts/studies/criterion_bias_report.py"
 
@@ -114,6 +113,6 @@ rule r075_report:
         runs=STUDY_RUN_TABLES["r075"],
         batch_size=STUDIES["r075"]["batch_size"],
         group_size=STUDIES["r075"]["group_size"],
-        code=STUDY_CODE,
+        code=code(stages.STUDIES, "studies/r075_report.py"),
     script:
         "../../scripts/studies/r075_report.py"

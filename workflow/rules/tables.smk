@@ -27,7 +27,7 @@ rule moments_table:
         mem_mb=500,
         cpus_per_task=1,
     params:
-        code=TABLE_CODE,
+        code=code(stages.COMPARISON, "moments_table.py"),
     script:
         "../../scripts/moments_table.py"
 
@@ -57,6 +57,6 @@ rule validation_table:
         mem_mb=500,
         cpus_per_task=1,
     params:
-        code=VALIDATION_CODE,
+        code=code(stages.VALIDATION, "validation_table.py"),
     script:
         "../../scripts/validation_table.py"

@@ -15,7 +15,7 @@ rule theory:
         cpus_per_task=1,
     params:
         grid=config["theory"]["restitution_grid"],
-        code=THEORY_CODE,
+        code=code(stages.THEORY, "theory.py"),
     script:
         "../../scripts/theory.py"
 
@@ -37,6 +37,6 @@ rule fit:
     params:
         restitution=restitution_value,
         settings=config["fits"],
-        code=FIT_CODE,
+        code=code(stages.FITS, "fit.py"),
     script:
         "../../scripts/fit.py"
