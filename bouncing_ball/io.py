@@ -8,6 +8,7 @@ import json
 import os
 import tempfile
 from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
@@ -94,8 +95,60 @@ def write_table(frame: pd.DataFrame, path, provenance: dict) -> None:
     write_tables({path: frame}, provenance)
 
 
-def read_table(path) -> tuple[pd.DataFrame, dict]:
-    """The frame and provenance of a table written by ``write_table``."""
+@dataclass(frozen=True)
+class TableKind:
+    """A kind of table the workflow writes: the rule that writes it and its columns
+    (docs/outputs.md); a reader names the kind it expects (``read_table``)."""
+
+    name: str
+    rule: str
+    columns: tuple[str, ...]
+
+
+_SUMMARY = ("r", "mean_x", "delta_x", "collision_rate")
+SIMULATED_P0V = TableKind(
+    "simulated P(0,v)", "merge_shards", ("v_lo", "v_hi", "v", "p0v", "p0v_err", "count")
+)
+SIMULATED_POSITION = TableKind(
+    "simulated P(x)",
+    "merge_shards",
+    ("x_lo", "x_hi", "x", "px", "px_err", "v2_given_x", "v2_given_x_err"),
+)
+SIMULATED_SUMMARY = TableKind(
+    "simulated summary",
+    "merge_shards",
+    (*_SUMMARY, "mean_x_err", "delta_x_err", "collision_rate_err"),
+)
+SOLVER_P0V = TableKind("solver P(0,v)", "solve", ("v", "p0v"))
+SOLVER_SUMMARY = TableKind("solver summary", "solve", (*_SUMMARY, "small_speed_exponent"))
+TIME_AVERAGES = TableKind("solver time averages", "solve_grid", _SUMMARY)
+EXACT_P0V = TableKind("exact P(0,v)", "exact_solution", ("v", "p0v"))
+EXACT_DISTRIBUTION = TableKind("exact P(x,v)", "exact_solution", ("x", "v", "pxv"))
+EXACT_SUMMARY = TableKind("exact summary", "exact_solution", _SUMMARY)
+EXPONENTS = TableKind("exponents", "theory", ("r", "beta", "m", "q"))
+FITS = TableKind(
+    "fits",
+    "fit",
+    (
+        "source",
+        "window",
+        "fit",
+        "parameter",
+        "value",
+        "error",
+        "theory",
+        "joint_p_value",
+        "chi2_per_dof",
+        "dof",
+        "v_min",
+        "v_max",
+    ),
+)
+
+
+def read_table(path, kind: TableKind | None = None) -> tuple[pd.DataFrame, dict]:
+    """The frame and provenance of a table written by ``write_table``; with ``kind``,
+    refused (naming the file) unless that kind's rule wrote it with its columns."""
     path = Path(path)
     try:
         table = pq.read_table(path)
@@ -112,7 +165,15 @@ def read_table(path) -> tuple[pd.DataFrame, dict]:
             f"{path}: no '{METADATA_KEY.decode()}' provenance metadata: not written by this workflow; "
             f"make it again with  snakemake --cores 2 --forcerun {path}"
         )
-    return table.to_pandas(), json.loads(raw)
+    frame, provenance = table.to_pandas(), json.loads(raw)
+    if kind is not None:
+        if provenance.get("rule") != kind.rule:
+            raise UnreadableFileError(
+                f"{path}: not a {kind.name} table: written by rule {provenance.get('rule')}, "
+                f"not {kind.rule}"
+            )
+        require_columns(frame, path, kind.columns)
+    return frame, provenance
 
 
 def require_columns(frame: pd.DataFrame, path, columns) -> pd.DataFrame:
@@ -125,10 +186,11 @@ def require_columns(frame: pd.DataFrame, path, columns) -> pd.DataFrame:
     return frame
 
 
-def read_tables_of_one_restitution(*paths) -> list[tuple[pd.DataFrame, dict]]:
-    """``read_table`` of each path, refused unless all were made for the same r
-    (e.g. the simulation, solver and fits that one figure panel compares)."""
-    tables = [read_table(path) for path in paths]
+def read_tables_of_one_restitution(*paths, kinds=None) -> list[tuple[pd.DataFrame, dict]]:
+    """``read_table`` of each path (with its kind of ``kinds``), refused unless all were
+    made for the same r (e.g. the simulation, solver and fits one figure panel compares)."""
+    kinds = [None] * len(paths) if kinds is None else kinds
+    tables = [read_table(path, kind) for path, kind in zip(paths, kinds, strict=True)]
     values = [provenance.get("r") for _, provenance in tables]
     if len(set(values)) > 1:
         which = ", ".join(

@@ -7,7 +7,7 @@ import numpy as np
 
 from bouncing_ball import fits
 from bouncing_ball.histograms import outgoing_speed_histogram
-from bouncing_ball.io import read_table, write_table
+from bouncing_ball.io import SOLVER_P0V, UnreadableFileError, read_table, write_table
 from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 from bouncing_ball.shards import read_shards
@@ -19,9 +19,9 @@ with job_log(snakemake.log[0]):
     shards, provenances = read_shards(list(snakemake.input.shards), label)
     table = outgoing_speed_histogram(shards)
     times = np.array([s.time for s in shards])
-    curve, solver_provenance = read_table(snakemake.input.solver)
+    curve, solver_provenance = read_table(snakemake.input.solver, SOLVER_P0V)
     if solver_provenance.get("r_label") != label:
-        raise ValueError(
+        raise UnreadableFileError(
             f"{snakemake.input.solver}: solved for r = {solver_provenance.get('r_label')}, not r = {label}"
         )
     # the solver's output speeds up to where its P(0, v) underflows

@@ -5,11 +5,13 @@ there is none) -> results/tables/moments.csv (one row per r and quantity) and mo
 
 import logging
 
-from bouncing_ball.comparison import QUANTITIES, moment_rows, moments_markdown, moments_table
+from bouncing_ball.comparison import moment_rows, moments_markdown, moments_table
 from bouncing_ball.io import (
+    EXACT_SUMMARY,
+    SIMULATED_SUMMARY,
+    SOLVER_SUMMARY,
     read_table,
     read_tables_of_one_restitution,
-    require_columns,
     write_csv_and_markdown,
 )
 from bouncing_ball.jobs import job_log
@@ -18,17 +20,14 @@ from bouncing_ball.restitution import parse_restitution
 with job_log(snakemake.log[0]):
     exact = {}
     for path in snakemake.input.exact:
-        summary, provenance = read_table(path)
-        require_columns(summary, path, QUANTITIES)
+        summary, provenance = read_table(path, EXACT_SUMMARY)
         exact[parse_restitution(provenance["r"])] = summary.iloc[0]
     rows = []
     pairs = zip(snakemake.input.simulation, snakemake.input.solver, strict=True)
     for simulation, solver in pairs:
-        (simulated, provenance), (solved, _) = read_tables_of_one_restitution(simulation, solver)
-        require_columns(
-            simulated, simulation, [*QUANTITIES, *(f"{name}_err" for name in QUANTITIES)]
+        (simulated, provenance), (solved, _) = read_tables_of_one_restitution(
+            simulation, solver, kinds=(SIMULATED_SUMMARY, SOLVER_SUMMARY)
         )
-        require_columns(solved, solver, QUANTITIES)
         restitution = parse_restitution(provenance["r"])
         rows += moment_rows(
             provenance["r_label"],

@@ -7,26 +7,16 @@ validation.md."""
 import logging
 
 from bouncing_ball.comparison import validation_markdown, validation_rows, validation_table
-from bouncing_ball.io import read_tables_of_one_restitution, require_columns, write_csv_and_markdown
+from bouncing_ball.io import (
+    FITS,
+    SIMULATED_P0V,
+    SIMULATED_POSITION,
+    SOLVER_P0V,
+    read_tables_of_one_restitution,
+    write_csv_and_markdown,
+)
 from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import parse_restitution
-
-P0V_COLUMNS = ["v_lo", "v_hi", "v", "p0v", "p0v_err", "count"]
-POSITION_COLUMNS = ["x_lo", "x_hi", "x", "px", "px_err", "v2_given_x", "v2_given_x_err"]
-FIT_COLUMNS = [
-    "source",
-    "window",
-    "fit",
-    "parameter",
-    "value",
-    "error",
-    "theory",
-    "joint_p_value",
-    "chi2_per_dof",
-    "dof",
-    "v_min",
-    "v_max",
-]
 
 with job_log(snakemake.log[0]):
     rows = []
@@ -39,15 +29,8 @@ with job_log(snakemake.log[0]):
     )
     for paths in inputs:
         (p0v, provenance), (position, _), (curve, _), (fits, _) = read_tables_of_one_restitution(
-            *paths
+            *paths, kinds=(SIMULATED_P0V, SIMULATED_POSITION, SOLVER_P0V, FITS)
         )
-        for table, path, columns in zip(
-            (p0v, position, curve, fits),
-            paths,
-            (P0V_COLUMNS, POSITION_COLUMNS, ["v", "p0v"], FIT_COLUMNS),
-            strict=True,
-        ):
-            require_columns(table, path, columns)
         rows += validation_rows(
             provenance["r_label"],
             parse_restitution(provenance["r"]),

@@ -2,11 +2,11 @@
 
 from bouncing_ball import plotting
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION
-from bouncing_ball.io import read_table
+from bouncing_ball.io import EXPONENTS, read_table
 from bouncing_ball.jobs import job_log
 
 with job_log(snakemake.log[0]):
-    exponents, _ = read_table(snakemake.input.exponents)
+    exponents, _ = read_table(snakemake.input.exponents, EXPONENTS)
     figure = plotting.exponents_figure(exponents, CRITICAL_RESTITUTION)
     plotting.save_figure(
         figure,

@@ -1,11 +1,11 @@
 """Rule fig2: the decay rate q(r), eqs. (asym4) and (asym6)."""
 
 from bouncing_ball import plotting
-from bouncing_ball.io import read_table
+from bouncing_ball.io import EXPONENTS, read_table
 from bouncing_ball.jobs import job_log
 
 with job_log(snakemake.log[0]):
-    exponents, _ = read_table(snakemake.input.exponents)
+    exponents, _ = read_table(snakemake.input.exponents, EXPONENTS)
     figure = plotting.decay_rate_figure(exponents)
     plotting.save_figure(
         figure,

@@ -2,14 +2,14 @@
 r (1/2, 1/3), eqs. (fpsol), (psi), (weightfunc2), (constants)."""
 
 from bouncing_ball import plotting
-from bouncing_ball.io import read_table
+from bouncing_ball.io import EXACT_DISTRIBUTION, read_table
 from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import parse_restitution
 
 with job_log(snakemake.log[0]):
     panels = []
     for path in snakemake.input.distributions:
-        distribution, provenance = read_table(path)
+        distribution, provenance = read_table(path, EXACT_DISTRIBUTION)
         panels.append((parse_restitution(provenance["r"]), distribution))
     figure = plotting.exact_distribution_figure(panels)
     plotting.save_figure(

@@ -2,7 +2,7 @@
 simulation) and the solver's curve, one panel per r of figures.fig4."""
 
 from bouncing_ball import plotting
-from bouncing_ball.io import read_tables_of_one_restitution
+from bouncing_ball.io import FITS, SIMULATED_P0V, SOLVER_P0V, read_tables_of_one_restitution
 from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import parse_restitution
 
@@ -10,7 +10,9 @@ with job_log(snakemake.log[0]):
     panels = []
     inputs = snakemake.input
     for paths in zip(inputs.simulation, inputs.solver, inputs.fits, strict=True):
-        (simulated, provenance), (solved, _), (fitted, _) = read_tables_of_one_restitution(*paths)
+        (simulated, provenance), (solved, _), (fitted, _) = read_tables_of_one_restitution(
+            *paths, kinds=(SIMULATED_P0V, SOLVER_P0V, FITS)
+        )
         panels.append(
             {
                 "restitution": parse_restitution(provenance["r"]),

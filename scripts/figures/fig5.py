@@ -2,14 +2,16 @@
 with no adjustable parameter, one panel per r of figures.fig5 (1/2, 1/3)."""
 
 from bouncing_ball import plotting
-from bouncing_ball.io import read_tables_of_one_restitution
+from bouncing_ball.io import EXACT_P0V, SIMULATED_P0V, read_tables_of_one_restitution
 from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import parse_restitution
 
 with job_log(snakemake.log[0]):
     panels = []
     for paths in zip(snakemake.input.simulation, snakemake.input.exact, strict=True):
-        (simulated, provenance), (solution, _) = read_tables_of_one_restitution(*paths)
+        (simulated, provenance), (solution, _) = read_tables_of_one_restitution(
+            *paths, kinds=(SIMULATED_P0V, EXACT_P0V)
+        )
         panels.append(
             {
                 "restitution": parse_restitution(provenance["r"]),

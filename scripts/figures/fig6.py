@@ -6,18 +6,21 @@ import pandas as pd
 
 from bouncing_ball import plotting
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION
-from bouncing_ball.io import read_table
+from bouncing_ball.io import EXACT_SUMMARY, SIMULATED_SUMMARY, TIME_AVERAGES, read_table
 from bouncing_ball.jobs import job_log
 
 
-def rows(paths):
-    frames = [read_table(path)[0] for path in paths]
+def rows(paths, kind):
+    frames = [read_table(path, kind)[0] for path in paths]
     return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
 
 
 with job_log(snakemake.log[0]):
-    solved, _ = read_table(snakemake.input.grid)
-    simulated, exact = rows(snakemake.input.simulation), rows(snakemake.input.exact)
+    solved, _ = read_table(snakemake.input.grid, TIME_AVERAGES)
+    simulated, exact = (
+        rows(snakemake.input.simulation, SIMULATED_SUMMARY),
+        rows(snakemake.input.exact, EXACT_SUMMARY),
+    )
     figure = plotting.time_averages_figure(solved, simulated, exact, CRITICAL_RESTITUTION)
     plotting.save_figure(
         figure,

@@ -5,14 +5,16 @@ import logging
 
 from bouncing_ball import plotting
 from bouncing_ball.comparison import outgoing_speed_residuals
-from bouncing_ball.io import read_tables_of_one_restitution
+from bouncing_ball.io import SIMULATED_P0V, SOLVER_P0V, read_tables_of_one_restitution
 from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import parse_restitution
 
 with job_log(snakemake.log[0]):
     panels = []
     for paths in zip(snakemake.input.simulation, snakemake.input.solver, strict=True):
-        (simulated, provenance), (solved, _) = read_tables_of_one_restitution(*paths)
+        (simulated, provenance), (solved, _) = read_tables_of_one_restitution(
+            *paths, kinds=(SIMULATED_P0V, SOLVER_P0V)
+        )
         residuals = outgoing_speed_residuals(simulated, solved)
         panels.append((parse_restitution(provenance["r"]), residuals))
         logging.info(

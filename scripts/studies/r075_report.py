@@ -5,11 +5,10 @@ import logging
 
 import pandas as pd
 
-from bouncing_ball.comparison import QUANTITIES
 from bouncing_ball.io import (
+    SOLVER_SUMMARY,
     UnreadableFileError,
     read_table,
-    require_columns,
     write_csv_and_markdown,
 )
 from bouncing_ball.jobs import job_log
@@ -17,8 +16,7 @@ from bouncing_ball.studies import r075_markdown, r075_rows, read_runs
 
 with job_log(snakemake.log[0]):
     runs = snakemake.params.runs
-    solved, provenance = read_table(snakemake.input.solver)
-    require_columns(solved, snakemake.input.solver, QUANTITIES)
+    solved, provenance = read_table(snakemake.input.solver, SOLVER_SUMMARY)
     label = runs[0]["r_label"]
     if provenance.get("r_label") != label:
         raise UnreadableFileError(

@@ -59,3 +59,14 @@ def test_a_failed_csv_and_markdown_pair_leaves_neither(tmp_path):
             pd.DataFrame({"r": [0.5]}), tmp_path / "table.csv", tmp_path / "table.md", "| r |"
         )
     assert not (tmp_path / "table.csv").exists()
+
+
+def test_a_reader_refuses_a_table_of_another_kind_naming_the_file(tmp_path):
+    path = tmp_path / "exponents.parquet"
+    write_table(pd.DataFrame({"v": [1.0], "p0v": [0.5]}), path, {"rule": "solve"})
+    with pytest.raises(UnreadableFileError, match="exponents.parquet: not a exponents table"):
+        read_table(path, EXPONENTS)
+    write_table(pd.DataFrame({"r": [0.5], "beta": [1.0]}), path, {"rule": "theory"})
+    with pytest.raises(UnreadableFileError, match="exponents.parquet: .*lacks the columns m, q"):
+        read_table(path, EXPONENTS)
+    assert read_table(path)[1]["rule"] == "theory"  # no kind asked: read as it is

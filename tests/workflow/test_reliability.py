@@ -197,3 +197,34 @@ def test_extreme_r_runs_end_to_end_within_its_budget(tmp_path):
     assert below.collision_rate.iloc[0] == float("inf")
     table = pd.read_csv(directory / "results/tables/moments.csv")
     assert np.isnan(table[(table.r_label == 0.05) & (table.quantity == "collision_rate")].z.iloc[0])
+
+
+def test_every_reader_refuses_a_table_of_the_wrong_kind_or_r(finished_run, tmp_path):
+    """A table of the wrong kind gave a raw AttributeError; the r = 1/3 solver curve under
+    the r = 1/2 simulation would be a wrong comparison: each reader names the file."""
+    directory = tmp_path / "copy"
+    shutil.copytree(finished_run, directory)
+    results = directory / "results"
+    shutil.copy(results / "solver/r0.5/p0v.parquet", results / "theory/exponents.parquet")
+    shutil.copy(results / "solver/r0.333333/p0v.parquet", results / "solver/r0.5/p0v.parquet")
+    shutil.copy(results / "solver/r0.5/summary.parquet", results / "exact/r0.5/summary.parquet")
+    before = {path: path.read_bytes() for path in results.rglob("*.p*")}
+    result = snakemake(directory, "--keep-going")
+    assert result.returncode != 0
+    wrong_kind = "results/theory/exponents.parquet: not a exponents table: written by rule solve"
+    wrong_r = "not the same r: results/simulation/r0.5/p0v.parquet (r = 1/2), results/solver/r0.5/p0v.parquet (r = 1/3)"
+    expected = {
+        "figures/fig1": wrong_kind,
+        "figures/fig2": wrong_kind,
+        "figures/fig7": wrong_r,
+        "fits/r0.5": "results/solver/r0.5/p0v.parquet: solved for r = 0.333333, not r = 0.5",
+        "figures/fig6": "results/exact/r0.5/summary.parquet: not a exact summary table",
+        "tables/moments": "results/exact/r0.5/summary.parquet: not a exact summary table",
+    }
+    for log, message in expected.items():
+        text = (directory / "logs" / f"{log}.log").read_text()
+        assert message in text and "UnreadableFileError" in text, (log, text[-1500:])
+    # Fig. 4 and the validation table wait for the fit of r = 1/2, which failed
+    # the failed jobs' outputs are gone (Snakemake removes them), nothing else changed
+    after = {path: path.read_bytes() for path in results.rglob("*.p*")}
+    assert {path: data for path, data in before.items() if path in after} == after
