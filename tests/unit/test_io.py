@@ -7,6 +7,8 @@ import pandas as pd
 import pytest
 
 from bouncing_ball.io import (
+    EXPONENTS,
+    UnreadableFileError,
     atomic_paths,
     read_table,
     write_csv_and_markdown,
