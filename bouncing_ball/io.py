@@ -146,6 +146,35 @@ FITS = TableKind(
 )
 
 
+def _unreadable(path, error) -> UnreadableFileError:
+    return UnreadableFileError(
+        f"{path}: not a readable Parquet file ({error}). It is probably truncated or "
+        f"corrupt: make it again with  snakemake --cores 2 --forcerun {path}  (plus your targets)"
+    )
+
+
+def _provenance(path, schema) -> dict:
+    raw = (schema.metadata or {}).get(METADATA_KEY)
+    if raw is None:
+        raise UnreadableFileError(
+            f"{path}: no '{METADATA_KEY.decode()}' provenance metadata: not written by this workflow; "
+            f"make it again with  snakemake --cores 2 --forcerun {path}"
+        )
+    return json.loads(raw)
+
+
+def read_provenance(path) -> dict:
+    """The provenance of a table written by ``write_table``, without reading its data."""
+    path = Path(path)
+    try:
+        schema = pq.read_schema(path)
+    except FileNotFoundError:
+        raise UnreadableFileError(f"{path}: file not found") from None
+    except (pa.ArrowException, OSError) as error:
+        raise _unreadable(path, error) from None
+    return _provenance(path, schema)
+
+
 def read_table(path, kind: TableKind | None = None) -> tuple[pd.DataFrame, dict]:
     """The frame and provenance of a table written by ``write_table``; with ``kind``,
     refused (naming the file) unless that kind's rule wrote it with its columns."""
@@ -155,17 +184,8 @@ def read_table(path, kind: TableKind | None = None) -> tuple[pd.DataFrame, dict]
     except FileNotFoundError:
         raise UnreadableFileError(f"{path}: file not found") from None
     except (pa.ArrowException, OSError) as error:
-        raise UnreadableFileError(
-            f"{path}: not a readable Parquet file ({error}). It is probably truncated or "
-            f"corrupt: make it again with  snakemake --cores 2 --forcerun {path}  (plus your targets)"
-        ) from None
-    raw = (table.schema.metadata or {}).get(METADATA_KEY)
-    if raw is None:
-        raise UnreadableFileError(
-            f"{path}: no '{METADATA_KEY.decode()}' provenance metadata: not written by this workflow; "
-            f"make it again with  snakemake --cores 2 --forcerun {path}"
-        )
-    frame, provenance = table.to_pandas(), json.loads(raw)
+        raise _unreadable(path, error) from None
+    frame, provenance = table.to_pandas(), _provenance(path, table.schema)
     if kind is not None:
         if provenance.get("rule") != kind.rule:
             raise UnreadableFileError(

@@ -228,3 +228,62 @@ def test_every_reader_refuses_a_table_of_the_wrong_kind_or_r(finished_run, tmp_p
     # the failed jobs' outputs are gone (Snakemake removes them), nothing else changed
     after = {path: path.read_bytes() for path in results.rglob("*.p*")}
     assert {path: data for path, data in before.items() if path in after} == after
+
+
+def _copy_with_config(finished_run, tmp_path, change):
+    directory = tmp_path / "copy"
+    shutil.copytree(finished_run, directory)
+    config = yaml.safe_load((directory / "config/config.yaml").read_text())
+    change(config)
+    (directory / "config/config.yaml").write_text(yaml.safe_dump(config))
+    return directory
+
+
+def _longer_shards(config):
+    config["simulation"]["shard_time"] = 3.0e3
+
+
+def test_tables_of_another_config_without_snakemakes_record_are_named(finished_run, tmp_path):
+    """With .snakemake/ gone a changed shard_time gave "Nothing to be done" and kept the
+    old tables: each table's provenance is compared with the config, before any job."""
+    directory = _copy_with_config(finished_run, tmp_path, _longer_shards)
+    planned = subprocess.run(
+        [sys.executable, "-m", "snakemake", "--cores", "2", "--dry-run"],
+        cwd=directory,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert planned.returncode == 0 and "simulate_shard" in planned.stdout  # Snakemake knows
+    shutil.rmtree(directory / ".snakemake")
+    before = {path: path.stat().st_mtime_ns for path in (directory / "results").rglob("*")}
+    result = snakemake(directory)
+    message = result.stdout + result.stderr
+    assert result.returncode != 0
+    assert "results made for another config, which Snakemake has no record of" in message
+    assert "results/simulation/r0.5/shard2.parquet: shard_time = 2000.0 (config: 3000.0)" in message
+    assert "results/simulation/r0.333333/summary.parquet: shard_time = 2000.0" in message
+    assert "rm results/simulation/r0.333333/p0v.parquet" in message
+    assert {path: path.stat().st_mtime_ns for path in (directory / "results").rglob("*")} == before
+    for path in (directory / "results/simulation").rglob("*.parquet"):
+        path.unlink()  # as the message says
+    assert snakemake(directory, "results/simulation/r0.5/summary.parquet").returncode == 0
+
+
+def test_a_report_of_results_made_with_another_config_is_refused(finished_run, tmp_path):
+    """`snakemake --report` without the run's overlay captioned the overlay's figures
+    with the base config's r."""
+
+    def other_panels(config):
+        config["figures"]["fig4"] = ["1/3"]
+
+    directory = _copy_with_config(finished_run, tmp_path, other_panels)
+    result = snakemake(directory, "--report", str(tmp_path / "report.html"))
+    message = result.stdout + result.stderr
+    assert result.returncode != 0 and not (tmp_path / "report.html").exists()
+    assert "the report would caption results that are not this config's" in message
+    assert "results/figures/fig4.png: drawn from results/simulation/r0.5/p0v.parquet" in message
+    directory = _copy_with_config(finished_run, tmp_path / "b", _longer_shards)
+    result = snakemake(directory, "--report", str(tmp_path / "report.html"))
+    assert result.returncode != 0
+    assert "results/simulation/r0.5/summary.parquet: shard_time = 2000.0" in result.stderr
