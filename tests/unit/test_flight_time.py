@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from scipy import integrate, stats
 
+from bouncing_ball import exact
 from bouncing_ball import flight_time as ft
 from bouncing_ball.kernel import return_speed_kernel
 from bouncing_ball.solver import coordinate_of_speed, solve_outgoing_speed_density
@@ -68,11 +69,12 @@ def test_return_is_certain(u):
 
 @pytest.mark.parametrize("u", SPEEDS)
 def test_ito_identities(u):
+    """Exact identities of the process, all moments by quadrature of eq. (timemoments)."""
+
     def moment(k, m):
         return ft.conditional_moment(u, k, m)
 
-    mean_time = ft.mean_flight_time_given_speed(u)
-    second_time = ft.flight_time_second_moment_given_speed(u)
+    mean_time, second_time = moment(1, 0), moment(2, 0)
     # v + t
     assert mean_time == pytest.approx(u + moment(0, 1), rel=TOLERANCE)
     # v^2 + 2 x
@@ -82,6 +84,31 @@ def test_ito_identities(u):
     # (v + t)^3
     cube = moment(3, 0) - 3.0 * moment(2, 1) + 3.0 * moment(1, 2) - moment(0, 3)
     assert cube == pytest.approx(u**3 + 3.0 * second_time, rel=TOLERANCE)
+
+
+@pytest.mark.parametrize("u", [1e-20, *SPEEDS, 1e4])
+def test_closed_form_moments(u):
+    """Eqs. (meanT), (meanT2) against the quadrature of the joint law."""
+    assert ft.mean_flight_time_given_speed(u) == pytest.approx(
+        ft.conditional_moment(u, 1, 0), rel=TOLERANCE
+    )
+    assert ft.flight_time_second_moment_given_speed(u) == pytest.approx(
+        ft.conditional_moment(u, 2, 0), rel=TOLERANCE
+    )
+
+
+def test_closed_form_limits():
+    small, large = 1e-14, 400.0
+    assert ft.mean_flight_time_given_speed(small) == pytest.approx(
+        3.0 * np.sqrt(2.0 * small / np.pi), rel=1e-6
+    )
+    assert ft.flight_time_second_moment_given_speed(small) == pytest.approx(
+        18.0 * np.sqrt(2.0 * small / np.pi), rel=1e-6
+    )
+    mean = ft.mean_flight_time_given_speed(large)
+    assert mean == pytest.approx(2.0 * large + 4.0 / 3.0, rel=1e-14)
+    variance = ft.flight_time_second_moment_given_speed(large) - mean**2
+    assert variance == pytest.approx(16.0 * large / 3.0 + 80.0 / 9.0, rel=1e-9)
 
 
 @pytest.mark.parametrize("u", SPEEDS)
@@ -119,6 +146,29 @@ def test_equilibrium_mean_flight_time_is_inverse_collision_rate(solution):
     assert ft.flight_time_second_moment(solution) > ft.mean_flight_time(solution) ** 2
 
 
+@pytest.mark.parametrize("r", [0.5, 1 / 3])
+def test_time_weighted_mean_with_exact_solution(r):
+    """int du u P(0, u) E[T^2 | u] with the paper's exact P(0, v) (eq. (P(0,v))) against the
+    solver's; at r = 1/2 it is 12 - 2 sqrt(3) (eq. (meanT2) integrated against e^-u / 3)."""
+
+    def integrand(u):
+        return u * exact.outgoing_speed_density(u, r) * ft.flight_time_second_moment_given_speed(u)
+
+    value, _ = integrate.quad(integrand, 0.0, np.inf, epsabs=0.0, epsrel=1e-13, limit=200)
+    solution = solve_outgoing_speed_density(r)
+    assert ft.time_weighted_mean_flight_time(solution) == pytest.approx(value, rel=TOLERANCE)
+    if r == 0.5:
+        assert value == pytest.approx(12.0 - 2.0 * np.sqrt(3.0), rel=1e-13)
+
+
+def test_summary(solution):
+    row = ft.flight_time_summary(solution)
+    assert row["mean_flight_time"] * row["collision_rate"] == pytest.approx(1.0, abs=TOLERANCE)
+    # above r_c the time-weighted mean is <T^2> / <T>
+    ratio = row["flight_time_second_moment"] / row["mean_flight_time"]
+    assert row["time_weighted_mean_flight_time"] == pytest.approx(ratio, rel=TOLERANCE)
+
+
 def test_flights_fill_the_time_below_critical():
     """Below r_c, I = inf but int T nu(T) dT = 1 still holds; per collision the mean is 0."""
     solution = solve_outgoing_speed_density(0.1)
@@ -137,17 +187,19 @@ def _flight_rate_integrals(solution, step=0.25):
     weights[0] *= 2.0  # the lowest node gets its full weight; the rule continues below it
     nu = ft.flight_rate_density(solution, t)
     beta = solution.small_speed_exponent
-    below = [
-        weights[0] * t[0] ** k * nu[0] / np.expm1((1.0 + k - 0.5 * beta) * step) for k in (0, 1)
+    return [
+        weights @ (t**k * nu) + weights[0] * t[0] ** k * nu[0] / np.expm1((1 + k - beta / 2) * step)
+        for k in (0, 1, 2)
     ]
-    return weights @ nu + below[0], weights @ (t * nu) + below[1]
 
 
 def test_flight_rate_density_integrates_to_collision_rate(solution):
-    """int nu(T) dT = I and int T nu(T) dT = 1, by integrating nu(T) itself."""
-    count, time = _flight_rate_integrals(solution)
+    """int nu(T) dT = I, int T nu(T) dT = 1 and int T^2 nu dT = int du u P(0, u) E[T^2 | u]
+    (eq. (meanT2)), by integrating nu(T) itself."""
+    count, time, second = _flight_rate_integrals(solution)
     assert count == pytest.approx(solution.moment(1), rel=TOLERANCE)
     assert time == pytest.approx(1.0, rel=TOLERANCE)
+    assert second == pytest.approx(ft.flight_rate_moment(solution, 2), rel=TOLERANCE)
 
 
 def test_short_time_constant_against_gravity_free_law():
