@@ -42,14 +42,18 @@ def _time_integral(v, u, k):
 def test_time_marginal_of_joint_law_is_kernel3(u, v):
     """int dt p(t, v | u) = v G_g(v, u), eq. (GgP) with eq. (kernel3): McKean's law, its units
     (<xi xi> = 2 delta) and eq. (0g) together."""
-    assert _time_integral(v, u, 0) == pytest.approx(v * return_speed_kernel(v, u), rel=TOLERANCE)
+    assert _time_integral(v, u, 0) == pytest.approx(
+        v * return_speed_kernel(v, u), rel=TOLERANCE, abs=0.0
+    )
 
 
 @pytest.mark.parametrize("k", [0, 1, 2, 3])
 @pytest.mark.parametrize("u, v", PAIRS)
 def test_time_moments_in_closed_form(u, v, k):
     """Eq. (timemoments) (the y -> tau form) against the time integral of eq. (joint)."""
-    assert ft.return_time_moment(v, u, k) == pytest.approx(_time_integral(v, u, k), rel=TOLERANCE)
+    assert ft.return_time_moment(v, u, k) == pytest.approx(
+        _time_integral(v, u, k), rel=TOLERANCE, abs=0.0
+    )
 
 
 def test_gravity_free_limit():
@@ -76,34 +80,34 @@ def test_ito_identities(u):
 
     mean_time, second_time = moment(1, 0), moment(2, 0)
     # v + t
-    assert mean_time == pytest.approx(u + moment(0, 1), rel=TOLERANCE)
+    assert mean_time == pytest.approx(u + moment(0, 1), rel=TOLERANCE, abs=0.0)
     # v^2 + 2 x
-    assert moment(0, 2) == pytest.approx(u * u + 2.0 * mean_time, rel=TOLERANCE)
+    assert moment(0, 2) == pytest.approx(u * u + 2.0 * mean_time, rel=TOLERANCE, abs=0.0)
     # t v + t^2 / 2
-    assert second_time == pytest.approx(2.0 * moment(1, 1), rel=TOLERANCE)
+    assert second_time == pytest.approx(2.0 * moment(1, 1), rel=TOLERANCE, abs=0.0)
     # (v + t)^3
     cube = moment(3, 0) - 3.0 * moment(2, 1) + 3.0 * moment(1, 2) - moment(0, 3)
-    assert cube == pytest.approx(u**3 + 3.0 * second_time, rel=TOLERANCE)
+    assert cube == pytest.approx(u**3 + 3.0 * second_time, rel=TOLERANCE, abs=0.0)
 
 
 @pytest.mark.parametrize("u", [1e-20, *SPEEDS, 1e4])
 def test_closed_form_moments(u):
     """Eqs. (meanT), (meanT2) against the quadrature of the joint law."""
     assert ft.mean_flight_time_given_speed(u) == pytest.approx(
-        ft.conditional_moment(u, 1, 0), rel=TOLERANCE
+        ft.conditional_moment(u, 1, 0), rel=TOLERANCE, abs=0.0
     )
     assert ft.flight_time_second_moment_given_speed(u) == pytest.approx(
-        ft.conditional_moment(u, 2, 0), rel=TOLERANCE
+        ft.conditional_moment(u, 2, 0), rel=TOLERANCE, abs=0.0
     )
 
 
 def test_closed_form_limits():
     small, large = 1e-14, 400.0
     assert ft.mean_flight_time_given_speed(small) == pytest.approx(
-        3.0 * np.sqrt(2.0 * small / np.pi), rel=1e-6
+        3.0 * np.sqrt(2.0 * small / np.pi), rel=1e-6, abs=0.0
     )
     assert ft.flight_time_second_moment_given_speed(small) == pytest.approx(
-        18.0 * np.sqrt(2.0 * small / np.pi), rel=1e-6
+        18.0 * np.sqrt(2.0 * small / np.pi), rel=1e-6, abs=0.0
     )
     mean = ft.mean_flight_time_given_speed(large)
     assert mean == pytest.approx(2.0 * large + 4.0 / 3.0, rel=1e-14)
@@ -117,9 +121,11 @@ def test_flight_time_density_moments(u):
     at fixed v): the two orders of the double integral of eq. (joint)."""
     t, weights = ft.flight_time_nodes(u)
     f = ft.flight_time_density(t, u)
-    assert weights @ (t * f) == pytest.approx(ft.mean_flight_time_given_speed(u), rel=TOLERANCE)
+    assert weights @ (t * f) == pytest.approx(
+        ft.mean_flight_time_given_speed(u), rel=TOLERANCE, abs=0.0
+    )
     second = ft.flight_time_second_moment_given_speed(u)
-    assert weights @ (t * t * f) == pytest.approx(second, rel=TOLERANCE)
+    assert weights @ (t * t * f) == pytest.approx(second, rel=TOLERANCE, abs=0.0)
 
 
 @pytest.mark.parametrize("u", [1e-6, 0.05, 1.0, 20.0])
@@ -136,7 +142,7 @@ def test_flight_time_density_against_adaptive_quadrature(u, x):
     value, _ = integrate.quad(
         integrand, lo, hi, points=[np.log(centre)], epsabs=0.0, epsrel=1e-13, limit=500
     )
-    assert ft.flight_time_density(t, u) == pytest.approx(value, rel=TOLERANCE)
+    assert ft.flight_time_density(t, u) == pytest.approx(value, rel=TOLERANCE, abs=0.0)
 
 
 def test_equilibrium_mean_flight_time_is_inverse_collision_rate(solution):
@@ -156,7 +162,9 @@ def test_time_weighted_mean_with_exact_solution(r):
 
     value, _ = integrate.quad(integrand, 0.0, np.inf, epsabs=0.0, epsrel=1e-13, limit=200)
     solution = solve_outgoing_speed_density(r)
-    assert ft.time_weighted_mean_flight_time(solution) == pytest.approx(value, rel=TOLERANCE)
+    assert ft.time_weighted_mean_flight_time(solution) == pytest.approx(
+        value, rel=TOLERANCE, abs=0.0
+    )
     if r == 0.5:
         assert value == pytest.approx(12.0 - 2.0 * np.sqrt(3.0), rel=1e-13)
 
@@ -166,7 +174,7 @@ def test_summary(solution):
     assert row["mean_flight_time"] * row["collision_rate"] == pytest.approx(1.0, abs=TOLERANCE)
     # above r_c the time-weighted mean is <T^2> / <T>
     ratio = row["flight_time_second_moment"] / row["mean_flight_time"]
-    assert row["time_weighted_mean_flight_time"] == pytest.approx(ratio, rel=TOLERANCE)
+    assert row["time_weighted_mean_flight_time"] == pytest.approx(ratio, rel=TOLERANCE, abs=0.0)
 
 
 def test_flights_fill_the_time_below_critical():
@@ -197,9 +205,28 @@ def test_flight_rate_density_integrates_to_collision_rate(solution):
     """int nu(T) dT = I, int T nu(T) dT = 1 and int T^2 nu dT = int du u P(0, u) E[T^2 | u]
     (eq. (meanT2)), by integrating nu(T) itself."""
     count, time, second = _flight_rate_integrals(solution)
-    assert count == pytest.approx(solution.moment(1), rel=TOLERANCE)
-    assert time == pytest.approx(1.0, rel=TOLERANCE)
-    assert second == pytest.approx(ft.flight_rate_moment(solution, 2), rel=TOLERANCE)
+    assert count == pytest.approx(solution.moment(1), rel=TOLERANCE, abs=0.0)
+    assert time == pytest.approx(1.0, rel=TOLERANCE, abs=0.0)
+    assert second == pytest.approx(ft.flight_rate_moment(solution, 2), rel=TOLERANCE, abs=0.0)
+
+
+@pytest.mark.parametrize("t", [1e-20, 1e-10, 1e-3, 1.0, 30.0])
+def test_flight_rate_density_against_adaptive_quadrature(t):
+    """nu(T) of eq. (rate) against adaptive quadrature in ln u with the solver's Nystrom P(0, u);
+    below u = 1e-7 T^(1/2) the integrand is the power law u^(5/2 - beta) (in ln u)."""
+    solution = solve_outgoing_speed_density(0.25)
+
+    def integrand(log_u):
+        u = np.exp(np.atleast_1d(log_u))
+        rate = u * u * solution.outgoing_speed_density(u)
+        return (rate * ft.flight_time_density(t, u))[0]
+
+    lo = np.log(1e-7 * np.sqrt(t))
+    hi = np.log(solution.speeds[-1])
+    peak = np.log(max(np.sqrt(t), 0.5 * t))
+    value, _ = integrate.quad(integrand, lo, hi, points=[peak], epsabs=0.0, epsrel=1e-12, limit=400)
+    value += integrand(lo) / (2.5 - solution.small_speed_exponent)
+    assert ft.flight_rate_density(solution, t) == pytest.approx(value, rel=TOLERANCE, abs=0.0)
 
 
 def test_short_time_constant_against_gravity_free_law():
@@ -211,7 +238,7 @@ def test_short_time_constant_against_gravity_free_law():
             return u ** (2.0 - beta) * ft.free_flight_time_density(1.0, u)
 
         value, _ = integrate.quad(integrand, -60.0, 4.0, epsabs=0.0, epsrel=1e-12, limit=400)
-        assert ft.short_time_constant(beta) == pytest.approx(value, rel=1e-7)
+        assert ft.short_time_constant(beta) == pytest.approx(value, rel=1e-7, abs=0.0)
 
 
 @pytest.mark.parametrize("r", [0.1, 0.5, 0.9])
@@ -262,7 +289,7 @@ def test_return_speed_bins():
         v = np.geomspace(lo, v_upper[j], 1601)
         inner = integrate.simpson(v * return_speed_kernel(v[None, :], u[:, None]), x=v, axis=1)
         expected = integrate.simpson(flux * inner, x=u) / integrate.simpson(flux, x=u)
-        assert cells[3, j] == pytest.approx(expected, rel=1e-6)
+        assert cells[3, j] == pytest.approx(expected, rel=1e-6, abs=0.0)
 
 
 def _simulated_flights(u, count, dt, seed):
