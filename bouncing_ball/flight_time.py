@@ -212,7 +212,7 @@ def return_time_moment(v, u, k):
 # --- conditional moments given u ----------------------------------------------------------------
 
 
-def _trapezoid_nodes(lowest, highest, step):
+def trapezoid_nodes(lowest, highest, step):
     """Nodes and weights of the trapezoidal rule in s = ln x + x^(1/2) over [lowest, highest]."""
     s_lo, s_hi = coordinate_of_speed(lowest), coordinate_of_speed(highest)
     count = int(np.ceil((s_hi - s_lo) / step)) + 1
@@ -226,7 +226,7 @@ def return_speed_nodes(u, step=SPEED_STEP):
     """Return speeds and weights that integrate functions of v against p(., v | u)."""
     lowest = SMALLEST_RATIO * min(u, 1.0)
     highest = u + 140.0 + 16.0 * np.sqrt(u)  # e^-70 of the return-speed law, Gaussian and tail
-    return _trapezoid_nodes(lowest, highest, step)
+    return trapezoid_nodes(lowest, highest, step)
 
 
 def conditional_moment(u, time_power, speed_power, step=SPEED_STEP):
@@ -343,7 +343,7 @@ def flight_time_window(u, cut=EXPONENT_CUT):
 
 def flight_time_nodes(u, step=TIME_STEP):
     """Flight times and weights that integrate functions of t against f(t | u)."""
-    return _trapezoid_nodes(*flight_time_window(u), step)
+    return trapezoid_nodes(*flight_time_window(u), step)
 
 
 # --- equilibrium ---------------------------------------------------------------------------------

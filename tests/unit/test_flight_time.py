@@ -190,7 +190,7 @@ def test_flights_fill_the_time_below_critical():
 def _flight_rate_integrals(solution, step=0.25):
     """int nu dT and int T nu dT: the trapezoidal rule in s = ln T + T^(1/2) from 1e-16 to 300,
     continued below 1e-16 in closed form with nu ~ T^(-beta/2) (the rule extended to s = -inf)."""
-    t, weights = ft._trapezoid_nodes(1e-16, 300.0, step)
+    t, weights = ft.trapezoid_nodes(1e-16, 300.0, step)
     step = np.diff(coordinate_of_speed(t[:2]))[0]  # the rule's own step, <= the one asked for
     weights[0] *= 2.0  # the lowest node gets its full weight; the rule continues below it
     nu = ft.flight_rate_density(solution, t)
