@@ -1,0 +1,638 @@
+"""Flight times between collisions: McKean's first-passage law with gravity, for any r.
+
+Units of the paper (g = Lambda = 1): dx = v dt, dv = -dt + xi dt, <xi(t) xi(t')> = 2 delta(t - t').
+A ball leaves the floor with speed u > 0; p(t, v | u) dt dv is the probability that it first
+comes back after a flight time in [t, t + dt] with speed (incoming velocity -v) in [v, v + dv].
+
+1. McKean's law without gravity.  For integrated Brownian motion with unit diffusion
+   (Var B_t = t) started at x = 0 with velocity a > 0, McKean (J. Math. Kyoto Univ. 2, 227
+   (1963), eqs. (5), (6); also Lachal) gives the joint density of the hitting time and speed,
+
+       (3 w / (pi sqrt(2) t^2)) exp[-2 (w^2 - a w + a^2) / t] int_0^(4 a w / t) e^(-3 th / 2) dth / (pi th)^(1/2).
+
+   The integral is (2/3)^(1/2) erf[(6 a w / t)^(1/2)].  Our noise has Var = 2 t, i.e. speeds are
+   sqrt(2) times McKean's (a = u / sqrt 2, w = v / sqrt 2, density x 1/sqrt 2):
+
+       p_0(t, v | u) = (sqrt(3) v / (2 pi t^2)) exp[-(v^2 - u v + u^2) / t] erf[(3 u v / t)^(1/2)].
+
+   (= v P_0(0, -v; 0, u; t) of Appendix A.)
+
+2. Gravity, eq. (0g): P_g = exp[-(v - v0)/2 - t/4] P_0 at incoming velocity -v, v0 = u, so
+   p(t, v | u) = exp[(v + u)/2 - t/4] p_0(t, v | u).  The exponents combine into a sum of squares,
+
+       p(t, v | u) = (sqrt(3) v / (2 pi t^2)) exp{-[(t - u - v)^2 + 3 (v - u)^2] / (4 t)}
+                     * erf[(3 u v / t)^(1/2)],                                        (joint)
+
+   every term <= 0: nothing overflows, nothing cancels (the erf of a small argument is
+   evaluated to full relative precision by scipy).  In v at fixed t the exponent is
+   -(v - v*)^2 / t - 3 (t - 2 u)^2 / (16 t) with v* = (t + 2 u) / 4: the ballistic flight time 2 u
+   with a Gaussian spread.
+
+3. Time moments of the return at fixed v, in closed form.  With
+   erf(s^(1/2)) = 2 (s / pi)^(1/2) int_0^1 dy e^(-s y^2) and
+   int_0^inf dt t^(n - 1) e^(-t/4 - z^2/t) = 2 (2 z)^n K_n(z),
+
+       int_0^inf dt t^k p(t, v | u) = (3 v (u v)^(1/2) / pi) e^((v+u)/2) int_0^1 dy e^(-z) h_k(z),
+       z^2 = v^2 - v u + u^2 + 3 v u y^2,
+       h_0 = (z^-2 + z^-3) / 2,  h_1 = 1 / z,  h_2 = 2,  h_3 = 4 (1 + z)           (timemoments)
+
+   (K_{k-3/2} is elementary).  k = 0 is v G_g(v, u) of eq. (kernel3), so (joint) integrates over
+   t to the paper's kernel: this is the check that the time-domain law and its units are right
+   (eq. (GgP)).  Each y-integral is made stable exactly as in ``kernel.py`` (y -> z -> tau); the
+   result is
+
+       int dt t^k p = (2 sqrt(3) v / pi) exp[-(3/4)(v - u)^2 / ((v + u)/2 + z0)]
+                      * int_0^tau1 dtau e^(-z0 tau^2) z h_k(z) / (2 + tau^2)^(1/2),
+       z = z0 (1 + tau^2).
+
+4. Conditional moments E[T^k v^m | u] are one v-integral of (timemoments), done by the
+   trapezoidal rule in s = ln v + v^(1/2) (as the solver's; exponential convergence).  Ito's
+   formula with the generator v d/dx - d/dv + d^2/dv^2 gives exact identities they must obey
+   (x = 0 at both ends, v -> -v_return):
+
+       v + t:        E[T | u] = u + E[v | u]
+       v^2 + 2 x:    E[v^2 | u] = u^2 + 2 E[T | u]
+       t v + t^2/2:  E[T^2 | u] = 2 E[T v | u]
+       (v + t)^3:    E[(T - v)^3 | u] = u^3 + 3 E[T^2 | u]
+
+   Closed forms.  Through eq. (kernel2), E[v | u] = int dv v^2 G_g(v, u) needs
+   int_0^inf dx x e^(-x cos th) K_(i g)(x) at th = 2 pi / 3 (the th-derivative of
+   int dx e^(-x cos th) K_(i g)(x) = pi sinh(g th) / (sinh(pi g) sin th)); the Kontorovich-Lebedev
+   identities int_0^inf dg cosh(a g) K_(i g)(u) = (pi/2) e^(-u cos a) (|a| < pi/2) and their
+   a-derivatives at a = pi/3 then give u + 4/3, and the one term left,
+   int dg g^2 K_(i g)(u) / cosh(pi g / 3), follows from the Fourier pair
+   int_0^inf dg cos(g w) / cosh(pi g / 3) = (3/2) / cosh(3 w / 2),
+   K_(i g)(u) = int_0^inf dt e^(-u cosh t) cos(g t), two integrations by parts and y = sinh(t/2)
+   (Gaussian integrals of rational functions of y: erfcx).  With E[T | u] = u + E[v | u]:
+
+       E[T | u] = 2u + 4/3 - e^(-u/2) [(2/3) erfcx((2u)^(1/2)) + (2/3 + u) erfcx((u/2)^(1/2))
+                                       - (2u/pi)^(1/2)]                                 (meanT)
+
+   (u -> 0: 3 (2u/pi)^(1/2); u -> inf: 2u + 4/3 + O(e^(-u/2))).  The second moment has the same
+   structure; its coefficients were identified by a least-squares fit of the quadrature on that
+   basis (rational to ~1e-6, then confirmed to 4e-15 over 1e-8 <= u <= 300, not derived):
+
+       E[T^2 | u] = 4u^2 + 32u/3 + 32/3 - e^(-u/2) [(16/3 - 8u/3) erfcx((2u)^(1/2))
+                    + (16/3 + 16u/3 + 2u^2) erfcx((u/2)^(1/2)) - 2 (2/pi)^(1/2) (u^(1/2) + u^(3/2))]
+                                                                                        (meanT2)
+
+   (u -> 0: 18 (2u/pi)^(1/2); u -> inf: Var[T | u] = 16u/3 + 80/9).  Both are evaluated with
+   erfcx(x) - 1 and expm1 so that nothing cancels at small u.
+
+5. The flight-time density f(t | u) = int_0^inf dv p(t, v | u) by Gauss-Legendre in w = v^(1/2)
+   over the window |v - v*| < 6.5 t^(1/2) (e^-42 of the Gaussian beyond); the integrand
+   2 w^3 erf(a w) exp[-(w^2 - v*)^2 / t] is entire in w.
+
+6. Equilibrium.  Collisions with outgoing speed in du come at the rate u P(0, u) du
+   (eq. (collrate)), so flights of duration in dT come at the rate
+
+       nu(T) = int_0^inf du u P(0, u) f(T | u)                                        (rate)
+
+   per unit time, for every r.  int T nu(T) dT = M_2 + M_2 / r = 1 by eqs. (inteq) and
+   (normalization) (the time between collisions fills the time), and int nu dT = I = M_1.
+   Above r_c, rho(T) = nu(T) / I is the distribution of the flight time per collision, with mean
+   1 / I.  Below r_c (beta >= 2), I is infinite: almost all flights are infinitely short and
+   rho(T) = 0 for every T > 0, but nu(T) is finite for T > 0 and T nu(T) is a probability
+   density, that of the duration of the flight in progress at a random instant (for r > r_c it
+   is T rho(T) / <T>), with mean int T^2 nu dT (= <T^2> / <T> above r_c).
+
+   Short flights: a ball leaving with u << 1 hardly feels gravity, f(T | u) = u^-2 F(T / u^2)
+   with F McKean's law, and P(0, u) ~ A u^-beta (eq. (asym1)), so
+
+       nu(T) ~ A C_beta T^(-beta/2),   T -> 0,   C_beta = (1/2) E_0[T^(beta/2 - 1) | u = 1]
+             = (3 Gamma((5 - beta)/2) / (2 pi^(3/2))) int_0^inf dv v^(3/2) z0^(beta - 5)
+               2F1((5 - beta)/2, 1/2; 3/2; -3 v / z0^2),   z0^2 = v^2 - v + 1,       (short)
+
+   with relative corrections O(T^(1/2)).  The divergence T^(-beta/2) is integrable exactly when
+   beta < 2, i.e. r > r_c.
+
+   Long flights: at fixed u, f(T | u) ~ (sqrt(3) / (8 sqrt(pi))) T^(-1/2) e^(-3T/16)
+   e^(3u/4) erf((3u)^(1/2) / 2).  With P(0, u) ~ B u^-m e^(-q u) (eqs. (asym3)-(asym6)) the
+   u-integral converges where q > 3/4, i.e. r < (sqrt 5 - 1) / 2 = 0.618, and then
+
+       nu(T) ~ K T^(-1/2) e^(-3T/16),
+       K = (sqrt(3) / (8 sqrt(pi))) int du u P(0, u) e^(3u/4) erf((3u)^(1/2) / 2).   (long1)
+
+   For r > 0.618 (q < 3/4) long flights come from fast balls: a saddle at u* = c T,
+   c = 1/2 - 2q/3, gives
+
+       nu(T) ~ (B / 4) (2 - 4q/3) c^(1-m) T^(1-m) e^(-(q/2 - q^2/3) T).                (long2)
+
+   Both hold with relative corrections O(1/T) (near r = 0.618 they set in only at
+   T >> (q - 3/4)^-2); B is read off the solver at its highest node (approximate).
+"""
+
+import numpy as np
+import pandas as pd
+from scipy import integrate, special
+
+from .asymptotics import large_speed_decay_rate, large_speed_exponent
+from .kernel import TAIL, return_speed_kernel
+from .solver import coordinate_of_speed, speed_of_coordinate
+
+SQRT3 = np.sqrt(3.0)
+GOLDEN_RESTITUTION = 0.5 * (np.sqrt(5.0) - 1.0)  # q(r) = 3/4: where (long1) gives way to (long2)
+
+# Gauss-Legendre on [0, 1] for the tau integral of (timemoments) (kernel.py uses 20 for k = 0)
+_TAU_NODES, _TAU_WEIGHTS = np.polynomial.legendre.leggauss(24)
+_TAU_NODES, _TAU_WEIGHTS = 0.5 * (_TAU_NODES + 1.0), 0.5 * _TAU_WEIGHTS
+# Gauss-Legendre on [0, 1] for the v-integral of f(t | u), in w = v^(1/2): 40 nodes give 1e-13
+_SPEED_NODES, _SPEED_WEIGHTS = np.polynomial.legendre.leggauss(48)
+_SPEED_NODES, _SPEED_WEIGHTS = 0.5 * (_SPEED_NODES + 1.0), 0.5 * _SPEED_WEIGHTS
+# 16-point Gauss-Legendre on [-1, 1] for bin averages
+_BIN_NODES, _BIN_WEIGHTS = np.polynomial.legendre.leggauss(16)
+
+WINDOW = 6.5  # |v - v*| < WINDOW t^(1/2): the Gaussian of f(t | u) beyond is below e^-42
+SPEED_STEP = 0.15  # trapezoidal step in s = ln v + v^(1/2) for the conditional moments
+RATE_STEP = 0.125  # trapezoidal step in s = ln u + u^(1/2) for nu(T): e^-39 of the rule's error
+TIME_STEP = 0.1  # trapezoidal step in s = ln t + t^(1/2) for integrals over f(t | u)
+SMALLEST_RATIO = 1e-9  # lowest return speed / min(u, 1): (v / u)^(5/2) ~ 1e-22 of the rest
+EXPONENT_CUT = 45.0  # time window: the Gaussian factor of f(t | u) above e^-45
+MOMENT_POWERS = range(4)  # k of (timemoments)
+
+
+# --- the joint law ------------------------------------------------------------------------------
+
+
+def free_first_passage_density(t, v, u):
+    """McKean's law without gravity in our units, p_0(t, v | u) of item 1 (eqs. (5), (6) of [mck])."""
+    t, v, u = (np.asarray(a, dtype=float) for a in (t, v, u))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        value = (
+            SQRT3
+            * v
+            / (2.0 * np.pi * t * t)
+            * np.exp(-(v * v - u * v + u * u) / t)
+            * special.erf(np.sqrt(3.0 * u * v / t))
+        )
+    return np.where((t > 0.0) & (v > 0.0) & (u > 0.0), value, 0.0)
+
+
+def log_joint_density(t, v, u):
+    """ln p(t, v | u), eq. (joint): McKean's law with gravity through eqs. (0g), (GgP)."""
+    t, v, u = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (t, v, u)))
+    valid = (t > 0.0) & (v > 0.0) & (u > 0.0)
+    t, v, u = (np.where(valid, a, 1.0) for a in (t, v, u))
+    exponent = -((t - u - v) ** 2 + 3.0 * (v - u) ** 2) / (4.0 * t)
+    with np.errstate(divide="ignore"):
+        value = (
+            np.log(SQRT3 * v / (2.0 * np.pi))
+            - 2.0 * np.log(t)
+            + exponent
+            + np.log(special.erf(np.sqrt(3.0 * u * v / t)))
+        )
+    return np.where(valid, value, -np.inf)
+
+
+def joint_density(t, v, u):
+    """p(t, v | u) of eq. (joint): flight time t and return speed v of a ball leaving with speed u."""
+    return np.exp(log_joint_density(t, v, u))
+
+
+def return_time_moment(v, u, k):
+    """int_0^inf dt t^k p(t, v | u), eq. (timemoments), k = 0..3; k = 0 is v G_g(v, u) of eq. (kernel3)."""
+    if k not in MOMENT_POWERS:
+        raise ValueError(f"time power k must be one of {list(MOMENT_POWERS)}, got {k}")
+    v, u = np.broadcast_arrays(np.asarray(v, dtype=float), np.asarray(u, dtype=float))
+    valid = (v > 0.0) & (u > 0.0)
+    v, u = np.where(valid, v, 1.0)[..., None], np.where(valid, u, 1.0)[..., None]
+    difference = v - u
+    z0 = np.sqrt(difference * difference + v * u)
+    tau1 = np.sqrt(3.0 * v * u / ((v + u + z0) * z0))
+    upper = np.minimum(tau1, TAIL / np.sqrt(z0))
+    tau2 = (upper * _TAU_NODES) ** 2
+    z = z0 * (1.0 + tau2)
+    shape = {0: (1.0 + z) / (2.0 * z * z), 1: 1.0, 2: 2.0 * z, 3: 4.0 * z * (1.0 + z)}[k]
+    integrand = np.exp(-z0 * tau2) * shape / np.sqrt(2.0 + tau2)
+    gauss = np.exp(-0.75 * difference * difference / (0.5 * (v + u) + z0))
+    value = (2.0 * SQRT3 / np.pi) * (v * gauss * upper)[..., 0] * (integrand @ _TAU_WEIGHTS)
+    return np.where(valid, value, 0.0)
+
+
+# --- conditional moments given u ----------------------------------------------------------------
+
+
+def trapezoid_nodes(lowest, highest, step):
+    """Nodes and weights of the trapezoidal rule in s = ln x + x^(1/2) over [lowest, highest]."""
+    s_lo, s_hi = coordinate_of_speed(lowest), coordinate_of_speed(highest)
+    count = int(np.ceil((s_hi - s_lo) / step)) + 1
+    x = speed_of_coordinate(np.linspace(s_lo, s_hi, count))
+    weights = np.full(count, (s_hi - s_lo) / (count - 1)) * x / (1.0 + 0.5 * np.sqrt(x))
+    weights[[0, -1]] *= 0.5
+    return x, weights
+
+
+def return_speed_nodes(u, step=SPEED_STEP):
+    """Return speeds and weights that integrate functions of v against p(., v | u)."""
+    lowest = SMALLEST_RATIO * min(u, 1.0)
+    highest = u + 140.0 + 16.0 * np.sqrt(u)  # e^-70 of the return-speed law, Gaussian and tail
+    return trapezoid_nodes(lowest, highest, step)
+
+
+def conditional_moment(u, time_power, speed_power, step=SPEED_STEP):
+    """E[T^k v^m | u] for a ball leaving with speed u: the v-integral of eq. (timemoments)."""
+    v, weights = return_speed_nodes(float(u), step)
+    return float(np.sum(weights * v**speed_power * return_time_moment(v, u, time_power)))
+
+
+def _erfcx_minus_one(x):
+    """erfcx(x) - 1 without cancellation at small x: expm1(x^2) - e^(x^2) erf(x) below x = 1."""
+    x = np.asarray(x, dtype=float)
+    small = np.minimum(x, 1.0)
+    return np.where(
+        x < 1.0,
+        np.expm1(small * small) - np.exp(small * small) * special.erf(small),
+        special.erfcx(x) - 1.0,
+    )
+
+
+def _flight_time_ingredients(u):
+    """e^(-u/2), erfcx((2u)^(1/2)) - 1, erfcx((u/2)^(1/2)) - 1, (2u/pi)^(1/2): eqs. (meanT), (meanT2)."""
+    u = np.asarray(u, dtype=float)
+    return (
+        np.exp(-0.5 * u),
+        _erfcx_minus_one(np.sqrt(2.0 * u)),
+        _erfcx_minus_one(np.sqrt(0.5 * u)),
+        np.sqrt(2.0 * u / np.pi),
+    )
+
+
+def mean_flight_time_given_speed(u):
+    """E[T | u], eq. (meanT): 2u + 4/3 - e^(-u/2) [(2/3) erfcx((2u)^(1/2))
+    + (2/3 + u) erfcx((u/2)^(1/2)) - (2u/pi)^(1/2)], written without cancellation at small u
+    (where E[T | u] = 3 (2u/pi)^(1/2) + O(u)).  E[v | u] = E[T | u] - u (Ito on v + t)."""
+    u = np.asarray(u, dtype=float)
+    decay, a, b, root = _flight_time_ingredients(u)
+    bracket = (2.0 / 3.0) * (a + b) + u * (1.0 + b) - root
+    return 2.0 * u - (4.0 / 3.0) * np.expm1(-0.5 * u) - decay * bracket
+
+
+def flight_time_second_moment_given_speed(u):
+    """E[T^2 | u], eq. (meanT2): 4u^2 + 32u/3 + 32/3 - e^(-u/2) [(16/3 - 8u/3) erfcx((2u)^(1/2))
+    + (16/3 + 16u/3 + 2u^2) erfcx((u/2)^(1/2)) - 2 (2/pi)^(1/2) (u^(1/2) + u^(3/2))], without
+    cancellation at small u (where it is 18 (2u/pi)^(1/2) + O(u)).  Identified, not derived: see
+    the module docstring."""
+    u = np.asarray(u, dtype=float)
+    decay, a, b, root = _flight_time_ingredients(u)
+    bracket = (
+        (16.0 / 3.0) * (a + b)
+        - (8.0 / 3.0) * u * (1.0 + a)
+        + (16.0 / 3.0 + 2.0 * u) * u * (1.0 + b)
+        - 2.0 * root * (1.0 + u)
+    )
+    return 4.0 * u * u + (32.0 / 3.0) * u - (32.0 / 3.0) * np.expm1(-0.5 * u) - decay * bracket
+
+
+# --- the flight-time density given u -------------------------------------------------------------
+
+
+def _log_speed_integral(t, u, centre):
+    """ln int_0^inf dv v exp[-(v - centre)^2 / t] erf((3 u v / t)^(1/2)), vectorised: Gauss-Legendre
+    in w = v^(1/2) (the integrand 2 w^3 erf(a w) exp[-(w^2 - centre)^2 / t] is entire in w) over
+    |v - centre| < WINDOW t^(1/2)."""
+    half_width = WINDOW * np.sqrt(t)
+    w_lo = np.sqrt(np.maximum(centre - half_width, 0.0))[..., None]
+    w_hi = np.sqrt(centre + half_width)[..., None]
+    w = w_lo + (w_hi - w_lo) * _SPEED_NODES
+    v = w * w
+    integrand = (
+        2.0
+        * w
+        * v
+        * special.erf(np.sqrt(3.0 * u / t)[..., None] * w)
+        * np.exp(-((v - centre[..., None]) ** 2) / t[..., None])
+    )
+    with np.errstate(divide="ignore"):
+        return np.log((w_hi - w_lo)[..., 0] * (integrand @ _SPEED_WEIGHTS))
+
+
+def log_flight_time_density(t, u):
+    """ln f(t | u), f = int_0^inf dv p(t, v | u): item 5 of the module docstring."""
+    t, u = np.broadcast_arrays(np.asarray(t, dtype=float), np.asarray(u, dtype=float))
+    valid = (t > 0.0) & (u > 0.0)
+    t, u = np.where(valid, t, 1.0), np.where(valid, u, 1.0)
+    gauss = -3.0 * (t - 2.0 * u) ** 2 / (16.0 * t)
+    value = np.log(SQRT3 / (2.0 * np.pi)) - 2.0 * np.log(t) + gauss
+    value = value + _log_speed_integral(t, u, 0.25 * (t + 2.0 * u))
+    return np.where(valid, value, -np.inf)
+
+
+def flight_time_density(t, u):
+    """f(t | u): density of the flight time of a ball leaving the floor with speed u."""
+    return np.exp(log_flight_time_density(t, u))
+
+
+def free_flight_time_density(t, u):
+    """f_0(t | u) = int dv p_0(t, v | u): McKean's flight-time law without gravity."""
+    t, u = np.broadcast_arrays(np.asarray(t, dtype=float), np.asarray(u, dtype=float))
+    value = (
+        np.log(SQRT3 / (2.0 * np.pi))
+        - 2.0 * np.log(t)
+        - 0.75 * u * u / t
+        + _log_speed_integral(t, u, 0.5 * u)
+    )
+    return np.exp(value)
+
+
+def flight_time_window(u, cut=EXPONENT_CUT):
+    """[t_lo, t_hi] outside which 3 (t - 2u)^2 / (16 t) > cut: f(t | u) is negligible there."""
+    b = 4.0 * u + 16.0 * cut / 3.0
+    t_hi = 0.5 * (b + np.sqrt(b * b - 16.0 * u * u))
+    return 4.0 * u * u / t_hi, t_hi
+
+
+def flight_time_nodes(u, step=TIME_STEP):
+    """Flight times and weights that integrate functions of t against f(t | u)."""
+    return trapezoid_nodes(*flight_time_window(u), step)
+
+
+# --- equilibrium ---------------------------------------------------------------------------------
+
+
+def _outgoing_weights(solution):
+    """u_j P(0, u_j) w_j: the collision rate carried by each node of the solver."""
+    u = solution.speeds
+    return u, solution.quadrature_weights * u * solution.density
+
+
+def _lower_tail_factor(solution, exponent):
+    """Sum over the solver's rule continued below its lowest node u_0 of
+    w u P(0, u) (u / u_0)^exponent, divided by P(0, u_0); P is the power law u^-beta there (as in
+    the solver), du/ds = u."""
+    decay = 2.0 - solution.small_speed_exponent + exponent
+    if decay <= 0.0:
+        return np.inf
+    return solution.step * solution.speeds[0] ** 2 / np.expm1(decay * solution.step)
+
+
+def _outgoing_rule(solution, lowest, highest, step):
+    """Nodes u_k = u(s_lo + k step), s = ln u + u^(1/2), from ``lowest`` to beyond ``highest``,
+    and the collision rate w_k u_k P(0, u_k) each carries: P from the solver's Nystrom formula up
+    to its highest node u_max, continued above by its large-speed form (eq. (asym3))
+    P(0, u_max) (u / u_max)^-m e^(-q (u - u_max))."""
+    r, u_max = solution.restitution, solution.speeds[-1]
+    s_lo = coordinate_of_speed(lowest)
+    count = int(np.ceil((coordinate_of_speed(max(highest, u_max)) - s_lo) / step)) + 1
+    u = speed_of_coordinate(s_lo + step * np.arange(count))
+    inside = u <= u_max
+    density = np.empty(count)
+    density[inside] = solution.outgoing_speed_density(u[inside])
+    q, m = large_speed_decay_rate(r), large_speed_exponent(r)
+    beyond = u[~inside] / u_max
+    density[~inside] = solution.density[-1] * beyond**-m * np.exp(-q * u_max * (beyond - 1.0))
+    return u, step * u / (1.0 + 0.5 * np.sqrt(u)) * u * density
+
+
+def flight_rate_density(solution, times, step=RATE_STEP):
+    """nu(T), eq. (rate): flights of duration in dT per unit time, for any r (finite for T > 0).
+
+    The u-integral is a trapezoidal rule in s = ln u + u^(1/2) of step ``step``, finer than the
+    solver's (f(T | u) falls like exp(-3 u^2 / 4T) for u >> T^(1/2), which the solver's step
+    0.25 resolves only to ~1e-8), with P(0, u) from the solver's Nystrom formula, from
+    u_lo = min(u_0, 1e-4 T_min^(1/2)) up.  Below u_lo the rule is summed in closed form with
+    f(T | u) = f(T | u_lo) (u / u_lo)^(1/2) (relative error O(u_lo / T^(1/2))) and P(0, u) its
+    power law.  Above the solver's highest node u_max, P(0, u) is continued by its large-speed
+    form up to u = T/2 + 10 T^(1/2) (long flights come from fast balls where q(r) < 3/4, i.e.
+    r > 0.618); where that matters (T >~ u_max / (1/2 - 2q/3)) nu(T) is only as good as that
+    form.
+    """
+    times = np.asarray(times, dtype=float)
+    positive = times[times > 0.0]
+    shortest = float(np.min(positive, initial=1.0))
+    longest = float(np.max(positive, initial=0.0))
+    lowest = min(solution.speeds[0], 1e-4 * np.sqrt(shortest))
+    u, rate = _outgoing_rule(solution, lowest, 0.5 * longest + 10.0 * np.sqrt(longest), step)
+    f = flight_time_density(times.ravel()[:, None], u[None, :])
+    # the rule below u_lo: sum_k>=1 of rate_0 (u_-k / u_lo)^(5/2 - beta) (1 + u_lo^(1/2) / 2)
+    decay = 2.5 - solution.small_speed_exponent
+    tail = rate[0] * (1.0 + 0.5 * np.sqrt(u[0])) / np.expm1(decay * step)
+    return (f @ rate + tail * f[:, 0]).reshape(times.shape)
+
+
+def collision_rate(solution):
+    """I = M_1 of eq. (collrate); inf below r_c."""
+    return solution.moment(1)
+
+
+def flight_time_density_equilibrium(solution, times):
+    """rho(T) = nu(T) / I: the flight-time distribution per collision (0 below r_c, where I = inf)."""
+    rate = collision_rate(solution)
+    nu = flight_rate_density(solution, times)
+    return nu / rate if np.isfinite(rate) else np.zeros_like(nu)
+
+
+def flight_rate_moment(solution, k):
+    """int_0^inf T^k nu(T) dT = int du u P(0, u) E[T^k | u], k = 0..3, for any r.
+
+    k = 0 is I (inf below r_c); k = 1 is 1 for every r (a check); k = 2 is the mean duration of
+    the flight in progress at a random instant.  E[T^k | u] from eqs. (meanT), (meanT2) for
+    k = 1, 2, by quadrature (``conditional_moment``) for k = 3.  Below u_0,
+    E[T^k | u] ~ u^(1/2) (k >= 1).
+    """
+    if k == 0:
+        return collision_rate(solution)
+    u, rate = _outgoing_weights(solution)
+    if k == 1:
+        moments = mean_flight_time_given_speed(u)
+    elif k == 2:
+        moments = flight_time_second_moment_given_speed(u)
+    else:
+        moments = np.array([conditional_moment(x, k, 0) for x in u])
+    tail = _lower_tail_factor(solution, 0.5) * solution.density[0] * moments[0]
+    return float(rate @ moments + tail)
+
+
+def mean_flight_time(solution):
+    """<T> per collision = int T nu dT / I (= 1 / I by the momentum balance); 0 below r_c."""
+    rate = collision_rate(solution)
+    return flight_rate_moment(solution, 1) / rate if np.isfinite(rate) else 0.0
+
+
+def flight_time_second_moment(solution):
+    """<T^2> per collision = int T^2 nu dT / I; 0 below r_c (I = inf)."""
+    rate = collision_rate(solution)
+    return flight_rate_moment(solution, 2) / rate if np.isfinite(rate) else 0.0
+
+
+def time_weighted_mean_flight_time(solution):
+    """Mean duration of the flight in progress at a random instant, int T^2 nu dT (any r);
+    <T^2> / <T> above r_c."""
+    return flight_rate_moment(solution, 2)
+
+
+# --- asymptotic forms ----------------------------------------------------------------------------
+
+
+def short_time_constant(beta):
+    """C_beta of eq. (short): int_0^inf du u^(1 - beta) f_0(1 | u) = (1/2) E_0[T^(beta/2 - 1) | u = 1]."""
+    a = 0.5 * (5.0 - beta)
+
+    def integrand(v):
+        z0_squared = v * v - v + 1.0
+        return v**1.5 * z0_squared ** (-a) * special.hyp2f1(a, 0.5, 1.5, -3.0 * v / z0_squared)
+
+    head, _ = integrate.quad(integrand, 0.0, 1.0, epsabs=0.0, epsrel=1e-12, limit=200)
+    tail, _ = integrate.quad(integrand, 1.0, np.inf, epsabs=0.0, epsrel=1e-12, limit=200)
+    return 3.0 * special.gamma(a) / (2.0 * np.pi**1.5) * (head + tail)
+
+
+def small_speed_amplitude(solution):
+    """A of P(0, u) ~ A u^-beta, read off the solver's lowest node (where that law is built in)."""
+    return solution.density[0] * solution.speeds[0] ** solution.small_speed_exponent
+
+
+def short_flight_rate_density(solution, times):
+    """Eq. (short): nu(T) ~ A C_beta T^(-beta/2) for T -> 0 (relative corrections O(T^(1/2)))."""
+    beta = solution.small_speed_exponent
+    amplitude = small_speed_amplitude(solution) * short_time_constant(beta)
+    return amplitude * np.asarray(times, dtype=float) ** (-0.5 * beta)
+
+
+def large_speed_amplitude(solution):
+    """B of P(0, u) ~ B u^-m e^(-q u), read off the solver's highest node (approximate)."""
+    r, u = solution.restitution, solution.speeds[-1]
+    q, m = large_speed_decay_rate(r), large_speed_exponent(r)
+    return solution.density[-1] * u**m * np.exp(q * u)
+
+
+def long_flight_rate_density(solution, times):
+    """Eqs. (long1) (r < 0.618) and (long2) (r > 0.618): nu(T) for T -> infinity."""
+    times = np.asarray(times, dtype=float)
+    r = solution.restitution
+    q, m = large_speed_decay_rate(r), large_speed_exponent(r)
+    if q > 0.75:
+        u, rate = _outgoing_weights(solution)
+        weight = np.exp(0.75 * u) * special.erf(0.5 * np.sqrt(3.0 * u))
+        # above u_max: P = B u^-m e^(-q u), erf = 1 (to e^-(3 u_max / 4)), an incomplete Gamma
+        a, x = 2.0 - m, (q - 0.75) * u[-1]
+        beyond = large_speed_amplitude(solution) * special.gammaincc(a, x) * special.gamma(a)
+        beyond /= (q - 0.75) ** a
+        constant = SQRT3 / (8.0 * np.sqrt(np.pi)) * (float(rate @ weight) + beyond)
+        return constant * times**-0.5 * np.exp(-3.0 * times / 16.0)
+    c = 0.5 - 2.0 * q / 3.0
+    amplitude = 0.25 * large_speed_amplitude(solution) * (2.0 - 4.0 * q / 3.0) * c ** (1.0 - m)
+    return amplitude * times ** (1.0 - m) * np.exp(-(0.5 * q - q * q / 3.0) * times)
+
+
+def long_time_decay_rate(restitution):
+    """kappa of nu(T) ~ e^(-kappa T): 3/16 (eq. (long1)) where q(r) > 3/4, q/2 - q^2/3 (eq. (long2))
+    where q(r) < 3/4 (r > 0.618)."""
+    q = large_speed_decay_rate(restitution)
+    return 3.0 / 16.0 if q > 0.75 else 0.5 * q - q * q / 3.0
+
+
+def flight_time_summary(solution):
+    """One row: r, I, <T> (= 1/I; 0 below r_c), <T^2> per collision (0 below r_c), the mean of the
+    flight in progress at a random instant (any r), the short-time exponent beta/2 of
+    nu ~ T^(-beta/2), its amplitude A C_beta, and the long-time decay rate kappa."""
+    beta = solution.small_speed_exponent
+    return {
+        "r": solution.restitution,
+        "collision_rate": collision_rate(solution),
+        "mean_flight_time": mean_flight_time(solution),
+        "flight_time_second_moment": flight_time_second_moment(solution),
+        "time_weighted_mean_flight_time": time_weighted_mean_flight_time(solution),
+        "short_time_exponent": 0.5 * beta,
+        "short_time_amplitude": small_speed_amplitude(solution) * short_time_constant(beta),
+        "long_time_decay_rate": long_time_decay_rate(solution.restitution),
+    }
+
+
+# --- tables and bin averages for the pipeline -----------------------------------------------------
+
+
+def flight_time_table(solution, times):
+    """Columns t, density (rho(T); NaN below r_c, where it is not defined), rate_density (nu(T))
+    and time_weighted_density (T nu(T), a probability density for every r)."""
+    times = np.asarray(times, dtype=float)
+    nu = flight_rate_density(solution, times)
+    rate = collision_rate(solution)
+    density = nu / rate if np.isfinite(rate) else np.full_like(nu, np.nan)
+    return pd.DataFrame(
+        {"t": times, "density": density, "rate_density": nu, "time_weighted_density": times * nu}
+    )
+
+
+def _log_gauss(lower, upper):
+    """16-point Gauss-Legendre in ln x on each finite bin: nodes (bins x 16) and weights for dx."""
+    lower = np.asarray(lower, dtype=float)[:, None]
+    upper = np.asarray(upper, dtype=float)[:, None]
+    half = 0.5 * np.log(upper / lower)
+    x = np.exp(half * _BIN_NODES[None, :] + 0.5 * np.log(upper * lower))
+    return x, half * x * _BIN_WEIGHTS[None, :]
+
+
+def flight_rate_bin_integrals(solution, lower, upper):
+    """int over each bin [lo, hi) of nu(T) dT: flights per unit time with duration in the bin, for
+    any r.  Finite bins: 16-point Gauss-Legendre in ln T.  An underflow bin (lo = 0): twelve
+    decades below hi the same way, and below those eq. (short) in closed form (inf below r_c,
+    where nu is not integrable at T = 0).  An overflow bin (hi = inf) is not supported (NaN)."""
+    lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    result = np.full(lower.shape, np.nan)
+    finite = (lower > 0.0) & np.isfinite(upper)
+    if np.any(finite):
+        t, weights = _log_gauss(lower[finite], upper[finite])
+        result[finite] = np.sum(flight_rate_density(solution, t) * weights, axis=1)
+    beta = solution.small_speed_exponent
+    for index in np.flatnonzero((lower <= 0.0) & np.isfinite(upper)):
+        edges = upper[index] * np.logspace(-12.0, 0.0, 13)
+        t, weights = _log_gauss(edges[:-1], edges[1:])
+        above = np.sum(flight_rate_density(solution, t) * weights)
+        if beta >= 2.0:
+            result[index] = np.inf
+        else:
+            head = short_flight_rate_density(solution, edges[0]) * edges[0] / (1.0 - 0.5 * beta)
+            result[index] = above + head
+    return result
+
+
+def flight_time_bin_average(solution, lower, upper):
+    """rho(T) averaged over each bin [lo, hi): int_bin rho dT / (hi - lo), what a histogram of
+    simulated flight times per collision measures; lo = 0 (underflow) allowed, hi = inf not (NaN).
+    Defined above r_c; below, I = inf and this is 0 (use ``flight_rate_bin_integrals``)."""
+    lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    rate = collision_rate(solution)
+    if not np.isfinite(rate):
+        return np.where(np.isfinite(upper), 0.0, np.nan)
+    return flight_rate_bin_integrals(solution, lower, upper) / rate / (upper - lower)
+
+
+def _speed_sub_bins(lower, upper, panels=10, efolds=40.0):
+    """Finite sub-bins covering each v-bin: itself if finite; an underflow bin [0, hi) by
+    ``panels`` log-panels over ``efolds`` e-folds below hi (v G_g ~ v^(3/2): e^-100 beyond);
+    an overflow bin by none.  Returns their edges and the index of the bin each belongs to."""
+    lo, hi, owner = [], [], []
+    for index, (a, b) in enumerate(zip(lower, upper)):
+        if not np.isfinite(b):
+            continue
+        underflow = b * np.exp(np.linspace(-efolds, 0.0, panels + 1))
+        edges = np.array([a, b]) if a > 0.0 else underflow
+        lo.extend(edges[:-1])
+        hi.extend(edges[1:])
+        owner.extend([index] * (edges.size - 1))
+    return np.array(lo), np.array(hi), np.array(owner, dtype=int)
+
+
+def return_speed_bin_probabilities(outgoing_density, u_lower, u_upper, v_lower, v_upper):
+    """Matrix [i, j]: probability that the return speed lies in v-bin j, given an outgoing speed in
+    u-bin i distributed as u P(0, u) (the rate of collisions, eq. (collrate)) within the bin:
+
+        int_(u-bin) du u P(0, u) int_(v-bin) dv v G_g(v, u) / int_(u-bin) du u P(0, u).
+
+    ``outgoing_density`` is P(0, u) as a function of an array (e.g. the solver's
+    ``outgoing_speed_density``).  u-bins must be finite; a v-bin may start at 0 (underflow) or end
+    at inf (overflow: 1 minus the rest, by eq. (normG)).  Gauss-Legendre in ln u and ln v.
+    """
+    u, u_weights = _log_gauss(u_lower, u_upper)
+    flux = u * outgoing_density(u) * u_weights  # (n_u, 16)
+    v_lower, v_upper = np.asarray(v_lower, dtype=float), np.asarray(v_upper, dtype=float)
+    lo, hi, owner = _speed_sub_bins(v_lower, v_upper)
+    v, v_weights = _log_gauss(lo, hi)  # (n_sub, 16)
+    kernel = return_speed_kernel(v[None, None, :, :], u[:, :, None, None])
+    sub = np.einsum("ab,abcd,cd->ac", flux, kernel, v * v_weights) / flux.sum(axis=1)[:, None]
+    cells = np.zeros((flux.shape[0], v_lower.size))
+    np.add.at(cells.T, owner, sub.T)
+    overflow = np.flatnonzero(~np.isfinite(v_upper))
+    if overflow.size:
+        cells[:, overflow[0]] = 1.0 - cells.sum(axis=1)
+    return cells
