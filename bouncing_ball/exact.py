@@ -244,10 +244,21 @@ def mean_speed_squared_given_position(x, restitution):
         u = np.sqrt(2.0 * x / 3.0)
         return u * special.k1(u) / (special.k0(u) / 3.0)
 
-    def tail(xi):
-        return integrate.quad(_position_density_third, xi, np.inf, epsrel=1e-11, limit=400)[0]
+    return np.vectorize(_position_tail_third)(x) / position_density(x, restitution)
 
-    return np.vectorize(tail)(x) / position_density(x, restitution)
+
+def _position_tail_third(x):
+    # int_x^inf P(x') dx' at r = 1/3, under the F integral of eq. (P(x)2):
+    # int_x^inf e^{-F x'} dx' = e^{-F x} / F, in ln F as in _position_density_third
+    def integrand(log_f):
+        f = np.exp(log_f)
+        z = 1.0 / (12.0 * f)
+        return special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z - f * x) / f
+
+    # at x = 0 the integrand decays only as F^(-5/6) in ln F
+    upper = np.log(60.0 / x) if x > 0.0 else np.log(1.0e16)
+    value, _ = integrate.quad(integrand, -8.0, max(upper, 8.0), limit=400, epsabs=0.0, epsrel=1e-11)
+    return value / (4.0 * np.pi)
 
 
 def distribution_table(positions, speeds, restitution):

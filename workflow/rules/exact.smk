@@ -9,6 +9,8 @@ rule exact_solution:
         summary="results/exact/r{r}/summary.parquet",
     log:
         "logs/exact/r{r}.log",
+    # started first: the r = 1/3 solution (about 15 s, quadratures) ends the quick look
+    priority: 10
     conda:
         "../envs/bouncing-ball.yaml"
     resources:
