@@ -113,6 +113,7 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
             )
     for name, positive in (
         ("solver.output_speeds", True),
+        ("solver.flight_times", True),
         ("exact.speeds", False),
         ("exact.position_grid", True),
     ):
@@ -229,7 +230,9 @@ def shard_count(config: dict, label: str) -> int:
 
 def solver_settings(config: dict) -> dict:
     """What one solve is run with (not the r grid of Fig. 6, which has its own job)."""
-    return {key: config["solver"][key] for key in ("quadrature_step", "output_speeds")}
+    return {
+        key: config["solver"][key] for key in ("quadrature_step", "output_speeds", "flight_times")
+    }
 
 
 def exact_settings(config: dict) -> dict:

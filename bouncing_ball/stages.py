@@ -10,7 +10,7 @@ importing numba, scipy or matplotlib.
 # that key the random streams; "jit" is how the compiled modules are compiled
 SIMULATION = ("bins", "free_flight", "jit", "restitution", "settings", "simulation", "tallies")
 MERGE = ("bins", "histograms", "io", "restitution", "settings", "shards", "tallies")
-SOLVER = ("asymptotics", "bins", "jit", "kernel", "solver")
+SOLVER = ("asymptotics", "bins", "flight_time", "jit", "kernel", "restitution", "solver")
 EXACT = ("bins", "exact")
 THEORY = ("asymptotics", "bins")
 FITS = (

@@ -1,12 +1,13 @@
-"""Rule solve: eq. (inteq) solved for P(0, v) at one r, with <x>, Delta x, I and accuracy
-checks -> results/solver/r{r}/p0v.parquet (v, p0v) and summary.parquet (one row)."""
+"""Rule solve: eq. (inteq) solved for P(0, v) at one r, with <x>, Delta x, I, accuracy checks
+and the collision statistics -> results/solver/r{r}/p0v.parquet (v, p0v), summary.parquet (one
+row) and flight_time.parquet (the equilibrium flight-time density on solver.flight_times)."""
 
 import logging
 import time
 
 import pandas as pd
 
-from bouncing_ball import solver
+from bouncing_ball import flight_time, solver
 from bouncing_ball.bins import log_grid
 from bouncing_ball.io import write_tables
 from bouncing_ball.jobs import job_log
@@ -21,6 +22,10 @@ with job_log(snakemake.log[0]):
     elapsed = time.perf_counter() - started
     speeds = log_grid(settings["output_speeds"])
     row = solver.solution_summary(solution)
+    # the collision statistics: McKean's first-passage law with gravity (bouncing_ball.flight_time)
+    collisions = flight_time.flight_time_summary(solution)
+    row.update({key: value for key, value in collisions.items() if key not in row})
+    flights = flight_time.flight_time_table(solution, log_grid(settings["flight_times"]))
     provenance = {
         "rule": "solve",
         "r": exact_string(exact),
@@ -31,7 +36,12 @@ with job_log(snakemake.log[0]):
     }
     p0v = pd.DataFrame({"v": speeds, "p0v": solution.outgoing_speed_density(speeds)})
     write_tables(
-        {snakemake.output.p0v: p0v, snakemake.output.summary: pd.DataFrame([row])}, provenance
+        {
+            snakemake.output.p0v: p0v,
+            snakemake.output.summary: pd.DataFrame([row]),
+            snakemake.output.flight_time: flights,
+        },
+        provenance,
     )
     logging.info(
         "r=%s: %d nodes, solved in %.1f ms (first call: includes loading the compiled kernel); "

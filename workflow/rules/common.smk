@@ -109,7 +109,9 @@ def exact_value(wildcards):
 
 def solver_targets():
     return expand(
-        "results/solver/r{r}/{table}.parquet", r=RESTITUTION, table=("p0v", "summary")
+        "results/solver/r{r}/{table}.parquet",
+        r=RESTITUTION,
+        table=("p0v", "summary", "flight_time"),
     )
 
 

@@ -5,6 +5,7 @@ rule solve:
     output:
         p0v="results/solver/r{r}/p0v.parquet",
         summary="results/solver/r{r}/summary.parquet",
+        flight_time="results/solver/r{r}/flight_time.parquet",
     log:
         "logs/solver/r{r}.log",
     localrule: True
