@@ -61,7 +61,9 @@ moments and bin averages of P(x) in closed form under the F integral; P(x, v)
 by eq. (fpsol) (x > 0), and at x = 0 from P(0, v) and eq. (bc).
 """
 
+import bisect
 import cmath
+import functools
 import math
 from dataclasses import dataclass
 
@@ -69,7 +71,7 @@ import numpy as np
 import pandas as pd
 from scipy import integrate, optimize, special
 
-from .asymptotics import large_speed_decay_rate, large_speed_exponent
+from .asymptotics import large_speed_decay_rate, large_speed_exponent, small_speed_exponent
 from .jit import njit
 from .solver import (
     TAIL_EFOLDS,
@@ -628,6 +630,28 @@ class WeightFunction:
             )
         return (smooth - self.small_force_decay * np.exp(-y)).reshape(np.shape(force))
 
+    def log_scalar(self, force: float) -> float:
+        """ln w(F) for one F (a fast path for scalar integrands: Clenshaw on the panel's series)."""
+        y = math.log(force)
+        if not self.edges[0] <= y <= self.edges[-1]:
+            return float(self.log(force))
+        index = min(bisect.bisect_right(self._edge_list, y) - 1, len(self.series) - 1)
+        a, b = self._edge_list[index], self._edge_list[index + 1]
+        t = (2.0 * y - a - b) / (b - a)
+        b1 = b2 = 0.0
+        coefficients = self._coefficients[index]
+        for c in coefficients[:0:-1]:
+            b1, b2 = c + 2.0 * t * b1 - b2, b1
+        return coefficients[0] + t * b1 - b2 - self.small_force_decay / force
+
+    @functools.cached_property
+    def _edge_list(self):
+        return [float(e) for e in self.edges]
+
+    @functools.cached_property
+    def _coefficients(self):
+        return [[float(c) for c in piece.coef] for piece in self.series]
+
     def __call__(self, force):
         """w(F) (over- or underflows where ``log`` does not)."""
         return np.exp(self.log(force))
@@ -665,8 +689,8 @@ def interpolated_weight_function(solution, panel_nodes=PANEL_CHEBYSHEV_NODES) ->
     the saddle e^(-S/F) and end-point e^(-1/(12F)) terms of w cross over), else PANEL_WIDTH."""
     density = _outgoing_density(solution)
     decay = small_force_decay(solution.restitution)
-    # below (S + 1/12)/150, F^(-1/2) w e^(-1/(12F)) < e^-150 of its largest values
-    lowest = _smallest_force(density, (decay + 1.0 / 12.0) / 150.0)
+    # below (S + 1/12)/200, F^(-1/2) w e^(-1/(12F)) < e^-200 of its largest values
+    lowest = _smallest_force(density, (decay + 1.0 / 12.0) / 200.0)
     lo, hi = np.log(lowest), np.log(LARGEST_FORCE)
     narrow = SMALL_PANEL_WIDTH if solution.restitution > 0.5 else PANEL_WIDTH
     small = int(np.ceil(-lo / narrow)) if lo < 0.0 else 0
@@ -722,11 +746,13 @@ def _total_decay(weight) -> float:
     return small_force_decay(weight.restitution) + 1.0 / 12.0
 
 
-def _force_quadrature(weight, width=0.5):
+def _force_quadrature(weight, largest_x=0.0, width=0.5):
     """Gauss-Legendre nodes in ln F (panels ``width`` wide) from where F^(-1/2) w e^(-1/(12F)) has
-    fallen below e^-100 up to F = 1e24, with ln of F^(1/2) w(F) e^(-1/(12F)) dF/dlnF folded in:
+    fallen below e^-100 (and below a twentieth of the saddle point ((S + 1/12)/x)^(1/2) of the
+    largest x) up to F = 1e24, with ln of F^(1/2) w(F) e^(-1/(12F)) dF/dlnF folded in:
     int dF F^(-1/2) w(F) e^(-1/(12F)) f(F) ~ sum_k exp(log_weights_k) f(F_k)."""
-    lo = np.log(_total_decay(weight) / 100.0)
+    total = _total_decay(weight)
+    lo = np.log(min(total / 100.0, np.sqrt(total / max(largest_x, 1e-300)) / 20.0))
     y, wy = _panels(lo, np.log(1e24), width)
     force = np.exp(y)
     log_weights = np.log(wy) + 0.5 * y + weight.log(force) - 1.0 / (12.0 * force)
@@ -735,8 +761,8 @@ def _force_quadrature(weight, width=0.5):
 
 def _laplace(weight, power, x):
     """int dF F^(-1/2 - power) w(F) exp(-1/(12F) - F x), for an array x >= 0."""
-    force, log_weights = _force_quadrature(weight)
     x = np.asarray(x, dtype=float)
+    force, log_weights = _force_quadrature(weight, float(np.max(x, initial=0.0)))
     exponent = log_weights[None, :] - power * np.log(force)[None, :] - np.outer(x.ravel(), force)
     return np.sum(np.exp(exponent), axis=1).reshape(x.shape)
 
@@ -775,9 +801,9 @@ def position_averages(weight) -> dict:
 
 def _bin_laplace(weight, power, lo, hi):
     """int dF F^(-1/2 - power) w e^(-1/(12F)) (e^(-F lo) - e^(-F hi)) (no cancellation in narrow bins)."""
-    force, log_weights = _force_quadrature(weight)
     lo = np.asarray(lo, dtype=float)
     hi = np.asarray(hi, dtype=float)
+    force, log_weights = _force_quadrature(weight, float(np.max(lo, initial=0.0)))
     lo_b, hi_b = np.broadcast_arrays(lo, hi)
     f = force[None, :]
     difference = -np.expm1(-f * (hi_b.ravel() - lo_b.ravel())[:, None])
@@ -806,11 +832,12 @@ def _distribution_integrand(log_force, x, v, weight):
     # e^{-v/2} w(F) e^{-F x} psi_{1/4,F}(-v) F, eqs. (fpsol), (psi); dF = F d(ln F)
     f = math.exp(log_force)
     argument = -(f ** (1.0 / 3.0)) * v + 0.25 * f ** (-2.0 / 3.0)
-    log_rest = float(weight.log(f)) + log_force - f * x - 0.5 * v - math.log(f) / 6.0
+    log_w = weight.log_scalar(f) if hasattr(weight, "log_scalar") else float(weight.log(f))
+    log_rest = log_w + log_force - f * x - 0.5 * v - log_force / 6.0
     if argument > 0.0:
-        airy = float(_airy_scaled(argument))
+        airy = special.airye(argument)[0] if argument < 1e6 else float(_airy_scaled(argument))
         return airy * math.exp(log_rest - (2.0 / 3.0) * argument**1.5)
-    return float(special.airy(argument)[0]) * math.exp(log_rest)
+    return special.airy(argument)[0] * math.exp(log_rest)
 
 
 def distribution_by_force_integral(x, v, weight):
@@ -896,3 +923,86 @@ def distribution_table(weight, solution, positions, speeds):
     finite = np.isfinite(pxv) & (pxv > 0.0)
     worst = float(np.max(error[finite] / pxv[finite])) if finite.any() else 0.0
     return pd.DataFrame({"x": x.ravel(), "v": v.ravel(), "pxv": pxv.ravel()}), worst
+
+
+# ---------------------------------------------------------------------------------------------
+# asymptotics of P(x), measured
+
+
+def predicted_exponents(restitution) -> dict:
+    """The asymptotic exponents of P(x) (derivation: docs/distribution_notes.md).
+
+    x -> 0: P(x) ~ x^((1 - beta)/3) (for beta < 1: P(0) - P(x) ~ x^((1 - beta)/3)),
+    P(x, 0) ~ x^(-beta/3).  x -> inf: P(x) ~ x^c exp(-b x^(1/2)) with b = 2 (S + 1/12)^(1/2)
+    (S of ``small_force_decay``: b = (2/3)^(1/2) for r <= 1/2, q (2 (3 - 2q) / 3)^(1/2) above)
+    and c = -(gamma + 1)/2 (gamma of ``small_force_power``: -1/2 for r < 1/2, -1/4 at r = 1/2,
+    1/4 - m/2 above), from the saddle point F ~ ((S + 1/12)/x)^(1/2) of eq. (P(x)1).
+    """
+    beta = small_speed_exponent(restitution)
+    total = small_force_decay(restitution) + 1.0 / 12.0
+    return {
+        "small_x_power": (1.0 - beta) / 3.0,
+        "small_x_power_at_zero_speed": -beta / 3.0,
+        "large_x_rate": 2.0 * np.sqrt(total),
+        "large_x_power": -(small_force_power(restitution) + 1.0) / 2.0,
+    }
+
+
+def _local_slope(x, y):
+    """d ln y / d ln x at the geometric centre of x, from a quadratic fit in ln x."""
+    lx = np.log(x)
+    centre = 0.5 * (lx[0] + lx[-1])
+    coefficients = np.polyfit(lx - centre, np.log(y), 2)
+    return float(coefficients[1])
+
+
+def measured_exponents(weight, large_window=None) -> dict:
+    """The exponents of ``predicted_exponents``, measured from this module's P(x) and P(x, 0).
+
+    Small x: local slopes of ln P (of ln(P(0) - P(x)) where beta < 1) and of ln P(x, 0) against
+    ln x at x ~ 1e-7.  Large x: a least-squares fit of ln P = a - b x^(1/2) + c ln x + d x^(-1/2)
+    on ``large_window`` = (x_lo, x_hi) (default: where the saddle point F_s = ((S + 1/12)/x)^(1/2)
+    lies between 2 F_min and (S + 1/12)/8, so that w(F) there is computed, not continued, and
+    x_hi at most 75^2 / (S + 1/12)).
+    """
+    beta = weight.small_speed_exponent
+    x_small = np.geomspace(1e-8, 1e-6, 9)
+    p_small = position_density(x_small, weight)
+    if beta < 1.0:
+        p_small = position_density(np.array([0.0]), weight)[0] - p_small
+    at_zero_speed = np.array(
+        [distribution_by_force_integral(x, 0.0, weight)[0] for x in np.geomspace(1e-7, 1e-5, 5)]
+    )
+    total = _total_decay(weight)
+    if large_window is None:
+        smallest = getattr(weight, "smallest_force", total / 150.0)
+        # up to where the exponent 2 ((S + 1/12) x)^(1/2) reaches 150 (P still a normal double)
+        large_window = (64.0 / total, min(total / (2.0 * smallest) ** 2, 75.0**2 / total))
+    x_large = np.geomspace(large_window[0], large_window[1], 40)
+    p_large = position_density(x_large, weight)
+    design = np.column_stack(
+        [np.ones_like(x_large), -np.sqrt(x_large), np.log(x_large), 1.0 / np.sqrt(x_large)]
+    )
+    (_, rate, power, _), *_ = np.linalg.lstsq(design, np.log(p_large), rcond=None)
+    return {
+        "small_x_power": _local_slope(x_small, p_small),
+        "small_x_power_at_zero_speed": _local_slope(np.geomspace(1e-7, 1e-5, 5), at_zero_speed),
+        "large_x_rate": float(rate),
+        "large_x_power": float(power),
+        "large_x_window": tuple(float(x) for x in large_window),
+    }
+
+
+def exponents_table(weights) -> pd.DataFrame:
+    """Measured and predicted exponents of P(x) for each weight function: one row per r."""
+    rows = []
+    for weight in weights:
+        measured = measured_exponents(weight)
+        predicted = predicted_exponents(weight.restitution)
+        row = {"r": weight.restitution}
+        for key, value in predicted.items():
+            row[f"{key}_measured"] = measured[key]
+            row[f"{key}_predicted"] = value
+        row["large_x_window_lo"], row["large_x_window_hi"] = measured["large_x_window"]
+        rows.append(row)
+    return pd.DataFrame(rows)
