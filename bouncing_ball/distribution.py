@@ -484,6 +484,9 @@ def _compute_kernel_transform_table(density):
 
 
 EPSILON = np.finfo(float).eps
+# rounding error of a sum of N terms of mixed signs, in units of EPSILON times the sum of their
+# magnitudes (~ N^(1/2) for N ~ 1000 terms)
+ROUNDING = 50.0
 
 
 def _split_point(q, force):
@@ -511,7 +514,7 @@ def _log_contour_part(density, force):
         )
     if endpoint_negligible:
         log_value, sign = _log_sum(all_terms, all_signs)
-        return log_value, sign, _log_sum(all_terms)[0] + np.log(1e3 * EPSILON)
+        return log_value, sign, _log_sum(all_terms)[0] + np.log(ROUNDING * EPSILON)
     v, wv = _contour(force, v1, q)
     # drop the nodes where the Airy factor times e^((1/2 - q) Re v) (|h| up to powers of v)
     # is below e^-50 of the largest term
@@ -530,7 +533,7 @@ def _log_contour_part(density, force):
     real = np.sum(all_signs * np.exp(all_terms - top))
     total = contour + real
     noise = 2.0 * np.sum(np.exp(np.log(magnitude) + log_rest.real - top)) * EPSILON
-    noise += np.sum(np.exp(all_terms - top)) * 1e3 * EPSILON
+    noise += np.sum(np.exp(all_terms - top)) * ROUNDING * EPSILON
     return top + np.log(abs(total)), float(np.sign(total)), top + np.log(noise)
 
 
@@ -552,7 +555,7 @@ def _log_weight_with_noise(forces, density):
         total = sign_a * np.exp(log_a - top) - np.sign(b[k]) * np.exp(log_b - top)
         if total > 0.0:
             log_w[k] = top + np.log(total)
-            noise[k] = np.exp(log_noise - log_w[k]) + 1e3 * EPSILON * np.exp(log_b - log_w[k])
+            noise[k] = np.exp(log_noise - log_w[k]) + ROUNDING * EPSILON * np.exp(log_b - log_w[k])
     return log_w, noise
 
 
