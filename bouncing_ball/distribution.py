@@ -90,9 +90,10 @@ KERNEL_TAIL = 6.4  # exp(-KERNEL_TAIL^2) ~ 1e-18: the cut of the tau integral, a
 SKIP_EFOLDS = 46.0  # a term of the Nystrom sum below e^-46 of the largest is skipped
 SMALLEST_SPEED = 1e-14  # below, P(0, v) = C v^-beta and the v integrals are done in closed form
 LARGEST_KERNEL_FORCE = 1e30  # above, T(G) by its small-v form
-LARGEST_FORCE = 1e10  # w computed up to here, continued by its power law (and correction) above
-PANEL_WIDTH = 3.5  # of the interpolation panels, in ln F
-SMALL_PANEL_WIDTH = 0.8  # (F < 1, r > 1/2)
+LARGEST_FORCE = 1e8  # w computed up to here, continued by its power law (and correction) above
+PANEL_WIDTH = 3.5  # of the interpolation panels, in ln F (F < 1)
+LARGE_PANEL_WIDTH = 5.0  # (F > 1: w is close to its power law there)
+SMALL_PANEL_WIDTH = 1.2  # (F < 1, r > 1/2)
 PANEL_CHEBYSHEV_NODES = 12
 SMALL_FORCE_DEGREE = 5  # of the polynomial in F continuing ln w below F_min
 PANEL_NODES = 10  # Gauss-Legendre nodes per panel of the real-axis v integrals
@@ -689,7 +690,8 @@ def _smallest_force(density, floor) -> float:
 def interpolated_weight_function(solution, panel_nodes=PANEL_CHEBYSHEV_NODES) -> WeightFunction:
     """w(F) of eq. (weightfunc) at Chebyshev nodes on panels in ln F, interpolated
     (``WeightFunction``).  Where r > 1/2 the panels at F < 1 are SMALL_PANEL_WIDTH wide (there
-    the saddle e^(-S/F) and end-point e^(-1/(12F)) terms of w cross over), else PANEL_WIDTH."""
+    the saddle e^(-S/F) and end-point e^(-1/(12F)) terms of w cross over), else PANEL_WIDTH;
+    LARGE_PANEL_WIDTH at F > 1."""
     density = _outgoing_density(solution)
     decay = small_force_decay(solution.restitution)
     # below (S + 1/12)/200, F^(-1/2) w e^(-1/(12F)) < e^-200 of its largest values
@@ -697,7 +699,7 @@ def interpolated_weight_function(solution, panel_nodes=PANEL_CHEBYSHEV_NODES) ->
     lo, hi = np.log(lowest), np.log(LARGEST_FORCE)
     narrow = SMALL_PANEL_WIDTH if solution.restitution > 0.5 else PANEL_WIDTH
     small = int(np.ceil(-lo / narrow)) if lo < 0.0 else 0
-    large = max(1, int(np.ceil((hi - max(lo, 0.0)) / PANEL_WIDTH)))
+    large = max(1, int(np.ceil((hi - max(lo, 0.0)) / LARGE_PANEL_WIDTH)))
     edges = np.concatenate(
         [np.linspace(lo, 0.0, small + 1)[:-1], np.linspace(max(lo, 0.0), hi, large + 1)]
     )

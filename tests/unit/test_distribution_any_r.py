@@ -1,12 +1,15 @@
-"""The equilibrium distribution (bouncing_ball.distribution) at the other r of issue 16: the moments
-of P(x) against the solver's Ito time averages and the moment identities of P(x, v).  Split from
-test_distribution.py because every r costs a ~5-15 s build of w(F)."""
+"""The equilibrium distribution (bouncing_ball.distribution) at any r: the moments of P(x) of
+eq. (P(x)1) against the solver's Ito time averages (moments of P(0, v) only), and the moment
+identities eqs. (moment1), (moment2) of P(x, v) of eq. (fpsol).  Split from test_distribution.py
+because every r costs a 3-12 s build of w(F)."""
 
 import numpy as np
 import pytest
 from distribution_support import build, check_moment_identities, check_position_moments
 
-OTHERS = [0.15, 0.25, 0.6, 0.9]  # 0.15 < r_c: beta > 2; 0.9 > sqrt(3) - 1: q < 1/2
+# 0.15 < r_c: beta > 2; 0.75, 0.9 > sqrt(3) - 1: q < 1/2 (the contour continues the real-axis
+# integral of eq. (weightfunc), which diverges there)
+OTHERS = [0.15, 0.25, 0.6, 0.75, 0.9]
 
 
 @pytest.fixture(scope="module")
