@@ -982,7 +982,10 @@ def measured_exponents(weight, large_window=None) -> dict:
     if large_window is None:
         smallest = getattr(weight, "smallest_force", total / 150.0)
         # up to where the exponent 2 ((S + 1/12) x)^(1/2) reaches 150 (P still a normal double)
-        large_window = (64.0 / total, min(total / (2.0 * smallest) ** 2, 75.0**2 / total))
+        # (at r = 0.9 the two bounds cross: the window is then the x between them)
+        large_window = tuple(
+            sorted((64.0 / total, min(total / (2.0 * smallest) ** 2, 75.0**2 / total)))
+        )
     x_large = np.geomspace(large_window[0], large_window[1], 40)
     p_large = position_density(x_large, weight)
     design = np.column_stack(
