@@ -1,0 +1,1016 @@
+"""The whole equilibrium distribution P(x, v) at any r, from the solver's P(0, v).
+
+Method.  The solver (``solver.py``) gives P(0, v) on the outgoing side,
+v > 0.  Everything else follows from the weight function w(F) of
+eq. (weightfunc),
+
+    w(F) = int_0^inf dv v phi_{1/4,F}(-v) h(v),   h(v) = e^(v/2) P(0, v),
+
+with phi of eq. (phi) at s = 1/4 (there (2/3) s^(3/2) = 1/12):
+
+    phi_F(-v) = psi_F(-v) - e^(-1/(12F)) int_0^inf dG/(2 pi) e^(-1/(12G)) psi_G(v) / (F + G),
+
+psi_F(v) = F^(-1/6) Ai(F^(1/3) v + F^(-2/3)/4), eq. (psi).  The v and G
+integrals are swapped in the second term, so
+
+    w(F) = A(F) - e^(-1/(12F)) B(F),
+    A(F) = int_0^inf dv v h(v) psi_F(-v),
+    B(F) = int_0^inf dG/(2 pi) e^(-1/(12G)) T(G) / (F + G),   T(G) = int_0^inf dv v h(v) psi_G(v).
+
+T(G) converges absolutely (psi_G(v) decays like exp(-1/(12G) - v/2 - G v^2/2 ...)).
+For G > 1e30 it is replaced by its v -> 0 form, h ~ C v^-beta:
+T(G) = C G^((2 beta - 5)/6) M(2 - beta), M the Mellin transform of Ai.  Where
+beta >= 2 (r <= r_c) int_0 v h(v) dv diverges; since phi_F(0) = 0 exactly (the
+two terms of eq. (phi) cancel at v = 0), the same regularisation of
+int_0^eps C v^(1-beta) dv (its analytic continuation in beta) in A and in every T
+cancels, and the formulas hold unchanged.
+
+A(F) is the hard part: beyond the turning point v = 1/(4F), psi_F(-v)
+oscillates with amplitude ~ v^(-1/4) while h(v) ~ v^-m e^((1/2 - q) v), so the
+real-axis integral diverges where q(r) < 1/2 (r > sqrt(3) - 1), and where it
+converges it cancels exponentially at small F.  A(F) is therefore taken along
+a contour: the real axis from 0 to a split point v1, then, writing
+Ai(z) = 2 Re[-omega Ai(omega z)] (omega = e^(2 pi i / 3); -omega Ai(omega z) =
+(Ai(z) - i Bi(z)) / 2 for real z), 2 Re of the integral of v h(v) (-omega)
+F^(-1/6) Ai(omega zeta(v)) along a path into the upper half plane: first at
+angle pi/3 (the steepest descent direction at the saddle) until arg v =
+THETA_MAX, then radially.  Along that path the Airy factor decays like
+exp(-c F^(1/2) |v|^(3/2)), faster than any exponential.  h is analytic for
+|arg v| < pi/3 (the kernel of eq. (kernel3) is); at complex v it is the
+Nystrom formula of the solver, P(0, v) = r^-2 int du u G_g(v/r, u) P(0, u),
+with G_g continued to complex v (``_complex_kernel_sums``) and the u integral
+on a grid REFINE times finer than the solver's (the trapezoidal rule in
+ln u loses accuracy as exp(-2 pi (pi/3 - arg v) / step)).  The split point
+is v1 = 1/(4F) where q >= 1/2 and the saddle of the continued integrand,
+v1 = q (1 - q) / F, where q < 1/2: there the real-axis part is exponentially
+smaller than the result and nothing cancels.  At small F,
+w(F) ~ exp(-S(q) / F) with S = (3p - p^3)/24, p = min(2q - 1, 1): for q < 1
+(r > 1/2) the saddle dominates, for q >= 1 the end point v = 0 does (S = 1/12).
+S < 0 for q < 1/2: w then grows without bound as F -> 0, which is why
+``log_weight_function`` exists.
+
+w is computed at Chebyshev nodes in ln F on [F_min, F_max] and interpolated
+(``WeightFunction``; log w + S/F is smooth); above F_max it is continued by
+its power law w ~ F^((2 beta - 5)/6) (from h ~ v^-beta), below F_min (where
+the contour would leave the range in which the solution's P(0, v) is
+accurate) by the interpolant's end slope; both regions carry weights far
+below 1e-10 in every result here.
+
+From w: P(x) by eq. (P(x)1); int_x^inf P and <v^2>_x by eq. (moment2);
+moments and bin averages of P(x) in closed form under the F integral; P(x, v)
+by eq. (fpsol) (x > 0), and at x = 0 from P(0, v) and eq. (bc).
+"""
+
+import bisect
+import cmath
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from scipy import integrate, optimize, special
+
+from .asymptotics import large_speed_decay_rate, large_speed_exponent, small_speed_exponent
+from .jit import njit
+from .solver import (
+    TAIL_EFOLDS,
+    UNDERFLOW_EFOLDS,
+    _jacobian,
+    coordinate_of_speed,
+    solve_outgoing_speed_density,
+    speed_of_coordinate,
+)
+
+OMEGA = np.exp(2j * np.pi / 3.0)
+THETA_MAX = 0.5  # largest arg v on the contour: trapezoid error ~ exp(-2 pi (pi/3 - 0.5) / step)
+REFINE = 2  # the u grid for complex v is this many times finer than the solver's
+TAU_NODES = 20  # Gauss-Legendre order of the kernel's tau integral, as kernel.py
+KERNEL_TAIL = 6.4  # exp(-KERNEL_TAIL^2) ~ 1e-18: the cut of the tau integral, as kernel.py
+SKIP_EFOLDS = 46.0  # a term of the Nystrom sum below e^-46 of the largest is skipped
+SMALLEST_SPEED = 1e-14  # below, P(0, v) = C v^-beta and the v integrals are done in closed form
+LARGEST_KERNEL_FORCE = 1e30  # above, T(G) by its small-v form
+LARGEST_FORCE = 1e8  # w computed up to here, continued by its power law (and correction) above
+PANEL_WIDTH = 3.5  # of the interpolation panels, in ln F (F < 1)
+LARGE_PANEL_WIDTH = 5.0  # (F > 1: w is close to its power law there)
+SMALL_PANEL_WIDTH = 1.2  # (F < 1, r > 1/2)
+PANEL_CHEBYSHEV_NODES = 12
+SMALL_FORCE_DEGREE = 5  # of the polynomial in F continuing ln w below F_min
+PANEL_NODES = 10  # Gauss-Legendre nodes per panel of the real-axis v integrals
+ACCURATE_RANGE = 0.4  # P(0, v) of a solution is used up to this fraction of its highest node
+NEGLIGIBLE_EFOLDS = 60.0
+
+_TAU_X, _TAU_W = np.polynomial.legendre.leggauss(TAU_NODES)
+_TAU_X, _TAU_W = 0.5 * (_TAU_X + 1.0), 0.5 * _TAU_W
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(PANEL_NODES)
+
+
+def outgoing_speed_solution(restitution):
+    """P(0, v) solved with the highest node where P(0, v) reaches exp(-690) (the default stops at
+    exp(-45) below its value at v = 20): w(F) at small F needs P(0, v) far out (v ~ q (1-q) / F)."""
+    q = large_speed_decay_rate(restitution)
+    return solve_outgoing_speed_density(restitution, highest_speed=0.985 * UNDERFLOW_EFOLDS / q)
+
+
+# ---------------------------------------------------------------------------------------------
+# special functions
+
+
+def _airy_scaled(z):
+    """Ai(z) exp((2/3) z^(3/2)) (scipy's airye), with its leading asymptotic form where |z| > 1e6
+    (scipy returns NaN there)."""
+    z = np.asarray(z)
+    big = np.abs(z) > 1e6
+    safe = np.where(big, 1.0, z)
+    far = np.where(big, z, 1e6)
+    asymptotic = far**-0.25 / (2.0 * np.sqrt(np.pi)) * (1.0 - 5.0 / (48.0 * far**1.5))
+    return np.where(big, asymptotic, special.airye(safe)[0])
+
+
+def _log_psi(force, v):
+    """ln psi_F(v) of eq. (psi) where its argument F^(1/3) v + F^(-2/3)/4 is >= 0 (psi > 0 there)."""
+    argument = force ** (1.0 / 3.0) * v + 0.25 * force ** (-2.0 / 3.0)
+    return (
+        -np.log(force) / 6.0
+        + np.log(_airy_scaled(argument))
+        - (2.0 / 3.0) * np.maximum(argument, 0.0) ** 1.5
+    )
+
+
+def _psi(force, v):
+    """psi_F(v), eq. (psi), for real v (any sign)."""
+    argument = force ** (1.0 / 3.0) * v + 0.25 * force ** (-2.0 / 3.0)
+    positive = argument > 0.0
+    decaying = np.exp(_log_psi(force, np.where(positive, v, 0.0)))
+    oscillating = force ** (-1.0 / 6.0) * special.airy(np.where(positive, 0.0, argument))[0]
+    return np.where(positive, decaying, oscillating)
+
+
+def _log_psi_omega(force, v):
+    """ln of (-omega) F^(-1/6) Ai(omega zeta), zeta = F^(-2/3)/4 - F^(1/3) v (complex v): the half
+    of psi_F(-v) that decays in the upper half plane (2 Re of it is psi_F(-v) on the real axis)."""
+    z = OMEGA * (0.25 * force ** (-2.0 / 3.0) - force ** (1.0 / 3.0) * v)
+    return (
+        np.log(-OMEGA)
+        - np.log(force) / 6.0
+        + np.log(_airy_scaled(z).astype(complex))
+        - (2.0 / 3.0) * z**1.5
+    )
+
+
+def _airy_mellin(s):
+    """int_0^inf t^(s-1) Ai(t) dt = 3^(-(s+2)/3) Gamma(s) / Gamma((s+2)/3), continued to -1 < s < 0."""
+    return 3.0 ** (-(s + 2.0) / 3.0) * special.gamma(s) / special.gamma((s + 2.0) / 3.0)
+
+
+# ---------------------------------------------------------------------------------------------
+# P(0, v) on the real axis (Chebyshev panels) and at complex v (Nystrom formula)
+
+
+@dataclass(frozen=True)
+class _OutgoingDensity:
+    """ln P(0, v) for real v > 0, and P(0, v) e^(q v) for complex v, from a solution."""
+
+    restitution: float
+    beta: float
+    q: float
+    log_amplitude: float  # ln C, P(0, v) = C v^-beta below the solution's lowest node
+    lowest: float
+    largest: float  # P(0, v) is trusted up to here
+    panel_edges: np.ndarray  # in s = ln v + v^(1/2)
+    coefficients: np.ndarray  # Chebyshev coefficients of ln P + beta ln v + q v, per panel
+    nodes: np.ndarray  # u grid of the complex Nystrom sum
+    log_weights: np.ndarray  # ln(weight u P(0, u))
+    remainder: float  # closed-form part of the lower tail, times P(0, u_0)
+
+    def log_density(self, v):
+        """ln P(0, v), real v in (0, largest]."""
+        v = np.asarray(v, dtype=float)
+        s = coordinate_of_speed(np.maximum(v, self.lowest))
+        index = np.clip(np.searchsorted(self.panel_edges, s) - 1, 0, len(self.coefficients) - 1)
+        lo, hi = self.panel_edges[index], self.panel_edges[index + 1]
+        t = (2.0 * s - lo - hi) / (hi - lo)
+        c = self.coefficients[index]
+        b1 = np.zeros_like(t)
+        b2 = np.zeros_like(t)
+        for k in range(c.shape[1] - 1, 0, -1):
+            b1, b2 = c[:, k] + 2.0 * t * b1 - b2, b1
+        smooth = c[:, 0] + t * b1 - b2
+        below = v < self.lowest
+        power = self.log_amplitude - self.beta * np.log(np.where(v > 0, v, 1.0))
+        return np.where(below, power, smooth - self.beta * np.log(v) - self.q * v)
+
+    def scaled_complex(self, v):
+        """P(0, v) e^(q v) at complex v, |arg v| < pi/3, and the sum of the magnitudes of the
+        terms of the Nystrom sum (rounding errors are ~1e-16 of it: at complex v the terms
+        cancel, increasingly so as Im(v)^2 / Re(v) grows)."""
+        v = np.ascontiguousarray(np.asarray(v, dtype=complex).ravel())
+        r = self.restitution
+        out = np.empty(v.size, dtype=complex)
+        magnitude = np.empty(v.size)
+        _complex_kernel_sums(
+            v, r, self.q, self.nodes, self.log_weights, _TAU_X, _TAU_W, out, magnitude
+        )
+        incoming = v / r
+        tail = (
+            self.remainder
+            * 1.5
+            / np.pi
+            * incoming**-2.5
+            * (1.0 + incoming)
+            * np.exp(-0.5 * incoming + self.q * v)
+        )
+        shape = np.shape(v)
+        return (out + tail / (r * r)).reshape(shape), (magnitude + np.abs(tail) / (r * r)).reshape(
+            shape
+        )
+
+
+@njit(cache=True)
+def _complex_kernel_sums(v, r, q, u, log_weights, tau_x, tau_w, out, magnitude):
+    """out_i = e^(q v_i) r^-2 sum_j exp(log_weights_j) G_g(v_i / r, u_j) for complex v_i: the
+    stable form of eq. (kernel3) in kernel.py, continued to complex v (the tau integral runs
+    along the straight segment from 0 to tau1).  Terms below e^-SKIP_EFOLDS of the largest
+    are skipped (at large |v| the kernel confines u to a window of width ~ |v|^(1/2))."""
+    root3_pi = math.sqrt(3.0) / math.pi
+    for i in range(v.size):
+        big_v = v[i] / r
+        best = -1e300
+        for j in range(u.size):
+            d = big_v - u[j]
+            z0 = cmath.sqrt(d * d + big_v * u[j])
+            e = (-0.75 * d * d / (0.5 * (big_v + u[j]) + z0)).real + log_weights[j]
+            e += 0.5 * math.log(min(u[j] / abs(big_v), 1.0))  # G ~ u^(1/2) for u << |v|
+            if e > best:
+                best = e
+        total = 0.0 + 0.0j
+        size = 0.0
+        for j in range(u.size):
+            d = big_v - u[j]
+            z0_squared = d * d + big_v * u[j]
+            z0 = cmath.sqrt(z0_squared)
+            exponent = -0.75 * d * d / (0.5 * (big_v + u[j]) + z0) + log_weights[j]
+            if exponent.real + 0.5 * math.log(min(u[j] / abs(big_v), 1.0)) < best - 46.0:
+                continue
+            if u[j] < 1e-13 * abs(big_v):
+                # kernel.kernel_small_u_limit: relative error O(u / |v|)
+                term = (
+                    1.5
+                    / math.pi
+                    * math.sqrt(u[j])
+                    * big_v**-2.5
+                    * (1.0 + big_v)
+                    * cmath.exp(log_weights[j] - 0.5 * big_v + q * v[i])
+                )
+                total += term
+                size += abs(term)
+                continue
+            tau1 = cmath.sqrt(3.0 * big_v * u[j] / ((big_v + u[j] + z0) * z0))
+            decay = (z0 * tau1 * tau1).real
+            upper = tau1
+            if decay > 0.0 and 6.4 / math.sqrt(decay) < 1.0:
+                upper = tau1 * (6.4 / math.sqrt(decay))
+            acc = 0.0 + 0.0j
+            for k in range(tau_x.size):
+                tau = upper * tau_x[k]
+                t2 = tau * tau
+                one_t2 = 1.0 + t2
+                acc += tau_w[k] * (
+                    cmath.exp(-z0 * t2)
+                    * (1.0 + z0 * one_t2)
+                    / (one_t2 * one_t2 * cmath.sqrt(2.0 + t2))
+                )
+            term = cmath.exp(exponent + q * v[i]) * root3_pi * upper * acc / z0_squared
+            total += term
+            size += abs(term)
+        out[i] = total / (r * r)
+        magnitude[i] = size / (r * r)
+
+
+def _outgoing_density(solution, panel_width=1.0, panel_order=20) -> _OutgoingDensity:
+    r = solution.restitution
+    beta = solution.small_speed_exponent
+    q = large_speed_decay_rate(r)
+    u0 = solution.speeds[0]
+    largest = ACCURATE_RANGE * solution.speeds[-1]
+    log_amplitude = float(np.log(solution.outgoing_speed_density(u0)) + beta * np.log(u0))
+    # Chebyshev panels in s for ln P + beta ln v + q v (smooth, O(1))
+    s_lo, s_hi = coordinate_of_speed(u0), coordinate_of_speed(largest)
+    count = max(1, int(np.ceil((s_hi - s_lo) / panel_width)))
+    edges = np.linspace(s_lo, s_hi, count + 1)
+    cheb = np.cos(np.pi * (np.arange(panel_order) + 0.5) / panel_order)
+    s = 0.5 * (edges[:-1, None] + edges[1:, None]) + 0.5 * np.diff(edges)[:, None] * cheb[None, :]
+    v = speed_of_coordinate(s.ravel())
+    smooth = np.log(solution.outgoing_speed_density(v)) + beta * np.log(v) + q * v
+    coefficients = np.array(
+        [
+            np.polynomial.chebyshev.chebfit(cheb, row, panel_order - 1)
+            for row in smooth.reshape(count, panel_order)
+        ]
+    )
+    # the u grid of the complex Nystrom sum: the solver's rule, REFINE times finer
+    step = solution.step / REFINE
+    s0 = coordinate_of_speed(u0)
+    s_top = coordinate_of_speed(solution.speeds[-1])
+    main = speed_of_coordinate(s0 + step * np.arange(int(np.floor((s_top - s0) / step)) + 1))
+    main_density = solution.outgoing_speed_density(main)
+    tail_count = int(np.ceil(TAIL_EFOLDS / step))
+    tail = speed_of_coordinate(s0 - step * np.arange(1, tail_count + 1))
+    tail_density = main_density[0] * (tail / u0) ** -beta
+    nodes = np.concatenate([tail[::-1], main])
+    density = np.concatenate([tail_density[::-1], main_density])
+    with np.errstate(divide="ignore"):
+        log_weights = np.log(step * _jacobian(nodes) * nodes * density)
+    alpha = 2.5 - beta
+    remainder = (
+        step
+        * u0**2.5
+        * np.exp(-alpha * (tail_count + 1) * step)
+        / -np.expm1(-alpha * step)
+        * main_density[0]
+    )
+    return _OutgoingDensity(
+        r, beta, q, log_amplitude, u0, largest, edges, coefficients, nodes, log_weights, remainder
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# w(F), eq. (weightfunc)
+
+
+def small_force_decay(restitution) -> float:
+    """S(q) in w(F) ~ exp(-S / F) as F -> 0: (3p - p^3) / 24 with p = min(2q - 1, 1)."""
+    p = min(2.0 * large_speed_decay_rate(restitution) - 1.0, 1.0)
+    return (3.0 * p - p**3) / 24.0
+
+
+def small_force_power(restitution) -> float:
+    """gamma in w(F) ~ F^gamma exp(-S/F) as F -> 0: m - 3/2 where q < 1 (r > 1/2: the saddle
+    v* = q (1 - q) / F of eq. (weightfunc), with P(0, v) ~ v^-m e^(-q v) of eq. (asym3)), -1/2 at
+    q = 1 (r = 1/2, eq. (weightfunc2)), 0 where q > 1 (r < 1/2: the end point v = 0)."""
+    q = large_speed_decay_rate(restitution)
+    if abs(q - 1.0) < 1e-12:
+        return -0.5
+    return large_speed_exponent(restitution) - 1.5 if q < 1.0 else 0.0
+
+
+def _panels(lo, hi, width):
+    """Gauss-Legendre nodes and weights on [lo, hi] cut into panels no wider than ``width``."""
+    count = max(1, int(np.ceil((hi - lo) / width)))
+    edges = np.linspace(lo, hi, count + 1)
+    half = 0.5 * np.diff(edges)[:, None]
+    x = (0.5 * (edges[:-1, None] + edges[1:, None]) + half * _GL_X[None, :]).ravel()
+    w = (half * _GL_W[None, :]).ravel()
+    return x, w
+
+
+def _log_sum(log_terms, signs=None):
+    """ln |sum_k signs_k exp(log_terms_k)| and its sign, without overflow."""
+    log_terms = np.asarray(log_terms, dtype=float)
+    top = np.max(log_terms)
+    if not np.isfinite(top):
+        return -np.inf, 0.0
+    total = np.sum((1.0 if signs is None else signs) * np.exp(log_terms - top))
+    return top + np.log(abs(total)), float(np.sign(total))
+
+
+def _real_segment_terms(density, force, v1):
+    """ln |terms| and signs of int_{SMALLEST_SPEED}^{v1} dv v h(v) psi_F(-v) (Gauss-Legendre in s),
+    and ln of the closed-form part below SMALLEST_SPEED (C psi_F(0) eps^(2-beta) / (2-beta))."""
+    s, ws = _panels(coordinate_of_speed(SMALLEST_SPEED), coordinate_of_speed(v1), 0.5)
+    v = speed_of_coordinate(s)
+    turning = 0.25 / force  # beyond, psi_F(-v) oscillates with amplitude O(F^(-1/6))
+    inside = v <= turning
+    psi_beyond = _psi(force, -np.where(inside, turning, v))
+    with np.errstate(divide="ignore"):
+        log_psi = np.where(
+            inside, _log_psi(force, -np.minimum(v, turning)), np.log(np.abs(psi_beyond))
+        )
+    signs = np.where(inside, 1.0, np.sign(psi_beyond))
+    log_terms = np.log(ws * _jacobian(v) * v) + 0.5 * v + density.log_density(v) + log_psi
+    beta = density.beta
+    small = (
+        density.log_amplitude
+        + _log_psi(force, 0.0)
+        + (2.0 - beta) * np.log(SMALLEST_SPEED)
+        - np.log(abs(2.0 - beta))
+    )
+    return log_terms, signs, small, np.sign(2.0 - beta)
+
+
+def _contour(force, v1, q):
+    """Nodes and weights (dv) of the path from v1: at angle pi/3 until arg v = THETA_MAX, then
+    radially, far enough that the Airy factor has decayed by e^-NEGLIGIBLE_EFOLDS more than
+    h can grow."""
+    direction = np.exp(1j * np.pi / 3.0)
+    tangent = np.tan(THETA_MAX)
+    t1 = v1 * tangent / (np.sin(np.pi / 3.0) - tangent * np.cos(np.pi / 3.0))
+    scale = force ** (-1.0 / 3.0)  # the Airy scale (the saddle is wider: (|1 - 2q| / F)^(1/2))
+    t, wt = _panels(0.0, t1, max(scale, t1 / 60.0))
+    leg1 = v1 + t * direction
+    p1 = v1 + t1 * direction
+    rho1 = abs(p1)
+    # radial leg: |Airy| ~ exp(-(2/3) F^(1/2) cos(3 (pi/3 - THETA_MAX)/2) rho^(3/2))
+    c = (2.0 / 3.0) * np.sqrt(force) * np.cos(1.5 * (np.pi / 3.0 - THETA_MAX))
+    growth = max((0.5 - q) * np.cos(THETA_MAX), 0.0) + 0.05  # |h(v)| ~ e^((1/2 - q) Re v)
+
+    def decayed(rho):  # e-folds gained beyond rho1
+        return c * (rho**1.5 - rho1**1.5) - growth * (rho - rho1) - NEGLIGIBLE_EFOLDS
+
+    top = rho1 + 1.0
+    while decayed(top) < 0.0:
+        top = 2.0 * top
+    rho2 = optimize.brentq(decayed, rho1, top)
+    # panels at most 40 % wide in rho (h varies on the scale |v|) and 6 / F^(1/2) in rho^(3/2)
+    # (the Airy phase)
+    edges = [rho1]
+    while edges[-1] < rho2:
+        edges.append(min(1.4 * edges[-1], (edges[-1] ** 1.5 + 6.0 / np.sqrt(force)) ** (2.0 / 3.0)))
+    edges = np.asarray(edges)
+    half = 0.5 * np.diff(edges)[:, None]
+    rho = (0.5 * (edges[:-1, None] + edges[1:, None]) + half * _GL_X[None, :]).ravel()
+    leg2 = p1 / rho1 * rho
+    w2 = p1 / rho1 * (half * _GL_W[None, :]).ravel()
+    return np.concatenate([leg1, leg2]), np.concatenate([wt * direction, w2])
+
+
+def _log_kernel_transform(density, forces):
+    """B(F) (see ``_kernel_transform_table``)."""
+    g, weights, transforms, tail = _kernel_transform_table(density)
+    forces = np.atleast_1d(forces)
+    return np.sum(weights * transforms / (forces[:, None] + g), axis=1) + tail
+
+
+_KERNEL_TRANSFORMS = {}
+
+
+def _kernel_transform_table(density):
+    """T(G) at Gauss-Legendre nodes in ln G, the weights of int dG/(2 pi) e^(-1/(12G)) ...,
+    and the closed-form remainder of B above LARGEST_KERNEL_FORCE (cached per density)."""
+    key = id(density)
+    if key in _KERNEL_TRANSFORMS and _KERNEL_TRANSFORMS[key][0] is density:
+        return _KERNEL_TRANSFORMS[key][1]
+    table = _compute_kernel_transform_table(density)
+    _KERNEL_TRANSFORMS.clear()
+    _KERNEL_TRANSFORMS[key] = (density, table)
+    return table
+
+
+def _compute_kernel_transform_table(density):
+    """ln T(G) at Gauss-Legendre nodes in ln G, with the weights of int dG/(2 pi) e^(-1/(12G)) ...,
+    and the closed-form remainder above LARGEST_KERNEL_FORCE (returned as a coefficient of
+    int_{G_c}^inf G^alpha / (F + G) dG)."""
+    beta = density.beta
+    log_g, wg = _panels(np.log(2e-3), np.log(LARGEST_KERNEL_FORCE), 1.0)
+    g = np.exp(log_g)
+    # v grid: Gauss-Legendre panels in s up to where P(0, v) has fallen by e^-60 from its peak
+    top = min(density.largest, 20.0 + NEGLIGIBLE_EFOLDS / density.q)
+    s, ws = _panels(coordinate_of_speed(SMALLEST_SPEED), coordinate_of_speed(top), 0.5)
+    v = speed_of_coordinate(s)
+    log_vh = np.log(ws * _jacobian(v) * v) + 0.5 * v + density.log_density(v)
+    transforms = np.empty(g.size)
+    for k, gk in enumerate(g):
+        body = np.sum(np.exp(log_vh + _log_psi(gk, v)))
+        small = (
+            np.exp(density.log_amplitude + _log_psi(gk, 0.0))
+            * SMALLEST_SPEED ** (2.0 - beta)
+            / (2.0 - beta)
+        )
+        transforms[k] = body + small
+    weights = wg * g * np.exp(-1.0 / (12.0 * g)) / (2.0 * np.pi)
+    alpha = (2.0 * beta - 5.0) / 6.0
+    tail_coefficient = np.exp(density.log_amplitude) * _airy_mellin(2.0 - beta) / (2.0 * np.pi)
+    tail = tail_coefficient * LARGEST_KERNEL_FORCE**alpha / -alpha  # F << G_c
+    return g, weights, transforms, tail
+
+
+EPSILON = np.finfo(float).eps
+# rounding error of a sum of N terms of mixed signs, in units of EPSILON times the sum of their
+# magnitudes (~ N^(1/2) for N ~ 1000 terms)
+ROUNDING = 50.0
+
+
+def _split_point(q, force):
+    """v1: the turning point 1/(4F) where q >= 1/2, the saddle q (1 - q) / F where q < 1/2; at
+    large F at least half the Airy scale F^(-1/3) (psi is O(1) there: a shorter complex path)."""
+    v1 = 0.25 / force if q >= 0.5 else q * (1.0 - q) / force
+    return max(v1, 0.5 * force ** (-1.0 / 3.0))
+
+
+def _log_contour_part(density, force):
+    """ln |A(F)|, its sign, and ln of an estimate of its rounding error: the real segment plus
+    2 Re of the complex path.  Raises ValueError where P(0, v) would be needed beyond the range
+    in which the solution's is accurate."""
+    q = density.q
+    v1 = _split_point(q, force)
+    cut = min(v1, density.largest)
+    log_terms, signs, small, small_sign = _real_segment_terms(density, force, cut)
+    all_terms = np.append(log_terms, small)
+    all_signs = np.append(signs, small_sign)
+    endpoint_negligible = log_terms[-1] < np.max(all_terms) - 36.0  # 2e-16
+    if cut < v1 and not endpoint_negligible:
+        raise ValueError(
+            f"w({force}) needs P(0, v) beyond v = {density.largest:.4g}: solve with a higher "
+            "highest node (distribution.outgoing_speed_solution)"
+        )
+    if endpoint_negligible:
+        log_value, sign = _log_sum(all_terms, all_signs)
+        return log_value, sign, _log_sum(all_terms)[0] + np.log(ROUNDING * EPSILON)
+    v, wv = _contour(force, v1, q)
+    # drop the nodes where the Airy factor times e^((1/2 - q) Re v) (|h| up to powers of v)
+    # is below e^-50 of the largest term
+    estimate = np.log(np.abs(wv * v)) + (0.5 - q) * v.real + _log_psi_omega(force, v).real
+    keep = estimate > max(np.max(estimate), np.max(all_terms)) - 50.0
+    v, wv = v[keep], wv[keep]
+    if np.max(np.abs(v)) > density.largest:
+        raise ValueError(
+            f"w({force}) needs P(0, v) at |v| = {np.max(np.abs(v)):.4g} > {density.largest:.4g}"
+        )
+    scaled, magnitude = density.scaled_complex(v)
+    log_rest = np.log(wv * v) + (0.5 - q) * v + _log_psi_omega(force, v)
+    log_terms_c = np.log(scaled) + log_rest  # complex logs
+    top = max(np.max(log_terms_c.real), np.max(all_terms))
+    contour = 2.0 * np.sum(np.exp(log_terms_c - top)).real
+    real = np.sum(all_signs * np.exp(all_terms - top))
+    total = contour + real
+    noise = 2.0 * np.sum(np.exp(np.log(magnitude) + log_rest.real - top)) * EPSILON
+    noise += np.sum(np.exp(all_terms - top)) * ROUNDING * EPSILON
+    return top + np.log(abs(total)), float(np.sign(total)), top + np.log(noise)
+
+
+def _log_weight_with_noise(forces, density):
+    """ln w(F) and an estimate of its relative rounding error (inf, and ln w NaN, where the
+    solution's P(0, v) does not reach far enough)."""
+    forces = np.atleast_1d(np.asarray(forces, dtype=float))
+    b = _log_kernel_transform(density, forces)
+    log_w = np.full(forces.size, np.nan)
+    noise = np.full(forces.size, np.inf)
+    for k, f in enumerate(forces):
+        try:
+            log_a, sign_a, log_noise = _log_contour_part(density, f)
+        except ValueError:
+            continue
+        z = 1.0 / (12.0 * f)
+        log_b = np.log(abs(b[k])) - z  # B < 0 is possible where beta > 2 (regularised)
+        top = max(log_a, log_b)
+        total = sign_a * np.exp(log_a - top) - np.sign(b[k]) * np.exp(log_b - top)
+        if total > 0.0:
+            log_w[k] = top + np.log(total)
+            noise[k] = np.exp(log_noise - log_w[k]) + ROUNDING * EPSILON * np.exp(log_b - log_w[k])
+    return log_w, noise
+
+
+def log_weight_function(force, solution, density=None):
+    """ln w(F) of eq. (weightfunc), evaluated directly (see the module docstring); NaN where the
+    solution's P(0, v) does not reach far enough (``outgoing_speed_solution`` reaches further)."""
+    density = _outgoing_density(solution) if density is None else density
+    return _log_weight_with_noise(force, density)[0].reshape(np.shape(force))
+
+
+def weight_function(force, solution, density=None):
+    """w(F) of eq. (weightfunc); over- or underflows where ``log_weight_function`` does not."""
+    return np.exp(log_weight_function(force, solution, density))
+
+
+# ---------------------------------------------------------------------------------------------
+# w(F) interpolated
+
+
+@dataclass(frozen=True)
+class WeightFunction:
+    """ln w(F) of eq. (weightfunc), interpolated: ln w + S/F by Chebyshev series in ln F on panels
+    covering [smallest_force, largest_force]; above, w = w(F_max) (F/F_max)^alpha
+    [(1 - kappa) + kappa (F/F_max)^(-1/3)] with alpha = (2 beta - 5)/6 (from h ~ v^-beta; the
+    correction from the next term of P(0, v) at small v) and kappa matching the slope; below,
+    the end value and slope of ln w + S/F in ln F (see the module docstring)."""
+
+    restitution: float
+    small_speed_exponent: float
+    small_force_decay: float  # S
+    edges: np.ndarray  # panel edges in ln F
+    series: tuple  # np.polynomial.Chebyshev per panel, of ln w + S / F against ln F
+    small_force_power: float  # gamma in w ~ F^gamma e^(-S/F) as F -> 0
+    small_force_series: np.polynomial.Polynomial  # ln w + S/F - gamma ln F against F, F < F_min
+
+    @property
+    def smallest_force(self) -> float:
+        return float(np.exp(self.edges[0]))
+
+    @property
+    def largest_force(self) -> float:
+        return float(np.exp(self.edges[-1]))
+
+    def _smooth(self, y):
+        index = np.clip(np.searchsorted(self.edges, y) - 1, 0, len(self.series) - 1)
+        out = np.empty_like(y)
+        for k, piece in enumerate(self.series):
+            chosen = index == k
+            out[chosen] = piece(y[chosen])
+        return out
+
+    def log(self, force):
+        """ln w(F)."""
+        force = np.asarray(force, dtype=float)
+        y = np.atleast_1d(np.log(force)).astype(float)
+        lo, hi = self.edges[0], self.edges[-1]
+        smooth = self._smooth(np.clip(y, lo, hi))
+        last = self.series[-1]
+        below = y < lo
+        f_below = np.exp(y[below])
+        smooth[below] = self.small_force_power * y[below] + self.small_force_series(f_below)
+        above = y > hi
+        if above.any():
+            decay = self.small_force_decay
+            value = last(hi) - decay * np.exp(-hi)  # ln w at F_max
+            slope = last.deriv()(hi) + decay * np.exp(-hi)  # d ln w / d ln F
+            alpha = (2.0 * self.small_speed_exponent - 5.0) / 6.0
+            kappa = 3.0 * (alpha - slope)
+            t = y[above] - hi
+            smooth[above] = (
+                value
+                + alpha * t
+                + np.log((1.0 - kappa) + kappa * np.exp(-t / 3.0))
+                + decay * np.exp(-y[above])
+            )
+        return (smooth - self.small_force_decay * np.exp(-y)).reshape(np.shape(force))
+
+    def log_scalar(self, force: float) -> float:
+        """ln w(F) for one F (a fast path for scalar integrands: Clenshaw on the panel's series)."""
+        y = math.log(force)
+        if not self.edges[0] <= y <= self.edges[-1]:
+            return float(self.log(force))
+        index = min(bisect.bisect_right(self._edge_list, y) - 1, len(self.series) - 1)
+        a, b = self._edge_list[index], self._edge_list[index + 1]
+        t = (2.0 * y - a - b) / (b - a)
+        b1 = b2 = 0.0
+        coefficients = self._coefficients[index]
+        for c in coefficients[:0:-1]:
+            b1, b2 = c + 2.0 * t * b1 - b2, b1
+        return coefficients[0] + t * b1 - b2 - self.small_force_decay / force
+
+    @functools.cached_property
+    def _edge_list(self):
+        return [float(e) for e in self.edges]
+
+    @functools.cached_property
+    def _coefficients(self):
+        return [[float(c) for c in piece.coef] for piece in self.series]
+
+    def __call__(self, force):
+        """w(F) (over- or underflows where ``log`` does not)."""
+        return np.exp(self.log(force))
+
+
+NOISE_TOLERANCE = 2e-9  # the largest estimated relative rounding error of w accepted
+
+
+def _accurate(density, force) -> bool:
+    _, noise = _log_weight_with_noise(np.array([force]), density)
+    return bool(noise[0] < NOISE_TOLERANCE)
+
+
+def _smallest_force(density, floor) -> float:
+    """The smallest F >= ``floor`` (to a factor 10^(1/8), by bisection in ln F) above which w(F)
+    is computed with an estimated rounding error below NOISE_TOLERANCE and with P(0, v) only
+    where the solution's is accurate (the error grows monotonically as F decreases)."""
+    if _accurate(density, floor):
+        return float(floor)
+    if not _accurate(density, 1.0):
+        raise ValueError("w(1) cannot be computed accurately from this solution")
+    lo, hi = np.log(floor), 0.0  # inaccurate at lo, accurate at hi
+    while hi - lo > np.log(10.0) / 8.0:
+        middle = 0.5 * (lo + hi)
+        if _accurate(density, np.exp(middle)):
+            hi = middle
+        else:
+            lo = middle
+    return float(np.exp(hi))
+
+
+def interpolated_weight_function(solution, panel_nodes=PANEL_CHEBYSHEV_NODES) -> WeightFunction:
+    """w(F) of eq. (weightfunc) at Chebyshev nodes on panels in ln F, interpolated
+    (``WeightFunction``).  Where r > 1/2 the panels at F < 1 are SMALL_PANEL_WIDTH wide (there
+    the saddle e^(-S/F) and end-point e^(-1/(12F)) terms of w cross over), else PANEL_WIDTH;
+    LARGE_PANEL_WIDTH at F > 1."""
+    density = _outgoing_density(solution)
+    decay = small_force_decay(solution.restitution)
+    # below (S + 1/12)/200, F^(-1/2) w e^(-1/(12F)) < e^-200 of its largest values
+    lowest = _smallest_force(density, (decay + 1.0 / 12.0) / 200.0)
+    lo, hi = np.log(lowest), np.log(LARGEST_FORCE)
+    narrow = SMALL_PANEL_WIDTH if solution.restitution > 0.5 else PANEL_WIDTH
+    small = int(np.ceil(-lo / narrow)) if lo < 0.0 else 0
+    large = max(1, int(np.ceil((hi - max(lo, 0.0)) / LARGE_PANEL_WIDTH)))
+    edges = np.concatenate(
+        [np.linspace(lo, 0.0, small + 1)[:-1], np.linspace(max(lo, 0.0), hi, large + 1)]
+    )
+    x = np.cos(np.pi * (np.arange(panel_nodes) + 0.5) / panel_nodes)
+    y = 0.5 * (edges[:-1, None] + edges[1:, None]) + 0.5 * np.diff(edges)[:, None] * x[None, :]
+    forces = np.exp(y.ravel())
+    values = log_weight_function(forces, solution, density) + decay / forces
+    series = tuple(
+        np.polynomial.Chebyshev.fit(yk, vk, panel_nodes - 1, domain=[a, b])
+        for yk, vk, a, b in zip(y, values.reshape(y.shape), edges[:-1], edges[1:])
+    )
+    # below F_min: gamma ln F + a polynomial in F, fitted on the first panel
+    gamma = small_force_power(solution.restitution)
+    f_fit = np.exp(np.linspace(edges[0], edges[1], 40))
+    below = np.polynomial.Polynomial.fit(
+        f_fit, series[0](np.log(f_fit)) - gamma * np.log(f_fit), SMALL_FORCE_DEGREE
+    )
+    return WeightFunction(
+        solution.restitution,
+        solution.small_speed_exponent,
+        decay,
+        edges,
+        series,
+        gamma,
+        below,
+    )
+
+
+def closed_form_weight_function(restitution, log_weight) -> "ClosedFormWeight":
+    """A weight function known in closed form (exact.py), usable wherever a ``WeightFunction`` is."""
+    return ClosedFormWeight(float(restitution), log_weight)
+
+
+@dataclass(frozen=True)
+class ClosedFormWeight:
+    restitution: float
+    log: object  # callable: ln w(F)
+
+    def __call__(self, force):
+        return np.exp(self.log(force))
+
+
+# ---------------------------------------------------------------------------------------------
+# P(x), eq. (P(x)1); int_x^inf P and <v^2>_x, eq. (moment2); moments and bin averages
+
+
+def _total_decay(weight) -> float:
+    """S + 1/12: F^(-1/2) w(F) e^(-1/(12F)) ~ exp(-(S + 1/12)/F) at small F."""
+    return small_force_decay(weight.restitution) + 1.0 / 12.0
+
+
+def _force_quadrature(weight, largest_x=0.0, width=0.5):
+    """Gauss-Legendre nodes in ln F (panels ``width`` wide) from where F^(-1/2) w e^(-1/(12F)) has
+    fallen below e^-100 (and below a twentieth of the saddle point ((S + 1/12)/x)^(1/2) of the
+    largest x) up to F = 1e24, with ln of F^(1/2) w(F) e^(-1/(12F)) dF/dlnF folded in:
+    int dF F^(-1/2) w(F) e^(-1/(12F)) f(F) ~ sum_k exp(log_weights_k) f(F_k)."""
+    total = _total_decay(weight)
+    lo = np.log(min(total / 100.0, np.sqrt(total / max(largest_x, 1e-300)) / 20.0))
+    y, wy = _panels(lo, np.log(1e24), width)
+    force = np.exp(y)
+    log_weights = np.log(wy) + 0.5 * y + weight.log(force) - 1.0 / (12.0 * force)
+    return force, log_weights
+
+
+def _laplace(weight, power, x):
+    """int dF F^(-1/2 - power) w(F) exp(-1/(12F) - F x), for an array x >= 0."""
+    x = np.asarray(x, dtype=float)
+    force, log_weights = _force_quadrature(weight, float(np.max(x, initial=0.0)))
+    exponent = log_weights[None, :] - power * np.log(force)[None, :] - np.outer(x.ravel(), force)
+    return np.sum(np.exp(exponent), axis=1).reshape(x.shape)
+
+
+def position_density(x, weight):
+    """P(x) = int dF F^(-1/2) w(F) exp(-1/(12F) - F x), eq. (P(x)1)."""
+    return _laplace(weight, 0.0, x)
+
+
+def position_tail(x, weight):
+    """int_x^inf P(x') dx' = int dF F^(-3/2) w(F) exp(-1/(12F) - F x), from eq. (P(x)1)."""
+    return _laplace(weight, 1.0, x)
+
+
+def mean_speed_squared_given_position(x, weight):
+    """<v^2>_x = P(x)^-1 int_x^inf P(x') dx', eq. (moment2)."""
+    return position_tail(x, weight) / position_density(x, weight)
+
+
+def position_moment(k: int, weight) -> float:
+    """int_0^inf x^k P(x) dx = k! int dF F^(-3/2 - k) w(F) e^(-1/(12F)), eqs. (P(x)1),
+    (normalization2) (k = 0)."""
+    return float(math.factorial(k) * _laplace(weight, 1.0 + k, 0.0))
+
+
+def position_averages(weight) -> dict:
+    """The normalisation, <x> and Delta x (eq. (xandDeltax)) from P(x)."""
+    norm, first, second = (position_moment(k, weight) for k in (0, 1, 2))
+    mean_x = first / norm
+    return {
+        "normalization": norm,
+        "mean_x": mean_x,
+        "delta_x": float(np.sqrt(second / norm - mean_x**2)),
+    }
+
+
+def _bin_laplace(weight, power, lo, hi):
+    """int dF F^(-1/2 - power) w e^(-1/(12F)) (e^(-F lo) - e^(-F hi)) (no cancellation in narrow bins)."""
+    lo = np.asarray(lo, dtype=float)
+    hi = np.asarray(hi, dtype=float)
+    force, log_weights = _force_quadrature(weight, float(np.max(lo, initial=0.0)))
+    lo_b, hi_b = np.broadcast_arrays(lo, hi)
+    f = force[None, :]
+    difference = -np.expm1(-f * (hi_b.ravel() - lo_b.ravel())[:, None])
+    exponent = log_weights[None, :] - power * np.log(f) - f * lo_b.ravel()[:, None]
+    return np.sum(np.exp(exponent) * difference, axis=1).reshape(lo_b.shape)
+
+
+def position_bin_average(lo, hi, weight):
+    """int_lo^hi P(x) dx / (hi - lo), the quantity a simulation's position bin measures."""
+    lo, hi = np.broadcast_arrays(np.asarray(lo, dtype=float), np.asarray(hi, dtype=float))
+    return _bin_laplace(weight, 1.0, lo, hi) / (hi - lo)
+
+
+def speed_squared_given_position_bin_average(lo, hi, weight):
+    """<v^2>_x of eq. (moment2) averaged over [lo, hi) with weight P(x):
+    int_bin dx int_x^inf P / int_bin P dx; under the F integral,
+    int_lo^hi dx int_x^inf e^(-F x') dx' = (e^(-F lo) - e^(-F hi)) / F^2."""
+    return _bin_laplace(weight, 2.0, lo, hi) / _bin_laplace(weight, 1.0, lo, hi)
+
+
+# ---------------------------------------------------------------------------------------------
+# P(x, v), eq. (fpsol)
+
+
+def _distribution_integrand(log_force, x, v, weight):
+    # e^{-v/2} w(F) e^{-F x} psi_{1/4,F}(-v) F, eqs. (fpsol), (psi); dF = F d(ln F)
+    f = math.exp(log_force)
+    argument = -(f ** (1.0 / 3.0)) * v + 0.25 * f ** (-2.0 / 3.0)
+    log_w = weight.log_scalar(f) if hasattr(weight, "log_scalar") else float(weight.log(f))
+    log_rest = log_w + log_force - f * x - 0.5 * v - log_force / 6.0
+    if argument > 0.0:
+        airy = special.airye(argument)[0] if argument < 1e6 else float(_airy_scaled(argument))
+        return airy * math.exp(log_rest - (2.0 / 3.0) * argument**1.5)
+    return special.airy(argument)[0] * math.exp(log_rest)
+
+
+def distribution_by_force_integral(x, v, weight):
+    """P(x, v) of eq. (fpsol) by integration over ln F, and quad's error estimate.
+
+    Converges absolutely for x > 0, and for x = 0 on the incoming side v < 0
+    (there the Airy function decays); at x = 0, v > 0 only conditionally.
+    """
+    xi, vi = float(x), float(v)
+    if xi < 0.0 or (xi == 0.0 and vi >= 0.0):
+        raise ValueError(
+            f"the F integral of eq. (fpsol) needs x > 0, or x = 0 with v < 0 (x = {x}, v = {v})"
+        )
+    # w(F) e^{-v/2} psi_F(-v) vanishes like e^{-(S + 1/12)/F} at small F (or faster);
+    # e^{-F x} cuts large F (at x = 0, v < 0 the Airy factor ~ exp(-(2/3) F^(1/2) |v|^(3/2)))
+    lower = np.log(_total_decay(weight) / 150.0)
+    upper = np.log(60.0 / xi) if xi > 0.0 else np.log((90.0 / abs(vi) ** 1.5) ** 2 + 1.0)
+    value, error, *_ = integrate.quad(
+        _distribution_integrand,
+        lower,
+        max(upper, lower + 1.0),
+        args=(xi, vi, weight),
+        limit=2000,
+        epsabs=0.0,
+        epsrel=1e-10,
+        full_output=1,
+    )
+    return value, error
+
+
+def distribution_with_error(x, v, weight, solution):
+    """P(x, v) and an estimate of its absolute error, for broadcast arrays x >= 0 and v.
+
+    x > 0: eq. (fpsol) by the F integral.  x = 0: the outgoing side is the
+    solver's P(0, v), the incoming side the boundary condition eq. (bc),
+    P(0, -v) = r^2 P(0, r v); P(0, 0) diverges and is NaN.
+    """
+    x, v = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(v, dtype=float))
+    values, errors = np.empty(x.shape), np.zeros(x.shape)
+    r = solution.restitution
+    for index in np.ndindex(x.shape):
+        xi, vi = float(x[index]), float(v[index])
+        if xi == 0.0:
+            if vi > 0.0:
+                values[index] = solution.outgoing_speed_density(vi)
+            elif vi < 0.0:
+                values[index] = r * r * solution.outgoing_speed_density(-r * vi)
+            else:
+                values[index] = np.nan
+            continue
+        values[index], errors[index] = distribution_by_force_integral(xi, vi, weight)
+    return values, errors
+
+
+def distribution(x, v, weight, solution):
+    """P(x, v), eq. (fpsol) for x > 0 (eq. (bc) and the solver's P(0, v) at x = 0)."""
+    return distribution_with_error(x, v, weight, solution)[0]
+
+
+# ---------------------------------------------------------------------------------------------
+# tables for the pipeline
+
+
+def weight_table(weight, forces):
+    """w(F) at ``forces``: columns F, w, log_w (w over- or underflows where log_w does not)."""
+    forces = np.asarray(forces, dtype=float)
+    log_w = weight.log(forces)
+    return pd.DataFrame({"F": forces, "w": np.exp(log_w), "log_w": log_w})
+
+
+def position_table(weight, positions):
+    """P(x) and <v^2>_x at ``positions``: columns x, px, v2_given_x."""
+    x = np.asarray(positions, dtype=float)
+    px = position_density(x, weight)
+    return pd.DataFrame({"x": x, "px": px, "v2_given_x": position_tail(x, weight) / px})
+
+
+def distribution_table(weight, solution, positions, speeds):
+    """P(x, v) for every x in ``positions`` and v in ``speeds`` (long format: x, v, pxv), and
+    the largest relative error quad estimates for it."""
+    x, v = np.meshgrid(np.asarray(positions, dtype=float), speeds, indexing="ij")
+    pxv, error = distribution_with_error(x, v, weight, solution)
+    finite = np.isfinite(pxv) & (pxv > 0.0)
+    worst = float(np.max(error[finite] / pxv[finite])) if finite.any() else 0.0
+    return pd.DataFrame({"x": x.ravel(), "v": v.ravel(), "pxv": pxv.ravel()}), worst
+
+
+# ---------------------------------------------------------------------------------------------
+# asymptotics of P(x), measured
+
+
+def predicted_exponents(restitution) -> dict:
+    """The asymptotic exponents of P(x) (derivation: docs/distribution_notes.md).
+
+    x -> 0: P(x) ~ x^((1 - beta)/3) (for beta < 1: P(0) - P(x) ~ x^((1 - beta)/3)),
+    P(x, 0) ~ x^(-beta/3).  x -> inf: P(x) ~ x^c exp(-b x^(1/2)) with b = 2 (S + 1/12)^(1/2)
+    (S of ``small_force_decay``: b = (2/3)^(1/2) for r <= 1/2, q (2 (3 - 2q) / 3)^(1/2) above)
+    and c = -(gamma + 1)/2 (gamma of ``small_force_power``: -1/2 for r < 1/2, -1/4 at r = 1/2,
+    1/4 - m/2 above), from the saddle point F ~ ((S + 1/12)/x)^(1/2) of eq. (P(x)1).
+    """
+    beta = small_speed_exponent(restitution)
+    total = small_force_decay(restitution) + 1.0 / 12.0
+    return {
+        "small_x_power": (1.0 - beta) / 3.0,
+        "small_x_power_at_zero_speed": -beta / 3.0,
+        "large_x_rate": 2.0 * np.sqrt(total),
+        "large_x_power": -(small_force_power(restitution) + 1.0) / 2.0,
+    }
+
+
+def _local_slope(x, y):
+    """d ln y / d ln x at the geometric centre of x, from a quadratic fit in ln x."""
+    lx = np.log(x)
+    centre = 0.5 * (lx[0] + lx[-1])
+    coefficients = np.polyfit(lx - centre, np.log(y), 2)
+    return float(coefficients[1])
+
+
+def measured_exponents(weight, large_window=None) -> dict:
+    """The exponents of ``predicted_exponents``, measured from this module's P(x) and P(x, 0).
+
+    Small x: local slopes of ln P (of ln(P(0) - P(x)) where beta < 1) and of ln P(x, 0) against
+    ln x at x ~ 1e-7.  Large x: a least-squares fit of ln P = a - b x^(1/2) + c ln x + d x^(-1/2)
+    on ``large_window`` = (x_lo, x_hi) (default: where the saddle point F_s = ((S + 1/12)/x)^(1/2)
+    lies between 2 F_min and (S + 1/12)/8, so that w(F) there is computed, not continued, and
+    x_hi at most 75^2 / (S + 1/12)).
+    """
+    beta = weight.small_speed_exponent
+    x_small = np.geomspace(1e-8, 1e-6, 9)
+    p_small = position_density(x_small, weight)
+    if beta < 1.0:
+        p_small = position_density(np.array([0.0]), weight)[0] - p_small
+    at_zero_speed = np.array(
+        [distribution_by_force_integral(x, 0.0, weight)[0] for x in np.geomspace(1e-7, 1e-5, 5)]
+    )
+    total = _total_decay(weight)
+    if large_window is None:
+        smallest = getattr(weight, "smallest_force", total / 150.0)
+        # up to where the exponent 2 ((S + 1/12) x)^(1/2) reaches 150 (P still a normal double)
+        # (at r = 0.9 the two bounds cross: the window is then the x between them)
+        large_window = tuple(
+            sorted((64.0 / total, min(total / (2.0 * smallest) ** 2, 75.0**2 / total)))
+        )
+    x_large = np.geomspace(large_window[0], large_window[1], 40)
+    p_large = position_density(x_large, weight)
+    design = np.column_stack(
+        [np.ones_like(x_large), -np.sqrt(x_large), np.log(x_large), 1.0 / np.sqrt(x_large)]
+    )
+    (_, rate, power, _), *_ = np.linalg.lstsq(design, np.log(p_large), rcond=None)
+    return {
+        "small_x_power": _local_slope(x_small, p_small),
+        "small_x_power_at_zero_speed": _local_slope(np.geomspace(1e-7, 1e-5, 5), at_zero_speed),
+        "large_x_rate": float(rate),
+        "large_x_power": float(power),
+        "large_x_window": tuple(float(x) for x in large_window),
+    }
+
+
+def exponents_table(weights) -> pd.DataFrame:
+    """Measured and predicted exponents of P(x) for each weight function: one row per r."""
+    rows = []
+    for weight in weights:
+        measured = measured_exponents(weight)
+        predicted = predicted_exponents(weight.restitution)
+        row = {"r": weight.restitution}
+        for key, value in predicted.items():
+            row[f"{key}_measured"] = measured[key]
+            row[f"{key}_predicted"] = value
+        row["large_x_window_lo"], row["large_x_window_hi"] = measured["large_x_window"]
+        rows.append(row)
+    return pd.DataFrame(rows)

@@ -1,0 +1,39 @@
+"""The equilibrium distribution (bouncing_ball.distribution) at any r: the moments of P(x) of
+eq. (P(x)1) against the solver's Ito time averages (moments of P(0, v) only), and the moment
+identities eqs. (moment1), (moment2) of P(x, v) of eq. (fpsol).  Split from test_distribution.py
+because every r costs a 3-12 s build of w(F)."""
+
+import numpy as np
+import pytest
+from distribution_support import build, check_moment_identities, check_position_moments
+
+# 0.15 < r_c: beta > 2; 0.75, 0.9 > sqrt(3) - 1: q < 1/2 (the contour continues the real-axis
+# integral of eq. (weightfunc), which diverges there)
+OTHERS = [0.15, 0.25, 0.6, 0.75, 0.9]
+
+
+@pytest.fixture(scope="module")
+def built():
+    return build
+
+
+@pytest.mark.parametrize("r", OTHERS)
+def test_position_moments_match_the_ito_time_averages(r):
+    """int P dx = 1, <x> and <x^2> from P(x) against the solver's Ito identities, to 1e-8."""
+    check_position_moments(r)
+
+
+@pytest.mark.parametrize("r", OTHERS)
+def test_distribution_obeys_the_moment_identities(r):
+    """int P(x, v) dv = P(x), <v>_x = 0, int v^2 P(x, v) dv = int_x^inf P, to 1e-6."""
+    check_moment_identities(r)
+
+
+def test_weight_function_grows_where_q_is_below_one_half(built):
+    """At r = 0.9, q < 1/2: w(F) ~ F^(m - 3/2) e^(-S/F) with S < 0 grows without bound as F -> 0
+    (ln w + S/F stays moderate), while F^(-1/2) w e^(-1/(12F)) still vanishes."""
+    _, weight = built(0.9)
+    forces = np.array([2e-3, 5e-3])
+    assert weight.small_force_decay < 0.0
+    assert np.all(weight.log(forces) > 10.0)
+    assert np.all(np.abs(weight.log(forces) + weight.small_force_decay / forces) < 20.0)
