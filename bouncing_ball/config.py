@@ -114,6 +114,9 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
     for name, positive in (
         ("solver.output_speeds", True),
         ("solver.flight_times", True),
+        ("solver.position_grid", True),
+        ("solver.forces", True),
+        ("solver.speeds", False),
         ("exact.speeds", False),
         ("exact.position_grid", True),
     ):
@@ -231,7 +234,16 @@ def shard_count(config: dict, label: str) -> int:
 def solver_settings(config: dict) -> dict:
     """What one solve is run with (not the r grid of Fig. 6, which has its own job)."""
     return {
-        key: config["solver"][key] for key in ("quadrature_step", "output_speeds", "flight_times")
+        key: config["solver"][key]
+        for key in (
+            "quadrature_step",
+            "output_speeds",
+            "flight_times",
+            "position_grid",
+            "positions",
+            "speeds",
+            "forces",
+        )
     }
 
 

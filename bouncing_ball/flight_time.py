@@ -542,14 +542,23 @@ def flight_time_summary(solution):
 
 
 def flight_time_table(solution, times):
-    """Columns t, density (rho(T); NaN below r_c, where it is not defined), rate_density (nu(T))
-    and time_weighted_density (T nu(T), a probability density for every r)."""
+    """Columns t, density (rho(T); NaN below r_c, where it is not defined), rate_density (nu(T)),
+    time_weighted_density (T nu(T), a probability density for every r), and the short- and
+    long-time forms of nu(T) (short_time_form, eq. (short); long_time_form, eqs. (long1),
+    (long2)) for the figure."""
     times = np.asarray(times, dtype=float)
     nu = flight_rate_density(solution, times)
     rate = collision_rate(solution)
     density = nu / rate if np.isfinite(rate) else np.full_like(nu, np.nan)
     return pd.DataFrame(
-        {"t": times, "density": density, "rate_density": nu, "time_weighted_density": times * nu}
+        {
+            "t": times,
+            "density": density,
+            "rate_density": nu,
+            "time_weighted_density": times * nu,
+            "short_time_form": short_flight_rate_density(solution, times),
+            "long_time_form": long_flight_rate_density(solution, times),
+        }
     )
 
 

@@ -10,7 +10,16 @@ importing numba, scipy or matplotlib.
 # that key the random streams; "jit" is how the compiled modules are compiled
 SIMULATION = ("bins", "free_flight", "jit", "restitution", "settings", "simulation", "tallies")
 MERGE = ("bins", "histograms", "io", "restitution", "settings", "shards", "tallies")
-SOLVER = ("asymptotics", "bins", "flight_time", "jit", "kernel", "restitution", "solver")
+SOLVER = (
+    "asymptotics",
+    "bins",
+    "distribution",
+    "flight_time",
+    "jit",
+    "kernel",
+    "restitution",
+    "solver",
+)
 EXACT = ("bins", "exact")
 THEORY = ("asymptotics", "bins")
 FITS = (
@@ -45,4 +54,4 @@ VALIDATION = ("bins", "comparison", "exact", "fits", "io")
 
 # what numba compiles: the modules with compiled functions and what those call into (the
 # key of numba's cache folder, bouncing_ball.jit); an edit elsewhere does not recompile
-COMPILED = ("free_flight", "jit", "kernel", "simulation")
+COMPILED = ("distribution", "free_flight", "jit", "kernel", "simulation")

@@ -1,14 +1,16 @@
-"""Rule solve: eq. (inteq) solved for P(0, v) at one r, with <x>, Delta x, I, accuracy checks
-and the collision statistics -> results/solver/r{r}/p0v.parquet (v, p0v), summary.parquet (one
-row) and flight_time.parquet (the equilibrium flight-time density on solver.flight_times)."""
+"""Rule solve: eq. (inteq) solved for P(0, v) at one r, with <x>, Delta x, I, accuracy checks,
+the collision statistics and the whole distribution -> results/solver/r{r}/: p0v (v, p0v),
+summary (one row), flight_time (the equilibrium flight-time density on solver.flight_times),
+position (P(x), <v^2>_x, eqs. (P(x)1), (moment2)), distribution (P(x, v), eq. (fpsol)) and
+weight (w(F), eq. (weightfunc))."""
 
 import logging
 import time
 
 import pandas as pd
 
-from bouncing_ball import flight_time, solver
-from bouncing_ball.bins import log_grid
+from bouncing_ball import distribution, flight_time, solver
+from bouncing_ball.bins import linear_grid, log_grid
 from bouncing_ball.io import write_tables
 from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
@@ -26,6 +28,22 @@ with job_log(snakemake.log[0]):
     collisions = flight_time.flight_time_summary(solution)
     row.update({key: value for key, value in collisions.items() if key not in row})
     flights = flight_time.flight_time_table(solution, log_grid(settings["flight_times"]))
+    # the whole distribution from P(0, v) (bouncing_ball.distribution): w(F), then P(x), P(x, v)
+    started_distribution = time.perf_counter()
+    far = distribution.outgoing_speed_solution(float(exact))  # P(0, v) out to ~e^-690
+    weight = distribution.interpolated_weight_function(far)
+    position = distribution.position_table(weight, log_grid(settings["position_grid"]))
+    joint, worst = distribution.distribution_table(
+        weight, far, settings["positions"], linear_grid(settings["speeds"])
+    )
+    weights = distribution.weight_table(weight, log_grid(settings["forces"]))
+    averages = distribution.position_averages(weight)
+    row["position_normalization"] = averages["normalization"]
+    row["mean_x_from_position"] = averages["mean_x"]
+    row["delta_x_from_position"] = averages["delta_x"]
+    measured = distribution.measured_exponents(weight)
+    for key, value in distribution.predicted_exponents(float(exact)).items():
+        row[f"{key}_measured"], row[f"{key}_predicted"] = measured[key], value
     provenance = {
         "rule": "solve",
         "r": exact_string(exact),
@@ -40,6 +58,9 @@ with job_log(snakemake.log[0]):
             snakemake.output.p0v: p0v,
             snakemake.output.summary: pd.DataFrame([row]),
             snakemake.output.flight_time: flights,
+            snakemake.output.position: position,
+            snakemake.output.distribution: joint,
+            snakemake.output.weight: weights,
         },
         provenance,
     )
@@ -64,3 +85,20 @@ with job_log(snakemake.log[0]):
             row["accuracy_estimate"],
             solver.ACCURACY_TARGET,
         )
+    logging.info(
+        "r=%s: w(F), P(x), P(x, v) in %.1f s; from P(x): int P dx - 1 = %.1e, <x> = %.10g, "
+        "Delta x = %.10g (Ito: %.10g, %.10g); P(x, v) quadrature error estimate %.1e; "
+        "large-x decay rate %.6g (predicted %.6g), power %.4g (predicted %.4g)",
+        label,
+        time.perf_counter() - started_distribution,
+        row["position_normalization"] - 1.0,
+        row["mean_x_from_position"],
+        row["delta_x_from_position"],
+        row["mean_x"],
+        row["delta_x"],
+        worst,
+        row["large_x_rate_measured"],
+        row["large_x_rate_predicted"],
+        row["large_x_power_measured"],
+        row["large_x_power_predicted"],
+    )

@@ -111,7 +111,7 @@ def solver_targets():
     return expand(
         "results/solver/r{r}/{table}.parquet",
         r=RESTITUTION,
-        table=("p0v", "summary", "flight_time"),
+        table=("p0v", "summary", "flight_time", "position", "distribution", "weight"),
     )
 
 

@@ -6,13 +6,16 @@ rule solve:
         p0v="results/solver/r{r}/p0v.parquet",
         summary="results/solver/r{r}/summary.parquet",
         flight_time="results/solver/r{r}/flight_time.parquet",
+        position="results/solver/r{r}/position.parquet",
+        distribution="results/solver/r{r}/distribution.parquet",
+        weight="results/solver/r{r}/weight.parquet",
     log:
         "logs/solver/r{r}.log",
     localrule: True
     conda:
         "../envs/bouncing-ball.yaml"
     resources:
-        runtime=5,
+        runtime=10,
         mem_mb=1000,
         cpus_per_task=1,
     params:
