@@ -29,7 +29,7 @@ depends on the state):
     changes a bin by about (sigma_x^2 / 2) P''/P, second order, ~1e-4.
   * the time spent in each cell of (x, v), x on the position bins and v on
     evenly spaced bins, for P(x, v).  Here the bridge's spread of v about the
-    mean path's slope, Var[v(t) | ends] ~ Delta / 2, is not negligible (steps
+    mean path's slope, Var[v(t) | ends] <= Delta / 6, is not negligible (steps
     away from the floor reach 0.1-1), so each recorded step [0, tau] of a
     step of length Delta draws one time s uniformly in [0, tau] and (x(s),
     v(s)) from the bridge's exact conditional Gaussian given both ends
