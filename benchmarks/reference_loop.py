@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from bouncing_ball.settings import ShardSettings
-from bouncing_ball.tallies import ShardTallies
+from bouncing_ball.tallies import BINS, ShardTallies, tally_seed_sequence
 
 HERE = Path(__file__).resolve().parent
 SOURCE = HERE / "reference" / "shard_loop.c"
@@ -117,6 +117,7 @@ def _load(library: str):
     function.restype = ctypes.c_int
     function.argtypes = [
         ctypes.c_void_p,  # bitgen_t *
+        ctypes.c_void_p,  # bitgen_t * of the P(x, v) draws
         ctypes.c_double,  # restitution
         ctypes.c_double,  # c
         ctypes.c_double,  # min_step_divisor
@@ -128,9 +129,16 @@ def _load(library: str):
         ctypes.c_int64,  # nv
         _double_array,  # x_edges
         ctypes.c_int64,  # nx
+        _double_array,  # u_edges (velocities of P(x, v))
+        ctypes.c_int64,  # nu
+        _double_array,  # f_edges (flight times)
+        ctypes.c_int64,  # nf
         _int64_array,  # speed_counts
         _double_array,  # position_time
         _double_array,  # position_v2_time
+        _int64_array,  # flight_time_counts
+        _double_array,  # position_velocity_time, row-major
+        _int64_array,  # return_speed_counts, row-major
         _double_array,  # scalars
     ]
     return function
@@ -146,16 +154,17 @@ def reference_shard(
     shared library, by default ``build()``)."""
     if not 0.0 < restitution < 1.0:
         raise ValueError(f"restitution must lie in (0, 1), got {restitution}")
-    speed_bins, position_bins = settings.speed_bins, settings.position_bins
     function = _load(str(library if library is not None else build()))
-    bit_generator = np.random.PCG64(seed_sequence)  # kept alive across the call
-    v_edges = np.ascontiguousarray(speed_bins.edges, dtype=np.float64)
-    x_edges = np.ascontiguousarray(position_bins.edges, dtype=np.float64)
-    speed_counts, position_time, position_v2_time, scalars = ShardTallies.loop_arrays(
-        speed_bins, position_bins
-    )
+    # both kept alive across the call
+    bit_generator = np.random.PCG64(seed_sequence)
+    tally_bit_generator = np.random.PCG64(tally_seed_sequence(seed_sequence))
+    edges = {
+        name: np.ascontiguousarray(getattr(settings, name).edges, dtype=np.float64) for name in BINS
+    }
+    arrays = ShardTallies.loop_arrays(settings)
     status = function(
         bit_generator.ctypes.bit_generator,
+        tally_bit_generator.ctypes.bit_generator,
         float(restitution),
         settings.criterion_c,
         settings.min_step_divisor,
@@ -163,28 +172,29 @@ def reference_shard(
         settings.equilibration_time,
         settings.shard_time,
         settings.max_steps,
-        v_edges,
-        speed_bins.n,
-        x_edges,
-        position_bins.n,
-        speed_counts,
-        position_time,
-        position_v2_time,
-        scalars,
+        edges["speed_bins"],
+        settings.speed_bins.n,
+        edges["position_bins"],
+        settings.position_bins.n,
+        edges["velocity_bins"],
+        settings.velocity_bins.n,
+        edges["flight_time_bins"],
+        settings.flight_time_bins.n,
+        arrays["speed_counts"],
+        arrays["position_time"],
+        arrays["position_v2_time"],
+        arrays["flight_time_counts"],
+        arrays["position_velocity_time"].ravel(),  # C-contiguous: a view
+        arrays["return_speed_counts"].ravel(),
+        arrays["scalars"],
     )
     if status != 0:
         raise MemoryError("the C reference could not allocate its bin bounds")
-    return ShardTallies.from_loop(
-        speed_bins, position_bins, speed_counts, position_time, position_v2_time, scalars
-    )
+    return ShardTallies.from_loop(settings, arrays)
 
 
 # what a shard records (its bins aside): every one must agree bit for bit
-TALLY_FIELDS = tuple(
-    field.name
-    for field in fields(ShardTallies)
-    if field.name not in ("speed_bins", "position_bins")
-)
+TALLY_FIELDS = tuple(field.name for field in fields(ShardTallies) if field.name not in BINS)
 
 
 def differing_tallies(first: ShardTallies, second: ShardTallies) -> list[str]:

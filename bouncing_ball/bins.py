@@ -1,8 +1,10 @@
-"""Log-spaced bins with an underflow and an overflow bin.
+"""Log- and evenly spaced bins, each with an underflow and an overflow bin.
 
 A ``LogBins(lo, hi, per_decade)`` has the finite edges e_0 = lo < ... < e_n = hi
 and n + 2 bins: index 0 holds everything below lo (including 0 and negative
 values), index j + 1 holds [e_j, e_{j+1}), and index n + 1 holds [hi, inf).
+A ``LinearBins(lo, hi, width)`` is the same with evenly spaced edges
+e_j = lo + j width; its underflow bin is (-inf, lo).
 """
 
 from dataclasses import dataclass
@@ -43,9 +45,46 @@ class LogBins:
         return np.concatenate([self.edges, [np.inf]])
 
 
+@dataclass(frozen=True)
+class LinearBins:
+    lo: float
+    hi: float
+    width: float
+
+    def __post_init__(self):
+        if not self.lo < self.hi:
+            raise ValueError(f"bins need lo < hi, got lo={self.lo}, hi={self.hi}")
+        if not self.width > 0.0:
+            raise ValueError(f"bins need width > 0, got width={self.width}")
+
+    @property
+    def n(self) -> int:
+        """Number of finite bins (hi is rounded up to a whole bin)."""
+        return int(np.ceil((self.hi - self.lo) / self.width - 1e-9))
+
+    @property
+    def edges(self) -> np.ndarray:
+        """The n + 1 finite edges."""
+        return self.lo + self.width * np.arange(self.n + 1)
+
+    @property
+    def lower(self) -> np.ndarray:
+        """Lower edge of each of the n + 2 bins (-inf for the underflow bin)."""
+        return np.concatenate([[-np.inf], self.edges])
+
+    @property
+    def upper(self) -> np.ndarray:
+        """Upper edge of each of the n + 2 bins (inf for the overflow bin)."""
+        return np.concatenate([self.edges, [np.inf]])
+
+
 # the config's specifications of bins and grids, e.g. {lo, hi, per_decade} and {min, max, points}
 def log_bins(spec: dict) -> LogBins:
     return LogBins(float(spec["lo"]), float(spec["hi"]), int(spec["per_decade"]))
+
+
+def linear_bins(spec: dict) -> LinearBins:
+    return LinearBins(float(spec["lo"]), float(spec["hi"]), float(spec["width"]))
 
 
 def log_grid(spec: dict):

@@ -105,9 +105,9 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
         check_types(config, schema, "config")
     grid = restitution_grid(config["restitution"])
     simulation = config["simulation"]
-    for name in ("speed_bins", "position_bins"):
-        bins = simulation[name]
-        if not bins["lo"] < bins["hi"]:
+    for name in ("speed_bins", "position_bins", "velocity_bins", "flight_time_bins"):
+        bins = simulation.get(name)  # the last two are optional (settings.ShardSettings defaults)
+        if bins is not None and not bins["lo"] < bins["hi"]:
             raise ValueError(
                 f"simulation.{name}: lo = {bins['lo']} must be smaller than hi = {bins['hi']}"
             )
@@ -287,7 +287,7 @@ def _study_settings(config: dict, label: str, study: dict, where: str, **changes
     """The main config's shard settings of r = ``label``, with the study's ``simulation``
     overrides and ``changes`` (shard_time, criterion_c) applied."""
     overrides = dict(study.get("simulation", {}))
-    for name in ("speed_bins", "position_bins"):
+    for name in ("speed_bins", "position_bins", "velocity_bins", "flight_time_bins"):
         bins = overrides.get(name)
         if bins is not None and not bins["lo"] < bins["hi"]:
             raise ValueError(

@@ -10,9 +10,14 @@ interpolation reproduces the cubic drift term -t^2/2); its variances are
     Var[x(t) | ends] = 2 t^3 (dt - t)^3 / (3 dt^3)
     Var[v(t) | ends] = 2 t (dt - t) (dt^2 - 3 t dt + 3 t^2) / dt^3
 
+and their covariance is
+
+    Cov[x(t), v(t) | ends] = t^2 (dt - t)^2 (dt - 2 t) / dt^3
+
 (the factor 2 is the noise strength 2 Lambda of eq. (eqmo)).  The simulation
-uses these to integrate x, x^2 and v^2 over a step exactly in expectation and
-to place a collision inside a step.
+uses these to integrate x, x^2 and v^2 over a step exactly in expectation, to
+place a collision inside a step, and to draw (x(t), v(t)) from the bridge
+(``bridge_sample``) for the time-weighted P(x, v).
 
 Everything here is numba-compiled scalar code (no allocation, no division by
 a constant: those are written as products with the reciprocal, which LLVM
@@ -28,6 +33,9 @@ from .jit import njit
 
 SQRT3 = math.sqrt(3.0)
 SQRT1_12 = math.sqrt(1.0 / 12.0)
+SQRT2_3 = math.sqrt(2.0 / 3.0)
+SQRT3_2 = math.sqrt(1.5)
+SQRT1_2 = math.sqrt(0.5)
 
 # Rational fits (see largest_safe_step) to the positive root of the cubic
 # c s^3 = x + v s^2, in units of a = (x/c)^(1/3), with t = |v| / (c a).
@@ -162,6 +170,41 @@ def mean_path_integrals(a0, a1, a2, a3, dt, tau):
     tau2 = tau * tau
     int_var = (2.0 / 3.0) * tau2 * tau2 * (0.25 - u * (3.0 / 5.0 - u * (0.5 - u * (1.0 / 7.0))))
     return int_x, int_m2 + int_var
+
+
+def bridge_covariance(dt, t):
+    """(Var x, Cov(x, v), Var v) of the bridge at time t of a step of length dt, given its ends.
+
+    Conditioning the integrated Brownian motion (x, v) at t on its value at dt
+    (Schur complement of the joint covariance; with w = u (1 - u), u = t / dt):
+    Var x = (2/3) dt^3 w^3, Cov = dt^2 w^2 (1 - 2u), Var v = 2 dt w (1 - 3w).
+    """
+    u = np.asarray(t, dtype=float) / dt
+    w = u * (1.0 - u)
+    return (
+        (2.0 / 3.0) * dt**3 * w**3,
+        dt**2 * w**2 * (1.0 - 2.0 * u),
+        2.0 * dt * w * (1.0 - 3.0 * w),
+    )
+
+
+@njit(cache=True)
+def bridge_sample(a0, a1, a2, a3, dt, t, normal_1, normal_2):
+    """(x(t), v(t)) on the bridge of a step of length dt, given its ends (``a``: the mean path).
+
+    The mean is (m(t), m'(t)); with w = u (1 - u), u = t / dt, the covariance
+    of ``bridge_covariance`` factors as x = m + (2/3)^(1/2) dt w (dt w)^(1/2) n1 and
+    v = m' + (dt w)^(1/2) ((3/2)^(1/2) (1 - 2u) n1 + (1/2)^(1/2) n2): Var v given x
+    is dt w / 2.  ``normal_1``, ``normal_2`` are independent standard normals.
+    """
+    u = t * (1.0 / dt)
+    w = max(u * (1.0 - u), 0.0)  # u may exceed 1 by a rounding error at t = dt
+    root = math.sqrt(dt * w)
+    x = cubic_value(a0, a1, a2, a3, t) + SQRT2_3 * dt * w * root * normal_1
+    v = cubic_slope(a1, a2, a3, t) + root * (
+        SQRT3_2 * (1.0 - 2.0 * u) * normal_1 + SQRT1_2 * normal_2
+    )
+    return x, v
 
 
 @njit(cache=True)

@@ -1,4 +1,4 @@
-"""From summed shard tallies to P(0,v), P(x), <v^2>_x and the moments.
+"""From summed shard tallies to P(0,v), P(x), <v^2>_x, P(x,v), the flights and the moments.
 
 Every estimate is a function of the shards' summed tallies; its standard
 error comes from the scatter between shards by the delete-one jackknife
@@ -98,6 +98,90 @@ def position_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
     )
 
 
+def distribution_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
+    """P(x, v) as cell averages: the time in each cell of (x, v) over the total time and the
+    cell's area (x on the position bins, v on the velocity bins).
+
+    Columns x_lo, x_hi, v_lo, v_hi, pxv, pxv_err, one row per cell, v fastest.  pxv is NaN
+    in cells of infinite area (x overflow, v under- and overflow); pxv_err also in cells the
+    particle never visited.  The x underflow cell [0, x_lo) also holds the rare bridge draws
+    below x = 0 (see ``simulation``).
+    """
+    first = shards[0]
+    x_lower, x_upper = first.position_bins.lower, first.position_bins.upper
+    v_lower, v_upper = first.velocity_bins.lower, first.velocity_bins.upper
+    area = np.outer(x_upper - x_lower, v_upper - v_lower)
+    in_cell = np.stack([s.position_velocity_time for s in shards])
+    times = np.array([s.time for s in shards])[:, None, None]
+    pxv, err = jackknife(lambda b, t: b / (t * area), in_cell, times)
+    infinite = ~np.isfinite(area)
+    pxv[infinite] = np.nan
+    err[infinite | (in_cell.sum(axis=0) == 0)] = np.nan
+    nx, nv = area.shape
+    return pd.DataFrame(
+        {
+            "x_lo": np.repeat(x_lower, nv),
+            "x_hi": np.repeat(x_upper, nv),
+            "v_lo": np.tile(v_lower, nx),
+            "v_hi": np.tile(v_upper, nx),
+            "pxv": pxv.ravel(),
+            "pxv_err": err.ravel(),
+        }
+    )
+
+
+def flight_time_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
+    """The density of the flight time T between consecutive collisions, per unit T and per
+    flight (bin averages): counts / (flights x bin width).
+
+    Columns t_lo, t_hi, t (geometric centre; the arithmetic one for the underflow bin
+    [0, t_lo)), density, density_err.  NaN in the overflow bin; density_err NaN in empty bins.
+    """
+    bins = shards[0].flight_time_bins
+    lower, upper = bins.lower, bins.upper
+    counts = np.stack([s.flight_time_counts for s in shards])
+    flights = np.array([s.flights for s in shards], dtype=float)[:, None]
+    density, err = jackknife(lambda c, n: c / (n * (upper - lower)), counts, flights)
+    density[~np.isfinite(upper)] = np.nan
+    err[~np.isfinite(upper) | (counts.sum(axis=0) == 0)] = np.nan
+    return pd.DataFrame(
+        {
+            "t_lo": lower,
+            "t_hi": upper,
+            "t": _bin_centres(lower, upper),
+            "density": density,
+            "density_err": err,
+        }
+    )
+
+
+def return_speed_table(shards: list[ShardTallies]) -> pd.DataFrame:
+    """The return speed v at the next collision given the outgoing speed u of a bounce: the
+    probability of each v bin given the u bin, counts over the counts of that u row.
+
+    Columns u_lo, u_hi, v_lo, v_hi, probability, probability_err, one row per (u, v) bin
+    pair of the speed bins, v fastest.  NaN (both) in rows of u with no flight;
+    probability_err NaN where the pair was never seen.
+    """
+    bins = shards[0].speed_bins
+    lower, upper = bins.lower, bins.upper
+    counts = np.stack([s.return_speed_counts for s in shards])
+    probability, err = jackknife(lambda c: c / c.sum(axis=-1, keepdims=True), counts)
+    total = counts.sum(axis=0)
+    err[total == 0] = np.nan
+    n = lower.shape[0]
+    return pd.DataFrame(
+        {
+            "u_lo": np.repeat(lower, n),
+            "u_hi": np.repeat(upper, n),
+            "v_lo": np.tile(lower, n),
+            "v_hi": np.tile(upper, n),
+            "probability": probability.ravel(),
+            "probability_err": err.ravel(),
+        }
+    )
+
+
 def _mean_x(int_x, time):
     return int_x / time
 
@@ -107,7 +191,8 @@ def _delta_x(int_x, int_x2, time):
 
 
 def position_moments_summary(shards: list[ShardTallies], restitution: float) -> pd.DataFrame:
-    """One row: <x>, Delta x and the collision rate I, eqs. (collrate), (xandDeltax)."""
+    """One row: <x>, Delta x and the collision rate I, eqs. (collrate), (xandDeltax), and the
+    mean and second moment of the flight time per flight."""
     time = np.array([s.time for s in shards])
     int_x = np.array([s.int_x for s in shards])
     int_x2 = np.array([s.int_x2 for s in shards])
@@ -115,6 +200,11 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
     mean_x, mean_x_err = jackknife(_mean_x, int_x, time)
     delta_x, delta_x_err = jackknife(_delta_x, int_x, int_x2, time)
     rate, rate_err = jackknife(lambda c, t: c / t, collisions, time)
+    flights = np.array([s.flights for s in shards], dtype=float)
+    flight_time = np.array([s.flight_time_sum for s in shards])
+    flight_time_squared = np.array([s.flight_time_squared_sum for s in shards])
+    mean_t, mean_t_err = jackknife(lambda f, n: f / n, flight_time, flights)
+    second_t, second_t_err = jackknife(lambda f, n: f / n, flight_time_squared, flights)
     total = merge_shards(shards)
     return pd.DataFrame(
         {
@@ -125,6 +215,11 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
             "delta_x_err": [float(delta_x_err)],
             "collision_rate": [float(rate)],
             "collision_rate_err": [float(rate_err)],
+            "mean_flight_time": [float(mean_t)],
+            "mean_flight_time_err": [float(mean_t_err)],
+            "flight_time_second_moment": [float(second_t)],
+            "flight_time_second_moment_err": [float(second_t_err)],
+            "flights": [int(total.flights)],
             "total_time": [float(total.time)],
             "collisions": [int(total.collisions)],
             "steps": [int(total.steps)],

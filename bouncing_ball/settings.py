@@ -10,11 +10,16 @@ existing ones alone.
 
 from dataclasses import asdict, dataclass, fields, replace
 
-from .bins import LogBins, log_bins
+from .bins import LinearBins, LogBins, linear_bins, log_bins
 
 # the largest step budget: far beyond any shard (10^15 steps are years of CPU), far inside
 # the compiled loop's 64-bit step counter (9.2e18); the config schema repeats it
 MAX_STEPS_LIMIT = 10**15
+
+# the bins of the tallies of issues 16 and 17, when a config or a caller does not name them
+# (the default config names them; config/README.md says why these)
+DEFAULT_VELOCITY_BINS = LinearBins(-24.0, 20.0, 0.25)
+DEFAULT_FLIGHT_TIME_BINS = LogBins(1.0e-12, 1.0e3, 5)
 
 
 @dataclass(frozen=True)
@@ -29,6 +34,8 @@ class ShardSettings:
     speed_bins: LogBins  # outgoing speeds, P(0, v)
     position_bins: LogBins  # heights, P(x) and <v^2>_x
     min_step_floor: float = 0.0  # lower bound on delta (0: the paper's rule alone)
+    velocity_bins: LinearBins = DEFAULT_VELOCITY_BINS  # v of the 2-D P(x, v) (x: position_bins)
+    flight_time_bins: LogBins = DEFAULT_FLIGHT_TIME_BINS  # times between collisions
 
     def __post_init__(self):
         for name in ("shard_time", "equilibration_time", "criterion_c", "min_step_divisor"):
@@ -37,10 +44,12 @@ class ShardSettings:
         if isinstance(self.max_steps, float) and not self.max_steps.is_integer():
             raise ValueError(f"max_steps must be a whole number, got {self.max_steps}")
         object.__setattr__(self, "max_steps", int(self.max_steps))
-        for name in ("speed_bins", "position_bins"):
+        for name in ("speed_bins", "position_bins", "flight_time_bins"):
             value = getattr(self, name)
             if not isinstance(value, LogBins):
                 object.__setattr__(self, name, log_bins(value))
+        if not isinstance(self.velocity_bins, LinearBins):
+            object.__setattr__(self, "velocity_bins", linear_bins(self.velocity_bins))
         problems = [
             f"{name} = {getattr(self, name)} must be {rule}"
             for name, rule, holds in (
@@ -67,7 +76,8 @@ class ShardSettings:
 
     @classmethod
     def from_mapping(cls, mapping: dict) -> "ShardSettings":
-        """From the config-shaped dict (bins as ``{lo, hi, per_decade}``); other keys ignored."""
+        """From the config-shaped dict (bins as ``{lo, hi, per_decade}``, velocity_bins as
+        ``{lo, hi, width}``); other keys ignored, missing optional ones at their defaults."""
         return cls(**{name: mapping[name] for name in cls.names() if name in mapping})
 
     def as_mapping(self) -> dict:

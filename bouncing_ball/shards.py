@@ -1,7 +1,6 @@
 """Reading a set of shard files back, with every check a downstream step needs."""
 
 from .asymptotics import CRITICAL_RESTITUTION
-from .bins import log_bins
 from .io import UnreadableFileError, read_table
 from .restitution import parse_restitution
 from .settings import ShardSettings
@@ -40,14 +39,9 @@ def read_shards(paths, label):
             )
         try:
             shards.append(
-                tallies_from_frame(
-                    frame,
-                    log_bins(provenance["speed_bins"]),
-                    log_bins(provenance["position_bins"]),
-                    source=str(path),
-                )
+                tallies_from_frame(frame, ShardSettings.from_mapping(provenance), source=str(path))
             )
-        except (KeyError, ValueError) as error:
+        except (KeyError, TypeError, ValueError) as error:
             raise UnreadableFileError(f"{path}: malformed shard ({error})") from None
         if not shards[-1].time > 0.0:
             below = parse_restitution(provenance["r"]) < CRITICAL_RESTITUTION

@@ -27,6 +27,27 @@ depends on the state):
     and <v^2>_x of eq. (moment2).  Assigning time by the mean path ignores
     the bridge's spread sigma_x ~ (Delta^3 / 96)^(1/2) about it; that
     changes a bin by about (sigma_x^2 / 2) P''/P, second order, ~1e-4.
+  * the time spent in each cell of (x, v), x on the position bins and v on
+    evenly spaced bins, for P(x, v).  Here the bridge's spread of v about the
+    mean path's slope, Var[v(t) | ends] <= Delta / 6, is not negligible (steps
+    away from the floor reach 0.1-1), so each recorded step [0, tau] of a
+    step of length Delta draws one time s uniformly in [0, tau] and (x(s),
+    v(s)) from the bridge's exact conditional Gaussian given both ends
+    (``free_flight.bridge_sample``), and adds tau to that cell.  Given the
+    ends, the expectation of what is added to a cell is
+    tau * (1/tau) int_0^tau Prob[(x(s), v(s)) in cell | ends] ds, the
+    expected time in the cell: unbiased, with no discretisation error.  The
+    draws come from their own generator (``tally_seed_sequence``), so the
+    trajectory and every other tally are those of a shard without it.
+  * the flights: for each recorded collision that has an earlier collision
+    (in the recording or in equilibration), the time T since that collision
+    (its count on log bins, sum T, sum T^2), and the pair (outgoing speed u
+    of that earlier collision, return speed |v| at this one) on the speed
+    bins.  A flight is counted at the collision that ends it, so in a
+    stationary shard the expected sum of f(T) over the recorded flights is
+    I x (recorded time) x E[f(T)] with E the equilibrium average per
+    collision (Palm): unbiased, with no edge effect at either end of the
+    recording (docs/methods.md, 'Flights').
 
 A shard's work is bounded: it stops after ``max_steps`` steps (equilibration
 included) even if the simulated time has not been reached, and says so.
@@ -55,6 +76,7 @@ import numpy as np
 
 from . import stages
 from .free_flight import (
+    bridge_sample,
     cubic_level_time,
     cubic_slope,
     cubic_value,
@@ -70,13 +92,23 @@ from .free_flight import (
 )
 from .jit import njit
 from .settings import ShardSettings
-from .tallies import ShardTallies
+from .tallies import ShardTallies, tally_seed_sequence
 
 # the modules whose code decides a shard's numbers (see ``source_digest``)
 SOURCES = stages.SIMULATION
 
 # indices into the scalar tally array of the compiled loop, in the order of tallies.SCALARS
-_TIME, _COLLISIONS, _STEPS, _INT_X, _INT_X2, _EXHAUSTED = range(6)
+(
+    _TIME,
+    _COLLISIONS,
+    _STEPS,
+    _INT_X,
+    _INT_X2,
+    _EXHAUSTED,
+    _FLIGHTS,
+    _FLIGHT_TIME_SUM,
+    _FLIGHT_TIME_SQUARED_SUM,
+) = range(9)
 
 
 def shard_seed_sequence(seed: int, label: str, shard: int) -> np.random.SeedSequence:
@@ -102,6 +134,25 @@ def _bin_index(value, log_lo, per_ln, n, edges):
     if k > n - 1:
         k = n - 1
     # correct a last-digit disagreement between log and the stored edges
+    while k > 0 and value < edges[k]:
+        k -= 1
+    while k < n - 1 and value >= edges[k + 1]:
+        k += 1
+    return k + 1
+
+
+@njit(cache=True)
+def _linear_bin_index(value, lo, per_unit, n, edges):
+    """Index of ``value`` in LinearBins (0 underflow, n + 1 overflow)."""
+    if value < edges[0]:
+        return 0
+    if value >= edges[n]:
+        return n + 1
+    k = int((value - lo) * per_unit)
+    if k < 0:
+        k = 0
+    if k > n - 1:
+        k = n - 1
     while k > 0 and value < edges[k]:
         k -= 1
     while k < n - 1 and value >= edges[k + 1]:
@@ -195,6 +246,7 @@ COLLAPSED_STEP = 1.0e-80
 @njit(cache=True)
 def _run(
     rng,
+    rng_tally,
     restitution,
     c,
     min_step_divisor,
@@ -204,17 +256,30 @@ def _run(
     max_steps,
     v_edges,
     x_edges,
+    u_edges,
+    f_edges,
     speed_counts,
     position_time,
     position_v2_time,
+    flight_time_counts,
+    position_velocity_time,
+    return_speed_counts,
     scalars,
 ):
+    # v_edges: speeds (log); x_edges: heights (log); u_edges: velocities of P(x, v) (linear);
+    # f_edges: flight times (log)
     nv = v_edges.shape[0] - 1
     v_log_lo = math.log(v_edges[0])
     v_per_ln = nv / (math.log(v_edges[nv]) - v_log_lo)
     nx = x_edges.shape[0] - 1
     x_log_lo = math.log(x_edges[0])
     x_per_ln = nx / (math.log(x_edges[nx]) - x_log_lo)
+    nu = u_edges.shape[0] - 1
+    u_lo = u_edges[0]
+    u_per_unit = nu / (u_edges[nu] - u_lo)
+    nf = f_edges.shape[0] - 1
+    f_log_lo = math.log(f_edges[0])
+    f_per_ln = nf / (math.log(f_edges[nf]) - f_log_lo)
     # the two ends of every x bin, the under- and overflow bins unbounded
     x_bin_lower = np.empty(nx + 2)
     x_bin_upper = np.empty(nx + 2)
@@ -238,6 +303,12 @@ def _run(
     int_x = 0.0
     int_x2 = 0.0
     exhausted = 0
+    flights = 0
+    flight_time_sum = 0.0
+    flight_time_squared_sum = 0.0
+    since_collision = 0.0  # time since the last collision (equilibration included)
+    collided_before = False
+    last_out_bin = 0  # speed bin of the last collision's outgoing speed
 
     while True:
         if t >= t_stop:
@@ -288,12 +359,37 @@ def _run(
                 position_time,
                 position_v2_time,
             )
+            # P(x, v): tau to the cell of (x(s), v(s)) on the bridge, s uniform in [0, tau]
+            s = rng_tally.random() * tau
+            normal_1 = rng_tally.standard_normal()
+            normal_2 = rng_tally.standard_normal()
+            x_s, v_s = bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2)
+            position_velocity_time[
+                _bin_index(x_s, x_log_lo, x_per_ln, nx, x_edges),
+                _linear_bin_index(v_s, u_lo, u_per_unit, nu, u_edges),
+            ] += tau
         t += tau
+        since_collision += tau
         if collided:
-            v_out = restitution * abs(v_tau)  # eq. (restitution)
+            v_in = abs(v_tau)
+            v_out = restitution * v_in  # eq. (restitution)
+            out_bin = _bin_index(v_out, v_log_lo, v_per_ln, nv, v_edges)
             if recording:
                 collisions += 1
-                speed_counts[_bin_index(v_out, v_log_lo, v_per_ln, nv, v_edges)] += 1
+                speed_counts[out_bin] += 1
+                if collided_before:  # the flight that ends here
+                    flights += 1
+                    flight_time_sum += since_collision
+                    flight_time_squared_sum += since_collision * since_collision
+                    flight_time_counts[
+                        _bin_index(since_collision, f_log_lo, f_per_ln, nf, f_edges)
+                    ] += 1
+                    return_speed_counts[
+                        last_out_bin, _bin_index(v_in, v_log_lo, v_per_ln, nv, v_edges)
+                    ] += 1
+            collided_before = True
+            since_collision = 0.0
+            last_out_bin = out_bin
             x = 0.0
             x_bin = 0
             v = v_out
@@ -309,6 +405,9 @@ def _run(
     scalars[_INT_X] = int_x
     scalars[_INT_X2] = int_x2
     scalars[_EXHAUSTED] = exhausted
+    scalars[_FLIGHTS] = flights
+    scalars[_FLIGHT_TIME_SUM] = flight_time_sum
+    scalars[_FLIGHT_TIME_SQUARED_SUM] = flight_time_squared_sum
 
 
 def simulate_shard(
@@ -321,13 +420,12 @@ def simulate_shard(
     """
     if not 0.0 < restitution < 1.0:
         raise ValueError(f"restitution must lie in (0, 1), got {restitution}")
-    speed_bins, position_bins = settings.speed_bins, settings.position_bins
     rng = np.random.Generator(np.random.PCG64(seed_sequence))
-    speed_counts, position_time, position_v2_time, scalars = ShardTallies.loop_arrays(
-        speed_bins, position_bins
-    )
+    rng_tally = np.random.Generator(np.random.PCG64(tally_seed_sequence(seed_sequence)))
+    arrays = ShardTallies.loop_arrays(settings)
     _run(
         rng,
+        rng_tally,
         float(restitution),
         settings.criterion_c,
         settings.min_step_divisor,
@@ -335,13 +433,16 @@ def simulate_shard(
         settings.equilibration_time,
         settings.shard_time,
         settings.max_steps,
-        speed_bins.edges,
-        position_bins.edges,
-        speed_counts,
-        position_time,
-        position_v2_time,
-        scalars,
+        settings.speed_bins.edges,
+        settings.position_bins.edges,
+        settings.velocity_bins.edges,
+        settings.flight_time_bins.edges,
+        arrays["speed_counts"],
+        arrays["position_time"],
+        arrays["position_v2_time"],
+        arrays["flight_time_counts"],
+        arrays["position_velocity_time"],
+        arrays["return_speed_counts"],
+        arrays["scalars"],
     )
-    return ShardTallies.from_loop(
-        speed_bins, position_bins, speed_counts, position_time, position_v2_time, scalars
-    )
+    return ShardTallies.from_loop(settings, arrays)

@@ -2,14 +2,21 @@
 
 A shard is stored as one long table, a row per tally entry:
 
-    tally               lo     hi     value
-    outgoing_speed      v_lo   v_hi   collisions with v_out in [v_lo, v_hi)
-    position_time       x_lo   x_hi   time spent with x in [x_lo, x_hi)
-    position_v2_time    x_lo   x_hi   int v^2 dt over that time
-    time, collisions, steps, int_x, int_x2, budget_exhausted
-                        NaN    NaN    the scalar
+    tally                   lo     hi     lo2    hi2    value
+    outgoing_speed          v_lo   v_hi   NaN    NaN    collisions with v_out in [v_lo, v_hi)
+    position_time           x_lo   x_hi   NaN    NaN    time spent with x in [x_lo, x_hi)
+    position_v2_time        x_lo   x_hi   NaN    NaN    int v^2 dt over that time
+    flight_time             t_lo   t_hi   NaN    NaN    flights with duration in [t_lo, t_hi)
+    position_velocity_time  x_lo   x_hi   v_lo   v_hi   time spent in that cell of (x, v)
+    return_speed            u_lo   u_hi   v_lo   v_hi   flights leaving the floor at speed u
+                                                        and returning at speed v in the cell
+    time, collisions, steps, int_x, int_x2, budget_exhausted,
+    flights, flight_time_sum, flight_time_squared_sum
+                            NaN    NaN    NaN    NaN    the scalar
 
-Every entry is additive over shards, so merging is a sum.
+A 2-D tally's rows run over its second variable fastest (row-major, the first
+variable's bins on the outer loop), each variable with its under- and
+overflow bins.  Every entry is additive over shards, so merging is a sum.
 """
 
 from dataclasses import dataclass, fields, replace
@@ -17,67 +24,104 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 import pandas as pd
 
-from .bins import LogBins
+from .bins import LinearBins, LogBins
 
+# name in the table: (the bins' attribute, the values' attribute, integer counts?)
 HISTOGRAMS = {
-    "outgoing_speed": ("speed_bins", "speed_counts"),
-    "position_time": ("position_bins", "position_time"),
-    "position_v2_time": ("position_bins", "position_v2_time"),
+    "outgoing_speed": ("speed_bins", "speed_counts", True),
+    "position_time": ("position_bins", "position_time", False),
+    "position_v2_time": ("position_bins", "position_v2_time", False),
+    "flight_time": ("flight_time_bins", "flight_time_counts", True),
 }
-SCALARS = ("time", "collisions", "steps", "int_x", "int_x2", "budget_exhausted")
-_INTEGER = ("collisions", "steps", "budget_exhausted")
+# name in the table: ((the bins of the first and of the second variable), values, integer?)
+HISTOGRAMS_2D = {
+    "position_velocity_time": (("position_bins", "velocity_bins"), "position_velocity_time", False),
+    "return_speed": (("speed_bins", "speed_bins"), "return_speed_counts", True),
+}
+SCALARS = (
+    "time",
+    "collisions",
+    "steps",
+    "int_x",
+    "int_x2",
+    "budget_exhausted",
+    "flights",
+    "flight_time_sum",
+    "flight_time_squared_sum",
+)
+_INTEGER = ("collisions", "steps", "budget_exhausted", "flights")
+BINS = ("speed_bins", "position_bins", "velocity_bins", "flight_time_bins")
+
+
+def tally_seed_sequence(seed_sequence: np.random.SeedSequence) -> np.random.SeedSequence:
+    """The stream of the P(x, v) draws of a shard (``simulation.simulate_shard``): the first
+    child of its stream, made without ``spawn`` (which would change the parent's state)."""
+    return np.random.SeedSequence(
+        entropy=seed_sequence.entropy,
+        spawn_key=(*seed_sequence.spawn_key, 0),
+        pool_size=seed_sequence.pool_size,
+    )
 
 
 @dataclass(frozen=True)
 class ShardTallies:
     speed_bins: LogBins
     position_bins: LogBins
-    speed_counts: np.ndarray
-    position_time: np.ndarray
-    position_v2_time: np.ndarray
+    velocity_bins: LinearBins
+    flight_time_bins: LogBins
+    speed_counts: np.ndarray  # outgoing speeds of the recorded collisions
+    position_time: np.ndarray  # time per x bin (along the mean path)
+    position_v2_time: np.ndarray  # int v^2 dt per x bin
+    flight_time_counts: np.ndarray  # durations of the recorded flights
+    position_velocity_time: np.ndarray  # (x bins, v bins): time per cell (sampled on the bridge)
+    return_speed_counts: np.ndarray  # (u bins, v bins): outgoing speed u, return speed v
     time: float
     collisions: int
     steps: int
     int_x: float
     int_x2: float
     budget_exhausted: int  # number of shards that ran out of their step budget
+    flights: int  # flights recorded: one per recorded collision with an earlier collision
+    flight_time_sum: float  # sum of their durations T
+    flight_time_squared_sum: float  # sum of T^2
 
     @staticmethod
-    def loop_arrays(speed_bins, position_bins):
-        """Zeroed arrays a compiled shard loop fills: speed counts, time and int v^2 dt per x bin
-        (each with under- and overflow), and the scalars in the order of ``SCALARS``."""
-        return (
-            np.zeros(speed_bins.n + 2, dtype=np.int64),
-            np.zeros(position_bins.n + 2),
-            np.zeros(position_bins.n + 2),
-            np.zeros(len(SCALARS)),
-        )
+    def loop_arrays(settings) -> dict:
+        """Zeroed arrays a compiled shard loop fills, by field name, each histogram with under-
+        and overflow bins, and ``scalars`` in the order of ``SCALARS``.  ``settings``: anything
+        with the four bins of ``BINS`` (a ``settings.ShardSettings``)."""
+        arrays = {}
+        for bins_attr, values_attr, integer in HISTOGRAMS.values():
+            arrays[values_attr] = np.zeros(
+                getattr(settings, bins_attr).n + 2, dtype=np.int64 if integer else np.float64
+            )
+        for (first, second), values_attr, integer in HISTOGRAMS_2D.values():
+            shape = (getattr(settings, first).n + 2, getattr(settings, second).n + 2)
+            arrays[values_attr] = np.zeros(shape, dtype=np.int64 if integer else np.float64)
+        arrays["scalars"] = np.zeros(len(SCALARS))
+        return arrays
 
     @classmethod
-    def from_loop(
-        cls, speed_bins, position_bins, speed_counts, position_time, position_v2_time, scalars
-    ):
-        """The tallies of a compiled shard loop: its three histograms and its scalar array,
-        ordered as ``SCALARS`` (the numba loop and its C reference both fill them so)."""
-        values = dict(zip(SCALARS, scalars))
+    def from_loop(cls, settings, arrays: dict) -> "ShardTallies":
+        """The tallies of a compiled shard loop: the arrays of ``loop_arrays`` after the loop
+        (the numba loop and its C reference both fill them so)."""
+        values = dict(zip(SCALARS, arrays["scalars"]))
         for name in _INTEGER:
             values[name] = int(values[name])
+        histograms = {name: array for name, array in arrays.items() if name != "scalars"}
         return cls(
-            speed_bins=speed_bins,
-            position_bins=position_bins,
-            speed_counts=speed_counts,
-            position_time=position_time,
-            position_v2_time=position_v2_time,
+            **{name: getattr(settings, name) for name in BINS},
+            **histograms,
             **values,
         )
 
     def __add__(self, other: "ShardTallies") -> "ShardTallies":
-        if (self.speed_bins, self.position_bins) != (other.speed_bins, other.position_bins):
+        if any(getattr(self, name) != getattr(other, name) for name in BINS):
             raise ValueError("cannot merge shards recorded on different bins")
         summed = {
             f.name: getattr(self, f.name) + getattr(other, f.name)
             for f in fields(self)
-            if f.name not in ("speed_bins", "position_bins")
+            if f.name not in BINS
         }
         return replace(self, **summed)
 
@@ -95,7 +139,7 @@ def merge_shards(shards) -> ShardTallies:
 
 def tallies_to_frame(tallies: ShardTallies) -> pd.DataFrame:
     parts = []
-    for name, (bins_attr, values_attr) in HISTOGRAMS.items():
+    for name, (bins_attr, values_attr, _) in HISTOGRAMS.items():
         bins = getattr(tallies, bins_attr)
         parts.append(
             pd.DataFrame(
@@ -103,7 +147,24 @@ def tallies_to_frame(tallies: ShardTallies) -> pd.DataFrame:
                     "tally": name,
                     "lo": bins.lower,
                     "hi": bins.upper,
+                    "lo2": np.nan,
+                    "hi2": np.nan,
                     "value": np.asarray(getattr(tallies, values_attr), dtype=float),
+                }
+            )
+        )
+    for name, ((first, second), values_attr, _) in HISTOGRAMS_2D.items():
+        outer, inner = getattr(tallies, first), getattr(tallies, second)
+        n_inner = inner.n + 2
+        parts.append(
+            pd.DataFrame(
+                {
+                    "tally": name,
+                    "lo": np.repeat(outer.lower, n_inner),
+                    "hi": np.repeat(outer.upper, n_inner),
+                    "lo2": np.tile(inner.lower, outer.n + 2),
+                    "hi2": np.tile(inner.upper, outer.n + 2),
+                    "value": np.asarray(getattr(tallies, values_attr), dtype=float).ravel(),
                 }
             )
         )
@@ -113,6 +174,8 @@ def tallies_to_frame(tallies: ShardTallies) -> pd.DataFrame:
                 "tally": list(SCALARS),
                 "lo": np.nan,
                 "hi": np.nan,
+                "lo2": np.nan,
+                "hi2": np.nan,
                 "value": [float(getattr(tallies, s)) for s in SCALARS],
             }
         )
@@ -120,29 +183,46 @@ def tallies_to_frame(tallies: ShardTallies) -> pd.DataFrame:
     return pd.concat(parts, ignore_index=True)
 
 
-def tallies_from_frame(
-    frame: pd.DataFrame, speed_bins: LogBins, position_bins: LogBins, source: str = "shard"
-) -> ShardTallies:
-    """Inverse of ``tallies_to_frame``; checks that the bins are the expected ones."""
-    missing = {"tally", "lo", "hi", "value"} - set(frame.columns)
+def _on_bins(rows, column, expected):
+    values = rows[column].to_numpy()
+    return len(values) == len(expected) and np.allclose(values, expected, equal_nan=True)
+
+
+def tallies_from_frame(frame: pd.DataFrame, settings, source: str = "shard") -> ShardTallies:
+    """Inverse of ``tallies_to_frame``; checks that the bins are those of ``settings``
+    (anything with the four bins of ``BINS``, e.g. a ``settings.ShardSettings``)."""
+    missing = {"tally", "lo", "hi", "lo2", "hi2", "value"} - set(frame.columns)
     if missing:
         raise ValueError(f"{source}: missing columns {sorted(missing)}")
-    values = {}
-    bins_of = {"speed_bins": speed_bins, "position_bins": position_bins}
-    for name, (bins_attr, values_attr) in HISTOGRAMS.items():
+    values = {name: getattr(settings, name) for name in BINS}
+    for name, (bins_attr, values_attr, integer) in HISTOGRAMS.items():
         rows = frame[frame["tally"] == name]
-        bins = bins_of[bins_attr]
-        if len(rows) != bins.n + 2 or not np.allclose(rows["lo"].to_numpy(), bins.lower):
+        bins = getattr(settings, bins_attr)
+        if not _on_bins(rows, "lo", bins.lower):
             raise ValueError(
                 f"{source}: tally '{name}' is not on the configured bins "
                 f"({len(rows)} rows, expected {bins.n + 2}); re-run the shard"
             )
         column = rows["value"].to_numpy()
-        values[values_attr] = column.astype(np.int64) if name == "outgoing_speed" else column
+        values[values_attr] = column.astype(np.int64) if integer else column
+    for name, ((first, second), values_attr, integer) in HISTOGRAMS_2D.items():
+        rows = frame[frame["tally"] == name]
+        outer, inner = getattr(settings, first), getattr(settings, second)
+        shape = (outer.n + 2, inner.n + 2)
+        if not (
+            _on_bins(rows, "lo", np.repeat(outer.lower, shape[1]))
+            and _on_bins(rows, "lo2", np.tile(inner.lower, shape[0]))
+        ):
+            raise ValueError(
+                f"{source}: tally '{name}' is not on the configured bins "
+                f"({len(rows)} rows, expected {shape[0] * shape[1]}); re-run the shard"
+            )
+        column = rows["value"].to_numpy().reshape(shape)
+        values[values_attr] = column.astype(np.int64) if integer else column
     for name in SCALARS:
         rows = frame.loc[frame["tally"] == name, "value"]
         if len(rows) != 1:
             raise ValueError(f"{source}: expected one '{name}' row, found {len(rows)}")
         value = float(rows.iloc[0])
         values[name] = int(value) if name in _INTEGER else value
-    return ShardTallies(speed_bins=speed_bins, position_bins=position_bins, **values)
+    return ShardTallies(**values)

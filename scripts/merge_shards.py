@@ -1,12 +1,17 @@
-"""Rule merge_shards: the shards of one r merged into P(0, v), P(x) and <v^2>_x, and the
-summary (<x>, Delta x, I) -> results/simulation/r{r}/{p0v,position,summary}.parquet."""
+"""Rule merge_shards: the shards of one r merged into P(0, v), P(x) and <v^2>_x, P(x, v), the
+flight-time density, the return speeds, and the summary (<x>, Delta x, I, the flight-time
+moments) -> results/simulation/r{r}/{p0v,position,distribution,flight_time,return_speed,
+summary}.parquet."""
 
 import logging
 
 from bouncing_ball.histograms import (
+    distribution_histogram,
+    flight_time_histogram,
     outgoing_speed_histogram,
     position_histogram,
     position_moments_summary,
+    return_speed_table,
 )
 from bouncing_ball.io import write_tables
 from bouncing_ball.jobs import job_log
@@ -33,13 +38,17 @@ with job_log(snakemake.log[0]):
         {
             snakemake.output.p0v: outgoing_speed_histogram(shards),
             snakemake.output.position: position_histogram(shards),
+            snakemake.output.distribution: distribution_histogram(shards),
+            snakemake.output.flight_time: flight_time_histogram(shards),
+            snakemake.output.return_speed: return_speed_table(shards),
             snakemake.output.summary: summary,
         },
         provenance,
     )
     row = summary.iloc[0]
     logging.info(
-        "r=%s: %d shards, time %.6g, <x> = %.5g +- %.2g, Delta x = %.5g +- %.2g, I = %.5g +- %.2g",
+        "r=%s: %d shards, time %.6g, <x> = %.5g +- %.2g, Delta x = %.5g +- %.2g, I = %.5g +- %.2g, "
+        "mean flight time %.5g +- %.2g",
         label,
         len(shards),
         row.total_time,
@@ -49,6 +58,8 @@ with job_log(snakemake.log[0]):
         row.delta_x_err,
         row.collision_rate,
         row.collision_rate_err,
+        row.mean_flight_time,
+        row.mean_flight_time_err,
     )
     if row.shards_out_of_budget:
         logging.warning(

@@ -7,8 +7,10 @@
  *   bouncing_ball/free_flight.py: free_flight_step, largest_safe_step,
  *       hermite_cubic, cubic_value, cubic_slope, mean_path_integrals,
  *       speed_squared_coefficients, quintic_antiderivative_value,
- *       cubic_level_time, slope_zeros, monotone_piece_end, first_crossing_time
- *   bouncing_ball/simulation.py: _bin_index, _tally_position, _tally_step, _run
+ *       cubic_level_time, slope_zeros, monotone_piece_end, first_crossing_time,
+ *       bridge_sample
+ *   bouncing_ball/simulation.py: _bin_index, _linear_bin_index, _tally_position,
+ *       _tally_step, _run
  *
  * (translated from the committed versions of those files).  Every floating-point
  * operation is the same as in the Python source and in the same order (same
@@ -19,7 +21,9 @@
  * own C generator, ``random_standard_normal`` of libnpyrandom.a, called on the
  * bit generator that Python passes in (``np.random.PCG64(seed).ctypes.bit_generator``),
  * i.e. the same ziggurat that numba's ``Generator.standard_normal`` ports, on
- * the same stream.
+ * the same stream.  The P(x, v) draws (a uniform and two normals per recorded step)
+ * come likewise from a second bit generator, ``simulation.tally_seed_sequence``'s,
+ * with numpy's ``random_standard_uniform`` (= numba's ``Generator.random``).
  *
  * What it is for: the yardstick of the performance target "the numba simulation
  * runs at >= 90 % of the speed of a plain C implementation of the same loop
@@ -49,6 +53,9 @@
 /* free_flight.py constants */
 #define SQRT3 0x1.bb67ae8584caap+0    /* math.sqrt(3.0) */
 #define SQRT1_12 0x1.279a74590331cp-2 /* math.sqrt(1.0 / 12.0) */
+#define SQRT2_3 0x1.a20bd700c2c3ep-1  /* math.sqrt(2.0 / 3.0) */
+#define SQRT3_2 0x1.3988e1409212ep+0  /* math.sqrt(1.5) */
+#define SQRT1_2 0x1.6a09e667f3bcdp-1  /* math.sqrt(0.5) */
 #define FIT_P 0.44356066
 #define FIT_Q 0.56163652
 #define FIT_N1 0.40104058
@@ -58,7 +65,17 @@
 
 /* simulation.py */
 #define COLLAPSED_STEP 1.0e-80
-enum { TIME, COLLISIONS, STEPS, INT_X, INT_X2, EXHAUSTED };
+enum {
+    TIME,
+    COLLISIONS,
+    STEPS,
+    INT_X,
+    INT_X2,
+    EXHAUSTED,
+    FLIGHTS,
+    FLIGHT_TIME_SUM,
+    FLIGHT_TIME_SQUARED_SUM
+};
 
 /* Python's min(a, b) and max(a, b) on floats, as numba compiles them */
 static inline double py_min(double a, double b) { return b < a ? b : a; }
@@ -298,7 +315,38 @@ static inline double first_crossing_time(double a0, double a1, double a2, double
     return t_end;
 }
 
+static inline void bridge_sample(double a0, double a1, double a2, double a3, double dt,
+                                 double t, double normal_1, double normal_2, double *x_out,
+                                 double *v_out)
+{
+    double u = t * (1.0 / dt);
+    double w = py_max(u * (1.0 - u), 0.0); /* u may exceed 1 by a rounding error at t = dt */
+    double root = sqrt(dt * w);
+    *x_out = cubic_value(a0, a1, a2, a3, t) + SQRT2_3 * dt * w * root * normal_1;
+    *v_out = cubic_slope(a1, a2, a3, t)
+             + root * (SQRT3_2 * (1.0 - 2.0 * u) * normal_1 + SQRT1_2 * normal_2);
+}
+
 /* ---------------------------------------------------------------- simulation.py */
+
+static inline int64_t linear_bin_index(double value, double lo, double per_unit, int64_t n,
+                                       const double *edges)
+{
+    if (value < edges[0])
+        return 0;
+    if (value >= edges[n])
+        return n + 1;
+    int64_t k = (int64_t)((value - lo) * per_unit);
+    if (k < 0)
+        k = 0;
+    if (k > n - 1)
+        k = n - 1;
+    while (k > 0 && value < edges[k])
+        k -= 1;
+    while (k < n - 1 && value >= edges[k + 1])
+        k += 1;
+    return k + 1;
+}
 
 static inline int64_t bin_index(double value, double log_lo, double per_ln, int64_t n,
                                 const double *edges)
@@ -397,20 +445,31 @@ static inline int64_t tally_step(double a0, double a1, double a2, double a3, dou
 }
 
 /*
- * _run.  v_edges has nv + 1 entries, x_edges nx + 1; speed_counts, position_time and
- * position_v2_time have nv + 2, nx + 2 and nx + 2 entries (zeroed by the caller);
- * scalars has 6.  Returns 0, or -1 if the two small bin-bound arrays cannot be allocated.
+ * _run.  v_edges (speeds) has nv + 1 entries, x_edges nx + 1, u_edges (velocities of
+ * P(x, v)) nu + 1, f_edges (flight times) nf + 1; speed_counts, position_time,
+ * position_v2_time and flight_time_counts have nv + 2, nx + 2, nx + 2 and nf + 2 entries,
+ * position_velocity_time (nx + 2) x (nu + 2) and return_speed_counts (nv + 2) x (nv + 2),
+ * row-major (all zeroed by the caller); scalars has 9.  Returns 0, or -1 if the two small
+ * bin-bound arrays cannot be allocated.
  */
-int bouncing_ball_shard_loop(bitgen_t *rng, double restitution, double c, double min_step_divisor,
-                             double min_step_floor, double equilibration_time,
-                             double recorded_time, int64_t max_steps, const double *v_edges,
-                             int64_t nv, const double *x_edges, int64_t nx, int64_t *speed_counts,
-                             double *position_time, double *position_v2_time, double *scalars)
+int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitution, double c,
+                             double min_step_divisor, double min_step_floor,
+                             double equilibration_time, double recorded_time, int64_t max_steps,
+                             const double *v_edges, int64_t nv, const double *x_edges, int64_t nx,
+                             const double *u_edges, int64_t nu, const double *f_edges, int64_t nf,
+                             int64_t *speed_counts, double *position_time,
+                             double *position_v2_time, int64_t *flight_time_counts,
+                             double *position_velocity_time, int64_t *return_speed_counts,
+                             double *scalars)
 {
     double v_log_lo = log(v_edges[0]);
     double v_per_ln = (double)nv / (log(v_edges[nv]) - v_log_lo);
     double x_log_lo = log(x_edges[0]);
     double x_per_ln = (double)nx / (log(x_edges[nx]) - x_log_lo);
+    double u_lo = u_edges[0];
+    double u_per_unit = (double)nu / (u_edges[nu] - u_lo);
+    double f_log_lo = log(f_edges[0]);
+    double f_per_ln = (double)nf / (log(f_edges[nf]) - f_log_lo);
     /* the two ends of every x bin, the under- and overflow bins unbounded */
     double *x_bin_lower = malloc((size_t)(nx + 2) * sizeof(double));
     double *x_bin_upper = malloc((size_t)(nx + 2) * sizeof(double));
@@ -441,6 +500,12 @@ int bouncing_ball_shard_loop(bitgen_t *rng, double restitution, double c, double
     double int_x = 0.0;
     double int_x2 = 0.0;
     int64_t exhausted = 0;
+    int64_t flights = 0;
+    double flight_time_sum = 0.0;
+    double flight_time_squared_sum = 0.0;
+    double since_collision = 0.0; /* time since the last collision (equilibration included) */
+    int collided_before = 0;
+    int64_t last_out_bin = 0; /* speed bin of the last collision's outgoing speed */
 
     for (;;) {
         if (t >= t_stop) {
@@ -489,14 +554,37 @@ int bouncing_ball_shard_loop(bitgen_t *rng, double restitution, double c, double
             int_x2 += ix2;
             x_bin = tally_step(a0, a1, a2, a3, dt, tau, x_tau, v_tau, x_bin, x_edges, nx,
                                x_bin_lower, x_bin_upper, position_time, position_v2_time);
+            /* P(x, v): tau to the cell of (x(s), v(s)) on the bridge, s uniform in [0, tau] */
+            double s = random_standard_uniform(rng_tally) * tau;
+            double normal_1 = random_standard_normal(rng_tally);
+            double normal_2 = random_standard_normal(rng_tally);
+            double x_s, v_s;
+            bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2, &x_s, &v_s);
+            int64_t cell_x = bin_index(x_s, x_log_lo, x_per_ln, nx, x_edges);
+            int64_t cell_v = linear_bin_index(v_s, u_lo, u_per_unit, nu, u_edges);
+            position_velocity_time[cell_x * (nu + 2) + cell_v] += tau;
         }
         t += tau;
+        since_collision += tau;
         if (collided) {
-            double v_out = restitution * fabs(v_tau); /* eq. (restitution) */
+            double v_in = fabs(v_tau);
+            double v_out = restitution * v_in; /* eq. (restitution) */
+            int64_t out_bin = bin_index(v_out, v_log_lo, v_per_ln, nv, v_edges);
             if (recording) {
                 collisions += 1;
-                speed_counts[bin_index(v_out, v_log_lo, v_per_ln, nv, v_edges)] += 1;
+                speed_counts[out_bin] += 1;
+                if (collided_before) { /* the flight that ends here */
+                    flights += 1;
+                    flight_time_sum += since_collision;
+                    flight_time_squared_sum += since_collision * since_collision;
+                    flight_time_counts[bin_index(since_collision, f_log_lo, f_per_ln, nf, f_edges)] += 1;
+                    return_speed_counts[last_out_bin * (nv + 2)
+                                        + bin_index(v_in, v_log_lo, v_per_ln, nv, v_edges)] += 1;
+                }
             }
+            collided_before = 1;
+            since_collision = 0.0;
+            last_out_bin = out_bin;
             x = 0.0;
             x_bin = 0;
             v = v_out;
@@ -514,6 +602,9 @@ int bouncing_ball_shard_loop(bitgen_t *rng, double restitution, double c, double
     scalars[INT_X] = int_x;
     scalars[INT_X2] = int_x2;
     scalars[EXHAUSTED] = (double)exhausted;
+    scalars[FLIGHTS] = (double)flights;
+    scalars[FLIGHT_TIME_SUM] = flight_time_sum;
+    scalars[FLIGHT_TIME_SQUARED_SUM] = flight_time_squared_sum;
     free(x_bin_lower);
     free(x_bin_upper);
     return 0;

@@ -18,20 +18,23 @@ CRITERION_C = DEFAULT_SETTINGS.criterion_c
 
 
 def _shard(arguments):
-    r, shard, recorded_time, seed, floor, criterion_c = arguments
+    r, shard, recorded_time, seed, floor, criterion_c, changes = arguments
     settings = DEFAULT_SETTINGS.replace(
-        shard_time=recorded_time, criterion_c=criterion_c, min_step_floor=floor
+        shard_time=recorded_time, criterion_c=criterion_c, min_step_floor=floor, **changes
     )
     return simulate_shard(
         float(r), shard_seed_sequence(seed, restitution_label(r), shard), settings
     )
 
 
-def simulate_shards(shard_times, shards, seed, min_step_floor=0.0, criterion_c=CRITERION_C):
+def simulate_shards(
+    shard_times, shards, seed, min_step_floor=0.0, criterion_c=CRITERION_C, **changes
+):
     """{r: [ShardTallies]} for {r: recorded time per shard}, two processes, the default config's c
-    (or ``criterion_c``) and delta rule (with a floor on delta if ``min_step_floor`` > 0)."""
+    (or ``criterion_c``) and delta rule (with a floor on delta if ``min_step_floor`` > 0), and
+    the default config's other settings but ``changes`` (e.g. velocity_bins)."""
     jobs = [
-        (r, k, time, seed, min_step_floor, criterion_c)
+        (r, k, time, seed, min_step_floor, criterion_c, changes)
         for r, time in shard_times.items()
         for k in range(shards)
     ]

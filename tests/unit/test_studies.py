@@ -2,7 +2,9 @@
 (bouncing_ball.config.study_runs)."""
 
 import copy
+from dataclasses import replace
 from fractions import Fraction
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -10,7 +12,7 @@ import yaml
 from workflow_support import REPOSITORY, SMALL
 
 from bouncing_ball import studies
-from bouncing_ball.bins import LogBins
+from bouncing_ball.bins import LinearBins, LogBins
 from bouncing_ball.config import shard_settings, study_runs
 from bouncing_ball.tallies import ShardTallies
 
@@ -18,20 +20,17 @@ BINS = LogBins(1.0, 10.0, 1)
 STUDIES = yaml.safe_load((REPOSITORY / "config" / "studies.yaml").read_text())
 
 
+BIN_SET = SimpleNamespace(
+    speed_bins=BINS,
+    position_bins=BINS,
+    velocity_bins=LinearBins(-1.0, 1.0, 1.0),
+    flight_time_bins=BINS,
+)
+
+
 def shard(collisions, int_x=1.0, int_x2=2.0, time=1.0):
-    return ShardTallies(
-        BINS,
-        BINS,
-        np.zeros(3, np.int64),
-        np.zeros(3),
-        np.zeros(3),
-        time,
-        collisions,
-        0,
-        int_x,
-        int_x2,
-        0,
-    )
+    empty = ShardTallies.from_loop(BIN_SET, ShardTallies.loop_arrays(BIN_SET))
+    return replace(empty, time=time, collisions=collisions, int_x=int_x, int_x2=int_x2)
 
 
 def test_batch_errors_are_the_scatter_of_batch_means_against_the_single_shard_jackknife():

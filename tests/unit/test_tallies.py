@@ -1,12 +1,23 @@
 """Merging shards is a sum; shards survive a round trip through Parquet."""
 
+from dataclasses import replace
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from bouncing_ball.bins import LogBins
-from bouncing_ball.histograms import jackknife, outgoing_speed_histogram
+from benchmarks import reference_loop
+from bouncing_ball.bins import LinearBins, LogBins
+from bouncing_ball.histograms import (
+    distribution_histogram,
+    flight_time_histogram,
+    jackknife,
+    outgoing_speed_histogram,
+    position_moments_summary,
+    return_speed_table,
+)
 from bouncing_ball.io import UnreadableFileError, read_table, write_table
 from bouncing_ball.shards import read_shards
 from bouncing_ball.tallies import (
@@ -18,25 +29,48 @@ from bouncing_ball.tallies import (
 
 SPEED_BINS = LogBins(1e-2, 1e1, 2)
 POSITION_BINS = LogBins(1e-1, 1e2, 1)
+VELOCITY_BINS = LinearBins(-1.0, 2.0, 1.0)
+FLIGHT_TIME_BINS = LogBins(1e-2, 1e1, 1)
+BIN_SET = SimpleNamespace(
+    speed_bins=SPEED_BINS,
+    position_bins=POSITION_BINS,
+    velocity_bins=VELOCITY_BINS,
+    flight_time_bins=FLIGHT_TIME_BINS,
+)
+
+
+def _shard(**changes):
+    """A shard on BIN_SET with nothing recorded, ``changes`` applied."""
+    return replace(ShardTallies.from_loop(BIN_SET, ShardTallies.loop_arrays(BIN_SET)), **changes)
 
 
 @st.composite
 def shard_tallies(draw):
     nv, nx = SPEED_BINS.n + 2, POSITION_BINS.n + 2
+    nu, nf = VELOCITY_BINS.n + 2, FLIGHT_TIME_BINS.n + 2
     counts = st.integers(0, 10**6)
     times = st.floats(0.0, 1e6, allow_nan=False)
-    return ShardTallies(
-        speed_bins=SPEED_BINS,
-        position_bins=POSITION_BINS,
-        speed_counts=np.array(draw(st.lists(counts, min_size=nv, max_size=nv)), dtype=np.int64),
-        position_time=np.array(draw(st.lists(times, min_size=nx, max_size=nx))),
-        position_v2_time=np.array(draw(st.lists(times, min_size=nx, max_size=nx))),
+
+    def array(elements, size, dtype=float, shape=None):
+        values = np.array(draw(st.lists(elements, min_size=size, max_size=size)), dtype=dtype)
+        return values.reshape(shape) if shape else values
+
+    return _shard(
+        speed_counts=array(counts, nv, np.int64),
+        position_time=array(times, nx),
+        position_v2_time=array(times, nx),
+        flight_time_counts=array(counts, nf, np.int64),
+        position_velocity_time=array(times, nx * nu, shape=(nx, nu)),
+        return_speed_counts=array(counts, nv * nv, np.int64, shape=(nv, nv)),
         time=draw(st.floats(1.0, 1e6)),
         collisions=draw(counts),
         steps=draw(counts),
         int_x=draw(times),
         int_x2=draw(times),
         budget_exhausted=draw(st.integers(0, 1)),
+        flights=draw(counts),
+        flight_time_sum=draw(times),
+        flight_time_squared_sum=draw(times),
     )
 
 
@@ -55,6 +89,18 @@ def test_merge_is_an_order_independent_sum(shards, random):
     assert merged.budget_exhausted == sum(s.budget_exhausted for s in shards)
     # floating-point sums agree to rounding, in any order
     np.testing.assert_allclose(merged.position_time, again.position_time, rtol=1e-12)
+    # the new tallies are sums too: 2-D ones cell by cell
+    assert np.array_equal(merged.flight_time_counts, sum(s.flight_time_counts for s in shards))
+    assert np.array_equal(merged.return_speed_counts, sum(s.return_speed_counts for s in shards))
+    assert merged.return_speed_counts.shape == (SPEED_BINS.n + 2,) * 2
+    np.testing.assert_allclose(
+        merged.position_velocity_time, sum(s.position_velocity_time for s in shards), rtol=1e-12
+    )
+    assert merged.flights == sum(s.flights for s in shards)
+    assert merged.flight_time_sum == pytest.approx(again.flight_time_sum, rel=1e-12)
+    assert merged.flight_time_squared_sum == pytest.approx(
+        sum(s.flight_time_squared_sum for s in shards), rel=1e-12
+    )
     assert merged.time == pytest.approx(sum(s.time for s in shards), rel=1e-12)
     assert merged.int_x2 == pytest.approx(again.int_x2, rel=1e-12)
 
@@ -62,57 +108,52 @@ def test_merge_is_an_order_independent_sum(shards, random):
 @settings(max_examples=20, deadline=None)
 @given(shard_tallies())
 def test_frame_round_trip(shard):
-    back = tallies_from_frame(tallies_to_frame(shard), SPEED_BINS, POSITION_BINS)
-    assert np.array_equal(back.speed_counts, shard.speed_counts)
-    assert np.array_equal(back.position_time, shard.position_time)
-    assert (back.time, back.collisions, back.int_x) == (shard.time, shard.collisions, shard.int_x)
+    back = tallies_from_frame(tallies_to_frame(shard), BIN_SET)
+    for name in reference_loop.TALLY_FIELDS:  # every field, bit for bit and of the same type
+        ours, theirs = getattr(shard, name), getattr(back, name)
+        if isinstance(ours, np.ndarray):
+            assert ours.dtype == theirs.dtype and np.array_equal(ours, theirs), name
+        else:
+            assert type(ours) is type(theirs) and ours == theirs, name
 
 
 def test_parquet_round_trip_keeps_provenance(tmp_path):
-    shard = ShardTallies(
-        SPEED_BINS,
-        POSITION_BINS,
-        np.arange(SPEED_BINS.n + 2),
-        np.ones(POSITION_BINS.n + 2),
-        np.ones(POSITION_BINS.n + 2),
-        10.0,
-        5,
-        50,
-        1.0,
-        2.0,
-        0,
+    shard = _shard(
+        speed_counts=np.arange(SPEED_BINS.n + 2),
+        position_time=np.ones(POSITION_BINS.n + 2),
+        position_v2_time=np.ones(POSITION_BINS.n + 2),
+        time=10.0,
+        collisions=5,
+        steps=50,
+        int_x=1.0,
+        int_x2=2.0,
     )
     path = tmp_path / "shard0.parquet"
     write_table(tallies_to_frame(shard), path, {"r": "1/3", "seed": 7})
     frame, provenance = read_table(path)
     assert provenance["r"] == "1/3" and provenance["seed"] == 7 and "package_version" in provenance
-    assert np.array_equal(
-        tallies_from_frame(frame, SPEED_BINS, POSITION_BINS).speed_counts, shard.speed_counts
-    )
+    assert np.array_equal(tallies_from_frame(frame, BIN_SET).speed_counts, shard.speed_counts)
     assert [p.name for p in tmp_path.iterdir()] == ["shard0.parquet"]  # no temporary left
 
 
 def _empty_shard():
     """A shard that recorded one time unit and nothing else."""
-    return ShardTallies(
-        SPEED_BINS,
-        POSITION_BINS,
-        np.zeros(SPEED_BINS.n + 2, dtype=np.int64),
-        np.zeros(POSITION_BINS.n + 2),
-        np.zeros(POSITION_BINS.n + 2),
-        1.0,
-        0,
-        0,
-        0.0,
-        0.0,
-        0,
-    )
+    return _shard(time=1.0)
 
 
 def test_shards_on_other_bins_are_refused():
     shard = _empty_shard()
     with pytest.raises(ValueError, match="not on the configured bins"):
-        tallies_from_frame(tallies_to_frame(shard), LogBins(1e-2, 1e1, 3), POSITION_BINS)
+        tallies_from_frame(tallies_to_frame(shard), replace_bins(speed_bins=LogBins(1e-2, 1e1, 3)))
+    # the 2-D tallies are checked on both variables
+    with pytest.raises(ValueError, match="'position_velocity_time' is not on the configured"):
+        tallies_from_frame(
+            tallies_to_frame(shard), replace_bins(velocity_bins=LinearBins(-1.0, 2.0, 0.5))
+        )
+
+
+def replace_bins(**bins):
+    return SimpleNamespace(**{**vars(BIN_SET), **bins})
 
 
 def test_jackknife_of_a_mean_is_the_standard_error():
@@ -126,19 +167,10 @@ def test_jackknife_of_a_mean_is_the_standard_error():
 def test_outgoing_speed_density_counts_rate_over_bin():
     # one shard, 10 collisions in [1, 10) over time 2: p0v = 10 / (2 * (100 - 1) / 2)
     bins = LogBins(1.0, 10.0, 1)
-    shard = ShardTallies(
-        bins,
-        POSITION_BINS,
-        np.array([0, 10, 0]),
-        np.zeros(POSITION_BINS.n + 2),
-        np.zeros(POSITION_BINS.n + 2),
-        2.0,
-        10,
-        100,
-        0.0,
-        0.0,
-        0,
+    shard = ShardTallies.from_loop(
+        replace_bins(speed_bins=bins), ShardTallies.loop_arrays(replace_bins(speed_bins=bins))
     )
+    shard = replace(shard, speed_counts=np.array([0, 10, 0]), time=2.0, collisions=10, steps=100)
     table = outgoing_speed_histogram([shard])
     assert table.p0v.iloc[1] == pytest.approx(10.0 / 99.0)
     assert table["count"].sum() == 10
@@ -169,6 +201,9 @@ def test_the_compiled_loop_fills_its_scalars_in_the_order_of_SCALARS():
         simulation._INT_X,
         simulation._INT_X2,
         simulation._EXHAUSTED,
+        simulation._FLIGHTS,
+        simulation._FLIGHT_TIME_SUM,
+        simulation._FLIGHT_TIME_SQUARED_SUM,
     )
     assert [SCALARS[k] for k in indices] == [
         "time",
@@ -177,6 +212,9 @@ def test_the_compiled_loop_fills_its_scalars_in_the_order_of_SCALARS():
         "int_x",
         "int_x2",
         "budget_exhausted",
+        "flights",
+        "flight_time_sum",
+        "flight_time_squared_sum",
     ]
 
 
@@ -186,3 +224,58 @@ def test_a_single_shard_is_refused_by_every_reader_of_shards(tmp_path):
     write_table(tallies_to_frame(_empty_shard()), path, {"r": "1/2", "r_label": "0.5"})
     with pytest.raises(UnreadableFileError, match=r"r = 0.5: 1 shard .*need two or more"):
         read_shards([path], "0.5")
+
+
+def test_new_merged_tables_on_hand_computed_shards():
+    # two shards of time 2 and 4; P(x, v): 1 time unit in cell (x bin 1, v bin 1) of each
+    cell = np.zeros((POSITION_BINS.n + 2, VELOCITY_BINS.n + 2))
+    cell[1, 1] = 1.0
+    flight_counts = np.zeros(FLIGHT_TIME_BINS.n + 2, dtype=np.int64)
+    flight_counts[2] = 3  # [0.1, 1)
+    returns = np.zeros((SPEED_BINS.n + 2,) * 2, dtype=np.int64)
+    returns[1, 1], returns[1, 2] = 1, 2  # u in [0.01, 0.0316): v there once, one bin up twice
+    shards = [
+        _shard(
+            time=t,
+            position_velocity_time=cell * k,
+            flight_time_counts=flight_counts,
+            return_speed_counts=returns,
+            flights=3,
+            flight_time_sum=s,
+            flight_time_squared_sum=q,
+        )
+        for t, k, s, q in ((2.0, 1.0, 1.5, 1.0), (4.0, 2.0, 1.5, 2.0))
+    ]
+    table = distribution_histogram(shards)
+    assert list(table.columns) == ["x_lo", "x_hi", "v_lo", "v_hi", "pxv", "pxv_err"]
+    assert len(table) == (POSITION_BINS.n + 2) * (VELOCITY_BINS.n + 2)
+    row = table[(table.x_lo == 0.1) & (table.v_lo == -1.0)].iloc[0]
+    # 3 time units of 6 in a cell of 0.9 x 1
+    assert row.pxv == pytest.approx(3.0 / 6.0 / 0.9) and row.x_hi == pytest.approx(1.0)
+    # jackknife of the ratio: leave-one-out 2/4/0.9 and 1/2/0.9 -> sqrt(1/2) * 0
+    assert row.pxv_err == pytest.approx(0.0, abs=1e-15)
+    assert table.pxv[~np.isfinite(table.v_lo)].isna().all()
+    flights = flight_time_histogram(shards)
+    assert list(flights.columns) == ["t_lo", "t_hi", "t", "density", "density_err"]
+    assert flights.density.iloc[2] == pytest.approx(6.0 / 6.0 / 0.9)
+    assert np.isnan(flights.density.iloc[-1])
+    returned = return_speed_table(shards)
+    assert list(returned.columns) == [
+        "u_lo",
+        "u_hi",
+        "v_lo",
+        "v_hi",
+        "probability",
+        "probability_err",
+    ]
+    n = SPEED_BINS.n + 2
+    assert returned.probability.iloc[n + 1] == pytest.approx(1.0 / 3.0)
+    assert returned.probability.iloc[n + 2] == pytest.approx(2.0 / 3.0)
+    assert returned.probability.iloc[:n].isna().all()  # no flight left at those u
+    summary = position_moments_summary(shards, 0.5)
+    assert summary.mean_flight_time.iloc[0] == pytest.approx(3.0 / 6.0)
+    assert summary.flight_time_second_moment.iloc[0] == pytest.approx(3.0 / 6.0)
+    # leave-one-out means 0.5 and 0.5: no scatter
+    assert summary.mean_flight_time_err.iloc[0] == pytest.approx(0.0, abs=1e-15)
+    # leave-one-out second moments 2/3 and 1/3: sqrt(1/2 * 2 * (1/6)^2) = 1/6
+    assert summary.flight_time_second_moment_err.iloc[0] == pytest.approx(1.0 / 6.0)

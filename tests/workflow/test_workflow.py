@@ -285,7 +285,17 @@ def test_adding_an_r_runs_only_its_jobs_and_the_aggregates(finished_run, tmp_pat
         [
             *(
                 f"results/simulation/r0.6/{name}.parquet"
-                for name in ("shard0", "shard1", "shard2", "p0v", "position", "summary")
+                for name in (
+                    "shard0",
+                    "shard1",
+                    "shard2",
+                    "p0v",
+                    "position",
+                    "distribution",
+                    "flight_time",
+                    "return_speed",
+                    "summary",
+                )
             ),
             "results/solver/r0.6/p0v.parquet",
             "results/solver/r0.6/summary.parquet",
@@ -443,7 +453,7 @@ def test_results_do_not_depend_on_cores(finished_run, tmp_path):
         timeout=600,
     )
     assert result.returncode == 0, result.stderr[-3000:]
-    for table in ("p0v", "position", "summary"):
+    for table in ("p0v", "position", "distribution", "flight_time", "return_speed", "summary"):
         one, _ = read_table(directory / f"results/simulation/r0.5/{table}.parquet")
         two, _ = read_table(finished_run / f"results/simulation/r0.5/{table}.parquet")
         pd.testing.assert_frame_equal(one, two, check_exact=True)

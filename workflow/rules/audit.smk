@@ -45,7 +45,7 @@ def stale_simulation():
             "code": code(stages.MERGE, "merge_shards.py"),
             **settings_of(label),
         }
-        for table in ("p0v", "position", "summary"):
+        for table in SIMULATION_TABLES:
             path = f"results/simulation/r{label}/{table}.parquet"
             found = table_differences(path, merged)
             if found:

@@ -86,11 +86,22 @@ def shard_files(wildcards):
     )
 
 
+# the merged tables of each r (rule merge_shards)
+SIMULATION_TABLES = (
+    "p0v",
+    "position",
+    "distribution",
+    "flight_time",
+    "return_speed",
+    "summary",
+)
+
+
 def simulation_targets():
     return expand(
         "results/simulation/r{r}/{table}.parquet",
         r=RESTITUTION,
-        table=("p0v", "position", "summary"),
+        table=SIMULATION_TABLES,
     )
 
 

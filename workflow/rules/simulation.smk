@@ -33,6 +33,9 @@ rule merge_shards:
     output:
         p0v="results/simulation/r{r}/p0v.parquet",
         position="results/simulation/r{r}/position.parquet",
+        distribution="results/simulation/r{r}/distribution.parquet",
+        flight_time="results/simulation/r{r}/flight_time.parquet",
+        return_speed="results/simulation/r{r}/return_speed.parquet",
         summary="results/simulation/r{r}/summary.parquet",
     log:
         "logs/simulation/r{r}/merge.log",
