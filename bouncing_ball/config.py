@@ -177,6 +177,10 @@ def per_restitution(config: dict) -> dict:
     return config["simulation"].get("per_restitution") or {}
 
 
+# the figures with an r list of their own (config["figures"]): each r is simulated for them
+SIMULATED_FIGURES = ("fig4", "fig5", "fig8", "fig10", "fig11")
+
+
 def figure_restitutions(config: dict, grid: dict | None = None) -> dict[str, Fraction]:
     """{label: exact r} of the panels of Figs. 4 and 5 (config["figures"]).
 
@@ -186,7 +190,7 @@ def figure_restitutions(config: dict, grid: dict | None = None) -> dict[str, Fra
     """
     grid = restitution_grid(config["restitution"]) if grid is None else grid
     shown = {}
-    for figure in ("fig4", "fig5"):
+    for figure in SIMULATED_FIGURES:
         values = config["figures"][figure]
         for index, (label, value) in enumerate(
             restitution_grid(values, f"figures.{figure}").items()
@@ -196,7 +200,7 @@ def figure_restitutions(config: dict, grid: dict | None = None) -> dict[str, Fra
                 raise ValueError(
                     f"{where}: r = {values[index]!r} has no exact solution (only 1/2 and 1/3)"
                 )
-            if figure == "fig4":  # drawn with the solver's P(0, v)
+            if figure != "fig5":  # drawn with the solver's answers
                 check_solver_restitution(values[index], where)
             for other in (grid, shown):
                 if label in other and other[label] != value:

@@ -562,6 +562,25 @@ def flight_time_table(solution, times):
     )
 
 
+def return_speed_table(solution, speed_bins):
+    """The return-speed law on a simulation's speed bins (``bins.LogBins``): u_lo, u_hi, v_lo,
+    v_hi, probability (``return_speed_bin_probabilities`` with the solver's P(0, u)), for
+    every finite u-bin and every v-bin (under- and overflow included)."""
+    u_lo, u_hi = speed_bins.edges[:-1], speed_bins.edges[1:]
+    v_lo, v_hi = speed_bins.lower, speed_bins.upper
+    cells = return_speed_bin_probabilities(solution.outgoing_speed_density, u_lo, u_hi, v_lo, v_hi)
+    rows, columns = np.indices(cells.shape)
+    return pd.DataFrame(
+        {
+            "u_lo": u_lo[rows.ravel()],
+            "u_hi": u_hi[rows.ravel()],
+            "v_lo": v_lo[columns.ravel()],
+            "v_hi": v_hi[columns.ravel()],
+            "probability": cells.ravel(),
+        }
+    )
+
+
 def _log_gauss(lower, upper):
     """16-point Gauss-Legendre in ln x on each finite bin: nodes (bins x 16) and weights for dx."""
     lower = np.asarray(lower, dtype=float)[:, None]

@@ -119,7 +119,29 @@ SIMULATED_SUMMARY = TableKind(
     "merge_shards",
     (*_SUMMARY, "mean_x_err", "delta_x_err", "collision_rate_err"),
 )
+SIMULATED_DISTRIBUTION = TableKind(
+    "simulated P(x,v)", "merge_shards", ("x_lo", "x_hi", "v_lo", "v_hi", "pxv", "pxv_err")
+)
+SIMULATED_FLIGHT_TIME = TableKind(
+    "simulated flight-time", "merge_shards", ("t_lo", "t_hi", "t", "density", "density_err")
+)
+SIMULATED_RETURN_SPEED = TableKind(
+    "simulated return-speed",
+    "merge_shards",
+    ("u_lo", "u_hi", "v_lo", "v_hi", "probability", "probability_err"),
+)
 SOLVER_P0V = TableKind("solver P(0,v)", "solve", ("v", "p0v"))
+SOLVER_POSITION = TableKind("solver P(x)", "solve", ("x", "px", "v2_given_x"))
+SOLVER_DISTRIBUTION = TableKind("solver P(x,v)", "solve", ("x", "v", "pxv"))
+SOLVER_FLIGHT_TIME = TableKind(
+    "solver flight-time",
+    "solve",
+    ("t", "density", "rate_density", "short_time_form", "long_time_form"),
+)
+SOLVER_RETURN_SPEED = TableKind(
+    "solver return-speed", "solve", ("u_lo", "u_hi", "v_lo", "v_hi", "probability")
+)
+EXACT_POSITION = TableKind("exact P(x)", "exact_solution", ("x", "px", "v2_given_x"))
 SOLVER_SUMMARY = TableKind("solver summary", "solve", (*_SUMMARY, "small_speed_exponent"))
 TIME_AVERAGES = TableKind("solver time averages", "solve_grid", _SUMMARY)
 EXACT_P0V = TableKind("exact P(0,v)", "exact_solution", ("v", "p0v"))

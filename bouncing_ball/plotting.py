@@ -401,3 +401,237 @@ def residuals_figure(panels):
         axis.set_ylabel(r"$\Delta P / \sigma$")
     axes[-1, 0].set_xlabel(r"$v$")
     return figure
+
+
+def _panel_grid(count, width=3.4, height=3.2):
+    """Axes for ``count`` panels, two to a row."""
+    columns = min(count, 2)
+    rows = -(-count // columns)
+    figure, axes = new_figure(rows, columns, width=width * columns, height=height * rows)
+    for axis in axes.ravel()[count:]:
+        axis.set_visible(False)
+    return figure, axes.ravel()[:count]
+
+
+@_styled
+def joint_distribution_figure(panels):
+    """Fig. 8 (past the paper, the paper's Fig. 3 for any r): P(x, v) against v at several x
+    from the solver, eqs. (fpsol), (weightfunc), (P(x)1); the simulation's time-weighted
+    cells of the x bin holding each x (points, one-sigma errors); the exact curve where r is
+    1/2 or 1/3 (eq. (weightfunc2)).
+
+    ``panels``: dicts with ``restitution``, ``solver`` (x, v, pxv), ``simulated``
+    (x_lo, x_hi, v_lo, v_hi, pxv, pxv_err) and ``exact`` (x, v, pxv, or None).
+    """
+    figure, axes = _panel_grid(len(panels))
+    for axis, panel in zip(axes, panels):
+        solver, simulated = panel["solver"], panel["simulated"]
+        positions = [x for x in sorted(solver.x.unique()) if x > 0]
+        top = 0.0
+        for index, x in enumerate(positions):
+            color = f"C{index}"
+            curve = solver[solver.x == x].sort_values("v")
+            axis.plot(curve.v, curve.pxv, color=color, label=rf"$x = {x:g}$")
+            top = max(top, float(np.nanmax(curve.pxv)))
+            if panel.get("exact") is not None:
+                exact = panel["exact"][np.isclose(panel["exact"].x, x, rtol=1e-12, atol=0)]
+                axis.plot(exact.v, exact.pxv, color="k", linestyle=":", linewidth=0.9)
+            cells = simulated[(simulated.x_lo <= x) & (simulated.x_hi > x)]
+            cells = cells[
+                np.isfinite(cells.v_lo)
+                & np.isfinite(cells.v_hi)
+                & (cells.v_lo >= curve.v.min())
+                & (cells.v_hi <= curve.v.max())
+                & np.isfinite(cells.pxv_err)
+            ]
+            if len(cells):
+                _error_bars(
+                    axis,
+                    0.5 * (cells.v_lo + cells.v_hi),
+                    cells.pxv,
+                    cells.pxv_err,
+                    log=False,
+                    color=color,
+                    marker=SIMULATION_MARKERS[index % len(SIMULATION_MARKERS)],
+                    zorder=3,
+                )
+        if panel.get("exact") is not None:
+            axis.plot([], [], color="k", linestyle=":", linewidth=0.9, label="exact")
+        axis.set_ylim(0.0, 1.15 * top if top > 0 else None)
+        axis.set_xlim(solver.v.min(), solver.v.max())
+        axis.set_xlabel(r"$v$")
+        axis.set_ylabel(r"$P(x, v)$")
+        axis.set_title(restitution_text(panel["restitution"]), fontsize=10)
+        axis.legend(loc="upper right")
+    return figure
+
+
+@_styled
+def position_density_figure(panels):
+    """Fig. 9 (past the paper): P(x) for every simulated r: the solver through w(F),
+    eqs. (weightfunc), (P(x)1) (line), the simulation's bins (points, one-sigma errors) and
+    the exact eq. (P(x)2) where r is 1/2 or 1/3 (dotted).
+
+    ``panels``: dicts with ``restitution``, ``solver`` (x, px), ``simulated`` (x_lo, x_hi,
+    x, px, px_err) and ``exact`` (x, px, or None).
+    """
+    figure, axes = _panel_grid(len(panels))
+    for index, (axis, panel) in enumerate(zip(axes, panels)):
+        simulated = panel["simulated"]
+        bins = simulated[
+            (simulated.x_lo > 0)
+            & np.isfinite(simulated.x_hi)
+            & (simulated.px > 0)
+            & np.isfinite(simulated.px_err)
+        ]
+        _error_bars(
+            axis,
+            bins.x,
+            bins.px,
+            bins.px_err,
+            color="k",
+            marker=SIMULATION_MARKERS[index % len(SIMULATION_MARKERS)],
+            label="simulation",
+            zorder=3,
+        )
+        solver = panel["solver"]
+        axis.plot(solver.x, solver.px, color="C0", label="solver, eq. (P(x)1)")
+        if panel.get("exact") is not None:
+            axis.plot(
+                panel["exact"].x,
+                panel["exact"].px,
+                color="C3",
+                linestyle=":",
+                label="exact, eq. (P(x)2)",
+            )
+        axis.set_xscale("log")
+        axis.set_yscale("log")
+        if len(bins):
+            axis.set_ylim(bins.px.min() / 10, bins.px.max() * 5)
+            axis.set_xlim(bins.x_lo.min(), bins.x_hi.max())
+        axis.set_xlabel(r"$x$")
+        axis.set_ylabel(r"$P(x)$")
+        axis.set_title(restitution_text(panel["restitution"]), fontsize=10)
+        axis.legend(loc="lower left")
+    return figure
+
+
+@_styled
+def flight_time_figure(panels):
+    """Fig. 10 (past the paper): the distribution of the time between bounces, rho(T), from
+    McKean's first-passage law with gravity, eqs. (0g), (GgP), and the solver's P(0, u)
+    (line); the simulation's flights (points); the short- and long-time forms (dashed,
+    dotted).  Below r_c, where rho is not defined, nu(T) = I rho(T) (flights per unit time).
+
+    ``panels``: dicts with ``restitution``, ``solver`` (t, density, rate_density,
+    short_time_form, long_time_form), ``collision_rate`` and ``simulated`` (t_lo, t_hi, t,
+    density, density_err).
+    """
+    figure, axes = _panel_grid(len(panels))
+    for index, (axis, panel) in enumerate(zip(axes, panels)):
+        solver, rate = panel["solver"], panel["collision_rate"]
+        per_flight = bool(np.isfinite(rate))
+        scale = 1.0 / rate if per_flight else 1.0
+        curve = solver.density if per_flight else solver.rate_density
+        axis.plot(solver.t, curve, color="C0", label="McKean + solver")
+        axis.plot(
+            solver.t,
+            solver.short_time_form * scale,
+            color="C2",
+            linestyle="--",
+            label=r"short $T$",
+        )
+        axis.plot(
+            solver.t,
+            solver.long_time_form * scale,
+            color="C3",
+            linestyle=":",
+            label=r"long $T$",
+        )
+        simulated = panel["simulated"]
+        bins = simulated[
+            (simulated.t_lo > 0)
+            & np.isfinite(simulated.t_hi)
+            & (simulated.density > 0)
+            & np.isfinite(simulated.density_err)
+        ]
+        if per_flight and len(bins):
+            _error_bars(
+                axis,
+                bins.t,
+                bins.density,
+                bins.density_err,
+                color="k",
+                marker=SIMULATION_MARKERS[index % len(SIMULATION_MARKERS)],
+                label="simulation",
+                zorder=3,
+            )
+        axis.set_xscale("log")
+        axis.set_yscale("log")
+        positive = curve[np.isfinite(curve) & (curve > 0)]
+        if len(positive):
+            axis.set_ylim(max(positive.min(), positive.max() * 1e-8), positive.max() * 5)
+        axis.set_xlabel(r"$T$")
+        axis.set_ylabel(r"$\rho(T)$" if per_flight else r"$\nu(T)$")
+        axis.set_title(restitution_text(panel["restitution"]), fontsize=10)
+        axis.legend(loc="lower left")
+    return figure
+
+
+@_styled
+def return_speed_figure(panels, outgoing_speeds):
+    """Fig. 11 (past the paper): the return-speed law, eq. (kernel3): the probability
+    density of the speed v at the next bounce for a ball that leaves with speed u in a bin,
+    v G_g(v, u) averaged over the bin with weight u P(0, u) (line), against the simulated
+    (outgoing, return) pairs (points, one-sigma errors), one panel per outgoing-speed bin
+    holding a speed of ``outgoing_speeds``.
+
+    ``panels``: dicts with ``restitution``, ``solver`` and ``simulated`` (u_lo, u_hi, v_lo,
+    v_hi, probability[, probability_err]).
+    """
+    figure, axes = _panel_grid(len(outgoing_speeds))
+    for axis, speed in zip(axes, outgoing_speeds):
+        drawn = []
+        for index, panel in enumerate(panels):
+            theory, simulated = panel["solver"], panel["simulated"]
+            row = theory[(theory.u_lo <= speed) & (theory.u_hi > speed)]
+            row = row[(row.v_lo > 0) & np.isfinite(row.v_hi)]
+            width = row.v_hi - row.v_lo
+            centre = np.sqrt(row.v_lo * row.v_hi)
+            label = restitution_text(panel["restitution"])
+            axis.plot(centre, row.probability / width, color=f"C{index}", label=label)
+            drawn.append((centre.to_numpy(), (row.probability / width).to_numpy()))
+            cells = simulated[(simulated.u_lo <= speed) & (simulated.u_hi > speed)]
+            cells = cells[
+                (cells.v_lo > 0)
+                & np.isfinite(cells.v_hi)
+                & (cells.probability > 0)
+                & np.isfinite(cells.probability_err)
+            ]
+            width = cells.v_hi - cells.v_lo
+            _error_bars(
+                axis,
+                np.sqrt(cells.v_lo * cells.v_hi),
+                cells.probability / width,
+                cells.probability_err / width,
+                color=f"C{index}",
+                marker=SIMULATION_MARKERS[index % len(SIMULATION_MARKERS)],
+                zorder=3,
+            )
+            if len(row):
+                u_lo, u_hi = float(row.u_lo.iloc[0]), float(row.u_hi.iloc[0])
+                axis.set_title(rf"${u_lo:.3g} \leq u < {u_hi:.3g}$", fontsize=10)
+        axis.set_xscale("log")
+        axis.set_yscale("log")
+        # four decades below the peak: where the law and the data can be told apart
+        centres = np.concatenate([c for c, _ in drawn]) if drawn else np.array([])
+        densities = np.concatenate([d for _, d in drawn]) if drawn else np.array([])
+        if densities.size and np.nanmax(densities) > 0:
+            top = float(np.nanmax(densities))
+            shown = centres[densities > 1e-4 * top]
+            axis.set_ylim(1e-4 * top, 3.0 * top)
+            axis.set_xlim(shown.min() / 1.5, shown.max() * 1.5)
+        axis.set_xlabel(r"return speed $v$")
+        axis.set_ylabel(r"$v\, G_g(v, u)$")
+        axis.legend(loc="lower left")
+    return figure

@@ -10,7 +10,7 @@ import time
 import pandas as pd
 
 from bouncing_ball import distribution, flight_time, solver
-from bouncing_ball.bins import linear_grid, log_grid
+from bouncing_ball.bins import linear_grid, log_bins, log_grid
 from bouncing_ball.io import write_tables
 from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
@@ -28,6 +28,7 @@ with job_log(snakemake.log[0]):
     collisions = flight_time.flight_time_summary(solution)
     row.update({key: value for key, value in collisions.items() if key not in row})
     flights = flight_time.flight_time_table(solution, log_grid(settings["flight_times"]))
+    returns = flight_time.return_speed_table(solution, log_bins(snakemake.params.speed_bins))
     # the whole distribution from P(0, v) (bouncing_ball.distribution): w(F), then P(x), P(x, v)
     started_distribution = time.perf_counter()
     far = distribution.outgoing_speed_solution(float(exact))  # P(0, v) out to ~e^-690
@@ -58,6 +59,7 @@ with job_log(snakemake.log[0]):
             snakemake.output.p0v: p0v,
             snakemake.output.summary: pd.DataFrame([row]),
             snakemake.output.flight_time: flights,
+            snakemake.output.return_speed: returns,
             snakemake.output.position: position,
             snakemake.output.distribution: joint,
             snakemake.output.weight: weights,

@@ -175,7 +175,7 @@ def test_the_report_has_every_figure_and_table_with_its_caption(finished_run, tm
     result = snakemake(finished_run, "--report", str(report))
     assert result.returncode == 0, result.stderr[-3000:]
     text = report.read_text()
-    for name in [*(f"fig{n}.png" for n in range(1, 8)), "moments.csv", "validation.csv"]:
+    for name in [*(f"fig{n}.png" for n in range(1, 12)), "moments.csv", "validation.csv"]:
         assert name in text, name
     for phrase in (
         "The exponents beta(r)",
@@ -337,7 +337,7 @@ def test_editing_a_plotting_script_reruns_only_figures(finished_run, tmp_path):
     package, env = _packagecopy_repository(tmp_path)
     with open(package / "plotting.py", "a") as handle:
         handle.write("\n# an edit\n")
-    assert planned_jobs(finished_run, env) == {f"fig{n}": 1 for n in range(1, 8)} | {"all": 1}
+    assert planned_jobs(finished_run, env) == {f"fig{n}": 1 for n in range(1, 12)} | {"all": 1}
 
 
 def test_one_target_builds_only_what_it_needs(tmp_path):

@@ -56,7 +56,7 @@ def stale_simulation():
 def stale_figures():
     """{figure: why} of the figures not drawn from what the config asks for now."""
     stale = {}
-    for n in range(1, 8):
+    for n in FIGURE_NUMBERS:
         drawing = getattr(rules, f"fig{n}").rule
         png = f"results/figures/fig{n}.png"
         found = figure_differences(png, drawing.input)

@@ -122,7 +122,15 @@ def solver_targets():
     return expand(
         "results/solver/r{r}/{table}.parquet",
         r=RESTITUTION,
-        table=("p0v", "summary", "flight_time", "position", "distribution", "weight"),
+        table=(
+            "p0v",
+            "summary",
+            "flight_time",
+            "return_speed",
+            "position",
+            "distribution",
+            "weight",
+        ),
     )
 
 
@@ -143,8 +151,11 @@ def figure_labels(figure):
     return list(restitution_grid(config["figures"][figure], f"figures.{figure}"))
 
 
+FIGURE_NUMBERS = range(1, 12)  # Figs. 1-5 the paper's, 6-11 past it
+
+
 def figure_targets():
-    return expand("results/figures/fig{n}.{ext}", n=range(1, 8), ext=("pdf", "png"))
+    return expand("results/figures/fig{n}.{ext}", n=FIGURE_NUMBERS, ext=("pdf", "png"))
 
 
 def table_targets():

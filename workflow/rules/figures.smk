@@ -199,3 +199,131 @@ rule fig7:
         code=code(stages.PLOTTING + stages.COMPARISON, "figures/fig7.py"),
     script:
         "../../scripts/figures/fig7.py"
+
+
+# Fig. 8: P(x,v) against v for any r (the paper's Fig. 3), r of figures.fig8.
+rule fig8:
+    input:
+        solver=expand(
+            "results/solver/r{r}/distribution.parquet", r=figure_labels("fig8")
+        ),
+        simulation=expand(
+            "results/simulation/r{r}/distribution.parquet", r=figure_labels("fig8")
+        ),
+        exact=expand("results/exact/r{r}/distribution.parquet", r=EXACT_LABELS),
+    output:
+        "results/figures/fig8.pdf",
+        report(
+            "results/figures/fig8.png",
+            caption="../report/fig8.rst",
+            category="Figures",
+        ),
+    log:
+        "logs/figures/fig8.log",
+    localrule: True
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=1000,
+        cpus_per_task=1,
+    params:
+        dpi=config["figures"]["png_dpi"],
+        code=code(stages.PLOTTING, "figures/fig8.py"),
+    script:
+        "../../scripts/figures/fig8.py"
+
+
+# Fig. 9: P(x) for every r of restitution: solver, simulation, exact.
+rule fig9:
+    input:
+        solver=expand("results/solver/r{r}/position.parquet", r=RESTITUTION),
+        simulation=expand("results/simulation/r{r}/position.parquet", r=RESTITUTION),
+        exact=expand("results/exact/r{r}/position.parquet", r=EXACT_LABELS),
+    output:
+        "results/figures/fig9.pdf",
+        report(
+            "results/figures/fig9.png",
+            caption="../report/fig9.rst",
+            category="Figures",
+        ),
+    log:
+        "logs/figures/fig9.log",
+    localrule: True
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=1000,
+        cpus_per_task=1,
+    params:
+        dpi=config["figures"]["png_dpi"],
+        code=code(stages.PLOTTING, "figures/fig9.py"),
+    script:
+        "../../scripts/figures/fig9.py"
+
+
+# Fig. 10: the flight-time distribution, r of figures.fig10.
+rule fig10:
+    input:
+        solver=expand(
+            "results/solver/r{r}/flight_time.parquet", r=figure_labels("fig10")
+        ),
+        summary=expand("results/solver/r{r}/summary.parquet", r=figure_labels("fig10")),
+        simulation=expand(
+            "results/simulation/r{r}/flight_time.parquet", r=figure_labels("fig10")
+        ),
+    output:
+        "results/figures/fig10.pdf",
+        report(
+            "results/figures/fig10.png",
+            caption="../report/fig10.rst",
+            category="Figures",
+        ),
+    log:
+        "logs/figures/fig10.log",
+    localrule: True
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=1000,
+        cpus_per_task=1,
+    params:
+        dpi=config["figures"]["png_dpi"],
+        code=code(stages.PLOTTING, "figures/fig10.py"),
+    script:
+        "../../scripts/figures/fig10.py"
+
+
+# Fig. 11: the return-speed law against the simulated bounce pairs, r of figures.fig11.
+rule fig11:
+    input:
+        solver=expand(
+            "results/solver/r{r}/return_speed.parquet", r=figure_labels("fig11")
+        ),
+        simulation=expand(
+            "results/simulation/r{r}/return_speed.parquet", r=figure_labels("fig11")
+        ),
+    output:
+        "results/figures/fig11.pdf",
+        report(
+            "results/figures/fig11.png",
+            caption="../report/fig11.rst",
+            category="Figures",
+        ),
+    log:
+        "logs/figures/fig11.log",
+    localrule: True
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=1000,
+        cpus_per_task=1,
+    params:
+        dpi=config["figures"]["png_dpi"],
+        outgoing_speeds=config["figures"]["return_speeds"],
+        code=code(stages.PLOTTING, "figures/fig11.py"),
+    script:
+        "../../scripts/figures/fig11.py"

@@ -6,6 +6,7 @@ rule solve:
         p0v="results/solver/r{r}/p0v.parquet",
         summary="results/solver/r{r}/summary.parquet",
         flight_time="results/solver/r{r}/flight_time.parquet",
+        return_speed="results/solver/r{r}/return_speed.parquet",
         position="results/solver/r{r}/position.parquet",
         distribution="results/solver/r{r}/distribution.parquet",
         weight="results/solver/r{r}/weight.parquet",
@@ -21,6 +22,8 @@ rule solve:
     params:
         restitution=solver_restitution_value,
         settings=solver_settings(config),
+        # the simulation's speed bins, on which the return-speed law is averaged
+        speed_bins=lambda wildcards: settings(wildcards)["speed_bins"],
         code=code(stages.SOLVER, "solve.py"),
     script:
         "../../scripts/solve.py"
