@@ -381,6 +381,65 @@ def solver_benchmark(repeats=7):
     }
 
 
+DISTRIBUTION_RESTITUTIONS = (0.25, 0.5, 0.75)
+
+
+def distribution_benchmark():
+    """What rule solve adds to P(0, v) for one r, with the default config's grids: w(F)
+    (bouncing_ball.distribution), the P(x), P(x, v) and w tables, the flight-time and
+    return-speed tables (bouncing_ball.flight_time)."""
+    from bouncing_ball import distribution, flight_time, solver
+    from bouncing_ball.bins import linear_grid, log_bins, log_grid
+    from bouncing_ball.config import read_config
+
+    config = read_config(REPOSITORY / "config" / "config.yaml")
+    grids = config["solver"]
+    speed_bins = log_bins(config["simulation"]["speed_bins"])
+    rows = []
+    for r in DISTRIBUTION_RESTITUTIONS:
+        started = time.perf_counter()
+        far = distribution.outgoing_speed_solution(r)
+        weight = distribution.interpolated_weight_function(far)
+        built = time.perf_counter()
+        distribution.position_table(weight, log_grid(grids["position_grid"]))
+        distribution.weight_table(weight, log_grid(grids["forces"]))
+        tabulated = time.perf_counter()
+        distribution.distribution_table(
+            weight, far, grids["positions"], linear_grid(grids["speeds"])
+        )
+        joint = time.perf_counter()
+        solution = solver.solve_outgoing_speed_density(r)
+        flight_time.flight_time_table(solution, log_grid(grids["flight_times"]))
+        flight_time.return_speed_table(solution, speed_bins)
+        collisions = time.perf_counter()
+        rows.append(
+            {
+                "r": r,
+                "weight_function_seconds": built - started,
+                "position_and_weight_tables_seconds": tabulated - built,
+                "distribution_table_seconds": joint - tabulated,
+                "collision_tables_seconds": collisions - joint,
+                "total_seconds": collisions - started,
+            }
+        )
+    return {"rows": rows}
+
+
+def _print_distribution(result):
+    print("The whole distribution and the collision statistics, per r (rule solve, default grids)")
+    print(
+        f"{'r':>6} {'w(F) build s':>13} {'P(x), w tables s':>17} {'P(x,v) table s':>15}"
+        f" {'flights s':>10} {'total s':>8}"
+    )
+    for row in result["rows"]:
+        print(
+            f"{row['r']:6.3g} {row['weight_function_seconds']:13.1f}"
+            f" {row['position_and_weight_tables_seconds']:17.2f}"
+            f" {row['distribution_table_seconds']:15.1f} {row['collision_tables_seconds']:10.2f}"
+            f" {row['total_seconds']:8.1f}"
+        )
+
+
 def _print_solver(result):
     from bouncing_ball import solver
 
@@ -472,6 +531,8 @@ def _print_all(results):
     )
     print()
     _print_solver(results["solver"])
+    print()
+    _print_distribution(results["distribution"])
     w = results["workflow"]
     print()
     if "skipped" in w:
@@ -522,6 +583,7 @@ def main(argv=None):
         "efficiency_paper_c": efficiency_benchmark({"criterion_c": PAPER_CRITERION_C}),
         "compile": compile_benchmark(),
         "solver": solver_result,
+        "distribution": distribution_benchmark(),
         "workflow": workflow_benchmark(),
     }
     if args.scaling:

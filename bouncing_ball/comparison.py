@@ -419,3 +419,54 @@ def validation_markdown(table: pd.DataFrame) -> str:
         }
     )
     return shown.to_markdown(index=False, disable_numparse=True) + "\n"
+
+
+# ---- the asymptotics of P(x) for any r (results/tables/position_asymptotics) ----
+
+POSITION_EXPONENTS = {
+    "small_x_power": "P(x) - P(0) or P(x) ~ x^a, x -> 0: a = (1 - beta)/3",
+    "small_x_power_at_zero_speed": "P(x, 0) ~ x^a, x -> 0: a = -beta/3",
+    "large_x_rate": "P(x) ~ x^c exp(-b x^(1/2)), x -> inf: b",
+    "large_x_power": "P(x) ~ x^c exp(-b x^(1/2)), x -> inf: c",
+}
+
+
+def position_asymptotics_table(summaries) -> pd.DataFrame:
+    """One row per r and exponent of P(x): measured from the solver's P(x) (eq. (P(x)1)) and
+    predicted (docs/distribution.md), from the solver summaries (r_label, summary row)."""
+    rows = []
+    for label, summary in summaries:
+        for exponent, meaning in POSITION_EXPONENTS.items():
+            measured = float(summary[f"{exponent}_measured"])
+            predicted = float(summary[f"{exponent}_predicted"])
+            rows.append(
+                {
+                    "r_label": label,
+                    "r": float(summary["r"]),
+                    "exponent": exponent,
+                    "meaning": meaning,
+                    "measured": measured,
+                    "predicted": predicted,
+                    "difference": measured - predicted,
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+def position_asymptotics_markdown(table: pd.DataFrame) -> str:
+    shown = pd.DataFrame(
+        {
+            "r": table.r_label,
+            "exponent": table.meaning,
+            "measured (solver's P(x))": table.measured.map(lambda value: f"{value:.6f}"),
+            "predicted": table.predicted.map(lambda value: f"{value:.6f}"),
+            "difference": table.difference.map(lambda value: f"{value:+.1e}"),
+        }
+    )
+    note = (
+        "\nSmall x: local slopes at x ~ 1e-7, with corrections of relative order x^(1/3) "
+        "(so differences of order 1e-2 are expected); at r = 1/2 (beta = 1) P(x) ~ -ln x, whose "
+        "local slope goes to 0 only like 1/ln x. Large x: a fit of ln P(x) over the window where "
+        "w(F) is computed (docs/distribution.md).\n"
+    )
+    return shown.to_markdown(index=False, disable_numparse=True) + "\n" + note

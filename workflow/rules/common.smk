@@ -164,4 +164,6 @@ def table_targets():
         "results/tables/moments.md",
         "results/tables/validation.csv",
         "results/tables/validation.md",
+        "results/tables/position_asymptotics.csv",
+        "results/tables/position_asymptotics.md",
     ]

@@ -60,3 +60,29 @@ rule validation_table:
         code=code(stages.VALIDATION, "validation_table.py"),
     script:
         "../../scripts/validation_table.py"
+
+
+# The asymptotics of P(x) at every r: measured from the solver's P(x), and predicted.
+rule position_asymptotics:
+    input:
+        expand("results/solver/r{r}/summary.parquet", r=RESTITUTION),
+    output:
+        csv=report(
+            "results/tables/position_asymptotics.csv",
+            caption="../report/position_asymptotics.rst",
+            category="Tables",
+        ),
+        md="results/tables/position_asymptotics.md",
+    log:
+        "logs/tables/position_asymptotics.log",
+    localrule: True
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=500,
+        cpus_per_task=1,
+    params:
+        code=code(stages.COMPARISON, "position_asymptotics.py"),
+    script:
+        "../../scripts/position_asymptotics.py"
