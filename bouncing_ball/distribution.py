@@ -833,12 +833,16 @@ def speed_squared_given_position_bin_average(lo, hi, weight):
 # P(x, v), eq. (fpsol)
 
 
-def _distribution_integrand(log_force, x, v, weight):
-    # e^{-v/2} w(F) e^{-F x} psi_{1/4,F}(-v) F, eqs. (fpsol), (psi); dF = F d(ln F)
+def _distribution_integrand(log_force, x, v, weight, width=0.0):
+    # e^{-v/2} w(F) e^{-F x} psi_{1/4,F}(-v) F, eqs. (fpsol), (psi); dF = F d(ln F); with
+    # width > 0, e^{-F x} is replaced by its average over [x, x + width],
+    # e^{-F x} (1 - e^{-F width}) / (F width)
     f = math.exp(log_force)
     argument = -(f ** (1.0 / 3.0)) * v + 0.25 * f ** (-2.0 / 3.0)
     log_w = weight.log_scalar(f) if hasattr(weight, "log_scalar") else float(weight.log(f))
     log_rest = log_w + log_force - f * x - 0.5 * v - log_force / 6.0
+    if width > 0.0:
+        log_rest += math.log(-math.expm1(-f * width) / (f * width))
     if argument > 0.0:
         airy = special.airye(argument)[0] if argument < 1e6 else float(_airy_scaled(argument))
         return airy * math.exp(log_rest - (2.0 / 3.0) * argument**1.5)
@@ -871,6 +875,54 @@ def distribution_by_force_integral(x, v, weight):
         full_output=1,
     )
     return value, error
+
+
+CELL_SPEED_NODES = 8  # Gauss-Legendre nodes per panel in v of ``distribution_cell_average``
+
+
+def distribution_cell_average(x_lo, x_hi, v_lo, v_hi, weight, speed_nodes=CELL_SPEED_NODES):
+    """(1 / area) int_{x_lo}^{x_hi} dx int_{v_lo}^{v_hi} dv P(x, v): what a cell of a simulation's
+    P(x, v) histogram measures, for broadcast arrays of cells with 0 < x_lo < x_hi and finite
+    v_lo < v_hi.
+
+    The x average is done under the F integral of eq. (fpsol) in closed form,
+    (1 / (x_hi - x_lo)) int dx e^{-F x} = e^{-F x_lo} (1 - e^{-F (x_hi - x_lo)}) / (F (x_hi - x_lo)),
+    the v average by Gauss-Legendre with ``speed_nodes`` nodes on equal panels no wider than
+    x_lo^(1/3), the width in v of the layer next to the floor in which P(x, v) crosses over from
+    P(0, v) ~ v^-beta (P(x, v) is analytic in v for x > 0).  Good to 1e-9 against brute-force
+    quadrature of the exact solutions for x_lo >= 0.01 (tests/unit/test_distribution_cells.py);
+    at x_lo = 1e-3 (r = 0.25, v in [0, 1)) 3 to 12 nodes per panel agree to 1e-8, not checked
+    against an independent computation.
+    """
+    x_lo, x_hi, v_lo, v_hi = np.broadcast_arrays(
+        *(np.asarray(a, dtype=float) for a in (x_lo, x_hi, v_lo, v_hi))
+    )
+    if np.any(~(x_lo > 0.0) | ~(x_hi > x_lo) | ~(v_hi > v_lo) | ~np.isfinite(x_hi + v_lo + v_hi)):
+        raise ValueError("cells need 0 < x_lo < x_hi < inf and finite v_lo < v_hi")
+    nodes, node_weights = np.polynomial.legendre.leggauss(speed_nodes)
+    lower = np.log(_total_decay(weight) / 150.0)
+    result = np.empty(x_lo.shape)
+    for index in np.ndindex(x_lo.shape):
+        lo, width = float(x_lo[index]), float(x_hi[index] - x_lo[index])
+        upper = max(np.log(60.0 / lo), lower + 1.0)
+        panels = int(np.ceil((v_hi[index] - v_lo[index]) / lo ** (1.0 / 3.0)))
+        edges = np.linspace(v_lo[index], v_hi[index], panels + 1)
+        total = 0.0
+        for a, b in zip(edges[:-1], edges[1:]):
+            for node, node_weight in zip(nodes, node_weights):
+                value, *_ = integrate.quad(
+                    _distribution_integrand,
+                    lower,
+                    upper,
+                    args=(lo, float(0.5 * (a + b) + 0.5 * (b - a) * node), weight, width),
+                    limit=2000,
+                    epsabs=0.0,
+                    epsrel=1e-10,
+                    full_output=1,
+                )
+                total += 0.5 * (b - a) * node_weight * value
+        result[index] = total / (v_hi[index] - v_lo[index])
+    return result
 
 
 def distribution_with_error(x, v, weight, solution):
