@@ -248,11 +248,21 @@ def test_adding_a_shard_runs_only_that_shard(finished_run, tmp_path):
         "fit": 1,
         "fig4": 1,
         "fig5": 1,
+        "fig8": 1,  # r = 1/2 is also a panel of Figs. 8 and 10 in the small config
+        "fig10": 1,
         **AGGREGATES,
     }
 
 
-AGGREGATES = {"fig6": 1, "fig7": 1, "moments_table": 1, "validation_table": 1, "all": 1}
+# what shows every simulated r
+AGGREGATES = {
+    "fig6": 1,
+    "fig7": 1,
+    "fig9": 1,
+    "moments_table": 1,
+    "validation_table": 1,
+    "all": 1,
+}
 
 
 def test_adding_an_r_runs_only_its_jobs_and_the_aggregates(finished_run, tmp_path):
@@ -267,6 +277,7 @@ def test_adding_an_r_runs_only_its_jobs_and_the_aggregates(finished_run, tmp_pat
         "merge_shards": 1,
         "solve": 1,
         "fit": 1,
+        "position_asymptotics": 1,
         **AGGREGATES,
     }, planned
     before = {
@@ -297,10 +308,22 @@ def test_adding_an_r_runs_only_its_jobs_and_the_aggregates(finished_run, tmp_pat
                     "summary",
                 )
             ),
-            "results/solver/r0.6/p0v.parquet",
-            "results/solver/r0.6/summary.parquet",
+            *(
+                f"results/solver/r0.6/{name}.parquet"
+                for name in (
+                    "p0v",
+                    "summary",
+                    "flight_time",
+                    "return_speed",
+                    "position",
+                    "distribution",
+                    "weight",
+                )
+            ),
             "results/fits/r0.6.parquet",
-            *(f"results/figures/fig{n}.{ext}" for n in (6, 7) for ext in ("pdf", "png")),
+            *(f"results/figures/fig{n}.{ext}" for n in (6, 7, 9) for ext in ("pdf", "png")),
+            "results/tables/position_asymptotics.csv",
+            "results/tables/position_asymptotics.md",
             "results/tables/moments.csv",
             "results/tables/moments.md",
             "results/tables/validation.csv",
@@ -356,6 +379,7 @@ def test_one_target_builds_only_what_it_needs(tmp_path):
         "exact_solution": 2,
         "moments_table": 1,
         "validation_table": 1,
+        "position_asymptotics": 1,
         "tables": 1,
     }
     result = snakemake(directory, "results/figures/fig1.png")
@@ -387,7 +411,8 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
     assert planned_jobs(finished_run, env) == {}
     with open(package / "histograms.py", "a") as handle:
         handle.write("\n# an edit\n")
-    downstream = {"fig4": 1, "fig5": 1, **AGGREGATES}  # everything drawn from the simulation
+    # everything drawn from the simulation
+    downstream = {"fig4": 1, "fig5": 1, "fig8": 1, "fig10": 1, "fig11": 1, **AGGREGATES}
     assert planned_jobs(finished_run, env) == {"merge_shards": 2, "fit": 2, **downstream}
     with open(package / "free_flight.py", "a") as handle:
         handle.write("\n# an edit\n")
@@ -404,8 +429,13 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
         "fig4": 1,
         "fig6": 1,
         "fig7": 1,
+        "fig8": 1,
+        "fig9": 1,
+        "fig10": 1,
+        "fig11": 1,
         "moments_table": 1,
         "validation_table": 1,
+        "position_asymptotics": 1,
     }
     for module, expected in (
         ("kernel", solved),
@@ -417,14 +447,29 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
                 "fig3": 1,
                 "fig5": 1,
                 "fig6": 1,
+                "fig8": 1,
+                "fig9": 1,
                 "moments_table": 1,
                 "validation_table": 1,  # the exact bin averages
             },
         ),
         # comparison uses fits
-        ("fits", {"fit": 2, "fig4": 1, "fig7": 1, "moments_table": 1, "validation_table": 1}),
+        (
+            "fits",
+            {
+                "fit": 2,
+                "fig4": 1,
+                "fig7": 1,
+                "moments_table": 1,
+                "validation_table": 1,
+                "position_asymptotics": 1,
+            },
+        ),
         ("asymptotics", {**solved, "theory": 1, "fig1": 1, "fig2": 1}),
-        ("comparison", {"fig7": 1, "moments_table": 1, "validation_table": 1}),
+        (
+            "comparison",
+            {"fig7": 1, "moments_table": 1, "validation_table": 1, "position_asymptotics": 1},
+        ),
     ):
         shutil.rmtree(package.parent)
         package, env = _packagecopy_repository(tmp_path)
