@@ -524,8 +524,8 @@ def flight_time_figure(panels):
     dotted).  Below r_c, where rho is not defined, nu(T) = I rho(T) (flights per unit time).
 
     ``panels``: dicts with ``restitution``, ``solver`` (t, density, rate_density,
-    short_time_form, long_time_form), ``collision_rate`` and ``simulated`` (t_lo, t_hi, t,
-    density, density_err).
+    short_time_form, long_time_form), ``collision_rate``, ``long_time_decay_rate`` (kappa of
+    nu ~ e^(-kappa T)) and ``simulated`` (t_lo, t_hi, t, density, density_err).
     """
     figure, axes = _panel_grid(len(panels))
     for index, (axis, panel) in enumerate(zip(axes, panels)):
@@ -534,16 +534,20 @@ def flight_time_figure(panels):
         scale = 1.0 / rate if per_flight else 1.0
         curve = solver.density if per_flight else solver.rate_density
         axis.plot(solver.t, curve, color="C0", label="McKean + solver")
+        # each form where it applies: short T below the decay time 1/kappa, long T beyond a
+        # fifth of it
+        decay_time = 1.0 / panel["long_time_decay_rate"]
+        short, long = solver[solver.t <= decay_time], solver[solver.t >= 0.2 * decay_time]
         axis.plot(
-            solver.t,
-            solver.short_time_form * scale,
+            short.t,
+            short.short_time_form * scale,
             color="C2",
             linestyle="--",
             label=r"short $T$",
         )
         axis.plot(
-            solver.t,
-            solver.long_time_form * scale,
+            long.t,
+            long.long_time_form * scale,
             color="C3",
             linestyle=":",
             label=r"long $T$",

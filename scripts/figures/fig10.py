@@ -24,6 +24,7 @@ with job_log(snakemake.log[0]):
                 "restitution": parse_restitution(provenance["r"]),
                 "solver": solved,
                 "collision_rate": float(summary.collision_rate.iloc[0]),
+                "long_time_decay_rate": float(summary.long_time_decay_rate.iloc[0]),
                 "simulated": simulated,
             }
         )
