@@ -572,9 +572,11 @@ def flight_time_figure(panels):
             )
         axis.set_xscale("log")
         axis.set_yscale("log")
-        positive = curve[np.isfinite(curve) & (curve > 0)]
-        if len(positive):
-            axis.set_ylim(max(positive.min(), positive.max() * 1e-8), positive.max() * 5)
+        # scaled to the simulated points where there are some, else to 20 decades of the curve
+        shown = bins.density if per_flight and len(bins) else curve[np.isfinite(curve)]
+        shown = shown[shown > 0]
+        if len(shown):
+            axis.set_ylim(max(shown.min() / 10, shown.max() * 1e-20), shown.max() * 5)
         axis.set_xlabel(r"$T$")
         axis.set_ylabel(r"$\rho(T)$" if per_flight else r"$\nu(T)$")
         axis.set_title(restitution_text(panel["restitution"]), fontsize=10)
