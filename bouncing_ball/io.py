@@ -16,6 +16,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from . import __version__
+from .restitution import parse_restitution
 
 METADATA_KEY = b"bouncing_ball"
 
@@ -240,6 +241,32 @@ def read_tables_of_one_restitution(*paths, kinds=None) -> list[tuple[pd.DataFram
         )
         raise UnreadableFileError(f"not the same r: {which}")
     return tables
+
+
+def comparison_panels(solver_paths, simulation_paths, exact_paths, kinds) -> list[dict]:
+    """One dict per r of a figure that compares the solver with the simulation, and with the
+    exact solution where r has one: ``restitution`` (the exact r), ``solver``, ``simulated`` and ``exact`` (None where r has no exact solution).
+    ``kinds``: the (solver, simulated, exact) ``TableKind``; each solver table is paired with
+    the simulation table of the same position and refused unless both are of one r."""
+    solver_kind, simulated_kind, exact_kind = kinds
+    exact = {}
+    for path in exact_paths:
+        table, provenance = read_table(path, exact_kind)
+        exact[provenance["r"]] = table
+    panels = []
+    for paths in zip(solver_paths, simulation_paths, strict=True):
+        (solved, provenance), (simulated, _) = read_tables_of_one_restitution(
+            *paths, kinds=(solver_kind, simulated_kind)
+        )
+        panels.append(
+            {
+                "restitution": parse_restitution(provenance["r"]),
+                "solver": solved,
+                "simulated": simulated,
+                "exact": exact.get(provenance["r"]),
+            }
+        )
+    return panels
 
 
 def write_csv_and_markdown(table: pd.DataFrame, csv_path, markdown_path, markdown: str) -> None:

@@ -94,9 +94,16 @@ def save_figure(figure, pdf, png, dpi, provenance: dict) -> None:
 def simulated_bins(p0v):
     """The bins of a merged P(0, v) table that can be drawn: not the under/overflow
     bins, at least one collision, a finite error."""
-    finite = np.isfinite(p0v.p0v) & np.isfinite(p0v.p0v_err) & (p0v["count"] > 0)
-    finite &= (p0v.v_lo > 0) & np.isfinite(p0v.v_hi)
-    return p0v[finite]
+    return drawable_bins(p0v, "v", "p0v")[lambda bins: bins["count"] > 0]
+
+
+def drawable_bins(table, variable, value):
+    """The rows of a merged table on log bins of ``variable`` (columns ``{variable}_lo``,
+    ``{variable}_hi``) that can be drawn on log axes: not the under- or overflow bins, a
+    positive ``value``, a finite ``{value}_err``."""
+    keep = (table[f"{variable}_lo"] > 0) & np.isfinite(table[f"{variable}_hi"])
+    keep &= (table[value] > 0) & np.isfinite(table[f"{value}_err"])
+    return table[keep]
 
 
 def _error_bars(axis, x, y, error, log=True, **style):
@@ -478,12 +485,7 @@ def position_density_figure(panels):
     figure, axes = _panel_grid(len(panels))
     for index, (axis, panel) in enumerate(zip(axes, panels)):
         simulated = panel["simulated"]
-        bins = simulated[
-            (simulated.x_lo > 0)
-            & np.isfinite(simulated.x_hi)
-            & (simulated.px > 0)
-            & np.isfinite(simulated.px_err)
-        ]
+        bins = drawable_bins(simulated, "x", "px")
         _error_bars(
             axis,
             bins.x,
@@ -553,12 +555,7 @@ def flight_time_figure(panels):
             label=r"long $T$",
         )
         simulated = panel["simulated"]
-        bins = simulated[
-            (simulated.t_lo > 0)
-            & np.isfinite(simulated.t_hi)
-            & (simulated.density > 0)
-            & np.isfinite(simulated.density_err)
-        ]
+        bins = drawable_bins(simulated, "t", "density")
         if per_flight and len(bins):
             _error_bars(
                 axis,
@@ -608,12 +605,7 @@ def return_speed_figure(panels, outgoing_speeds):
             axis.plot(centre, row.probability / width, color=f"C{index}", label=label)
             drawn.append((centre.to_numpy(), (row.probability / width).to_numpy()))
             cells = simulated[(simulated.u_lo <= speed) & (simulated.u_hi > speed)]
-            cells = cells[
-                (cells.v_lo > 0)
-                & np.isfinite(cells.v_hi)
-                & (cells.probability > 0)
-                & np.isfinite(cells.probability_err)
-            ]
+            cells = drawable_bins(cells, "v", "probability")
             width = cells.v_hi - cells.v_lo
             _error_bars(
                 axis,

@@ -34,7 +34,7 @@ FITS = (
     "tallies",
 )
 PLOTTING = ("io", "plotting", "restitution")
-COMPARISON = ("comparison", "fits", "io")
+COMPARISON = ("comparison", "fits", "io", "restitution")
 # the studies' reports (workflow/rules/studies.smk); their shards are SIMULATION's
 STUDIES = (
     "bins",
@@ -50,7 +50,7 @@ STUDIES = (
     "tallies",
 )
 # results/tables/validation: the comparison, the exact bin averages, the solver curve's bin averages
-VALIDATION = ("bins", "comparison", "exact", "fits", "io")
+VALIDATION = ("bins", "comparison", "exact", "fits", "io", "restitution")
 
 # what numba compiles: the modules with compiled functions and what those call into (the
 # key of numba's cache folder, bouncing_ball.jit); an edit elsewhere does not recompile

@@ -7,30 +7,18 @@ from bouncing_ball.io import (
     EXACT_DISTRIBUTION,
     SIMULATED_DISTRIBUTION,
     SOLVER_DISTRIBUTION,
-    read_table,
-    read_tables_of_one_restitution,
+    comparison_panels,
 )
 from bouncing_ball.jobs import job_log
-from bouncing_ball.restitution import parse_restitution
 
 with job_log(snakemake.log[0]):
-    exact = {}
-    for path in snakemake.input.exact:
-        table, provenance = read_table(path, EXACT_DISTRIBUTION)
-        exact[provenance["r"]] = table
-    panels = []
-    for paths in zip(snakemake.input.solver, snakemake.input.simulation, strict=True):
-        (solved, provenance), (simulated, _) = read_tables_of_one_restitution(
-            *paths, kinds=(SOLVER_DISTRIBUTION, SIMULATED_DISTRIBUTION)
-        )
-        panels.append(
-            {
-                "restitution": parse_restitution(provenance["r"]),
-                "solver": solved,
-                "simulated": simulated,
-                "exact": exact.get(provenance["r"]),
-            }
-        )
+    inputs = snakemake.input
+    panels = comparison_panels(
+        inputs.solver,
+        inputs.simulation,
+        inputs.exact,
+        (SOLVER_DISTRIBUTION, SIMULATED_DISTRIBUTION, EXACT_DISTRIBUTION),
+    )
     plotting.save_figure(
         plotting.joint_distribution_figure(panels),
         *snakemake.output,

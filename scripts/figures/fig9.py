@@ -6,30 +6,18 @@ from bouncing_ball.io import (
     EXACT_POSITION,
     SIMULATED_POSITION,
     SOLVER_POSITION,
-    read_table,
-    read_tables_of_one_restitution,
+    comparison_panels,
 )
 from bouncing_ball.jobs import job_log
-from bouncing_ball.restitution import parse_restitution
 
 with job_log(snakemake.log[0]):
-    exact = {}
-    for path in snakemake.input.exact:
-        table, provenance = read_table(path, EXACT_POSITION)
-        exact[provenance["r"]] = table
-    panels = []
-    for paths in zip(snakemake.input.solver, snakemake.input.simulation, strict=True):
-        (solved, provenance), (simulated, _) = read_tables_of_one_restitution(
-            *paths, kinds=(SOLVER_POSITION, SIMULATED_POSITION)
-        )
-        panels.append(
-            {
-                "restitution": parse_restitution(provenance["r"]),
-                "solver": solved,
-                "simulated": simulated,
-                "exact": exact.get(provenance["r"]),
-            }
-        )
+    inputs = snakemake.input
+    panels = comparison_panels(
+        inputs.solver,
+        inputs.simulation,
+        inputs.exact,
+        (SOLVER_POSITION, SIMULATED_POSITION, EXACT_POSITION),
+    )
     plotting.save_figure(
         plotting.position_density_figure(panels),
         *snakemake.output,

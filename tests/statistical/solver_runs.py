@@ -6,7 +6,7 @@ import functools
 from fractions import Fraction
 
 import numpy as np
-from shard_statistics import simulate_shards
+from shard_statistics import sign_flip_p_values, simulate_shards
 
 from bouncing_ball.bins import LinearBins
 
@@ -35,3 +35,15 @@ def shards(r):
 
 def times(run):
     return np.array([s.time for s in run])
+
+
+def assert_agrees(per_shard, expected):
+    """Shard-level values (shards x bins) agree with ``expected``: chi^2 and the worst bin
+    against the sign-flip null (``shard_statistics.sign_flip_p_values``), p > 1e-3 each."""
+    chi2_per_dof, p_chi2, p_worst = sign_flip_p_values(per_shard - expected)
+    error = per_shard.std(axis=0, ddof=1) / np.sqrt(SHARDS)
+    z = (per_shard.mean(axis=0) - expected) / error
+    assert p_chi2 > 1e-3 and p_worst > 1e-3, (
+        f"chi^2/dof = {chi2_per_dof:.3f} (p = {p_chi2:.4f}), worst p = {p_worst:.4f}, "
+        f"{len(expected)} bins, z = {np.round(z, 1)}"
+    )

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from distribution_support import build
 from shard_statistics import sign_flip_p_values
-from solver_runs import MINIMUM_TIME_FRACTION, SHARDS, shards, times
+from solver_runs import MINIMUM_TIME_FRACTION, SHARDS, assert_agrees, shards, times
 
 from bouncing_ball import distribution
 
@@ -66,22 +66,12 @@ def cells(request):
     return r, per_shard, expected
 
 
-def _message(per_shard, expected, chi2_per_dof, p_chi2, p_worst):
-    error = per_shard.std(axis=0, ddof=1) / np.sqrt(SHARDS)
-    z = (per_shard.mean(axis=0) - expected) / error
-    return (
-        f"chi^2/dof = {chi2_per_dof:.3f} (p = {p_chi2:.4f}), worst p = {p_worst:.4f}, "
-        f"{len(expected)} bins, z = {np.round(z, 1)}"
-    )
-
-
 def test_position_density_agrees(position):
     r, per_shard, expected = position
     error = per_shard.std(axis=0, ddof=1) / np.sqrt(SHARDS)
     assert len(expected) >= 15, "too few populated bins for a meaningful chi^2"
     assert np.median(error / expected) < 0.005, "run too short for a sharp test"
-    result = sign_flip_p_values(per_shard - expected)
-    assert result[1] > 1e-3 and result[2] > 1e-3, _message(per_shard, expected, *result)
+    assert_agrees(per_shard, expected)
 
 
 def test_position_density_detects_a_one_percent_error(position):
@@ -95,8 +85,7 @@ def test_distribution_agrees_cell_by_cell(cells):
     error = per_shard.std(axis=0, ddof=1) / np.sqrt(SHARDS)
     assert len(expected) >= 100, "too few populated cells"
     assert np.median(error / expected) < 0.02, "run too short for a sharp test"
-    result = sign_flip_p_values(per_shard - expected)
-    assert result[1] > 1e-3 and result[2] > 1e-3, _message(per_shard, expected, *result)
+    assert_agrees(per_shard, expected)
 
 
 def test_distribution_detects_a_one_percent_error(cells):

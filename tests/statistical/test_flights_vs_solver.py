@@ -24,7 +24,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 from shard_statistics import sign_flip_p_values
-from solver_runs import MINIMUM_COUNT, SHARDS, shards
+from solver_runs import MINIMUM_COUNT, SHARDS, assert_agrees, shards
 
 from bouncing_ball import flight_time, solver
 from bouncing_ball.histograms import position_moments_summary
@@ -84,20 +84,10 @@ def return_speeds(request):
     return _return_speeds(request.param)
 
 
-def _message(per_shard, expected, chi2_per_dof, p_chi2, p_worst):
-    error = per_shard.std(axis=0, ddof=1) / np.sqrt(SHARDS)
-    z = (per_shard.mean(axis=0) - expected) / error
-    return (
-        f"chi^2/dof = {chi2_per_dof:.3f} (p = {p_chi2:.4f}), worst p = {p_worst:.4f}, "
-        f"{len(expected)} bins, z = {np.round(z, 1)}"
-    )
-
-
 def test_return_speed_law_agrees(return_speeds):
     per_shard, expected = return_speeds
     assert len(expected) >= 300, "too few populated cells for a meaningful chi^2"
-    result = sign_flip_p_values(per_shard - expected)
-    assert result[1] > 1e-3 and result[2] > 1e-3, _message(per_shard, expected, *result)
+    assert_agrees(per_shard, expected)
 
 
 def test_flight_time_density_agrees(flight_times):
@@ -105,8 +95,7 @@ def test_flight_time_density_agrees(flight_times):
     error = per_shard.std(axis=0, ddof=1) / np.sqrt(SHARDS)
     assert len(expected) >= 25, "too few populated bins for a meaningful chi^2"
     assert np.median(error / expected) < 0.03, "run too short for a sharp test"
-    result = sign_flip_p_values(per_shard - expected)
-    assert result[1] > 1e-3 and result[2] > 1e-3, _message(per_shard, expected, *result)
+    assert_agrees(per_shard, expected)
 
 
 def test_flight_time_density_detects_a_one_percent_error(flight_times):
