@@ -20,11 +20,6 @@ def snakemake_has_record(path):
     return Path(".snakemake/metadata", name).exists()
 
 
-def expected_shard(label):
-    """The provenance a shard of r = ``label`` made with this config has."""
-    return {"seed": config["seed"], "code": SHARD_CODE, **settings_of(label)}
-
-
 def settings_of(label):
     return shard_settings(config, label).as_mapping()
 
@@ -33,7 +28,8 @@ def stale_simulation():
     """{file: what differs} of the shards and merged tables of every r the config simulates."""
     stale = {}
     for label in KNOWN_RESTITUTION:
-        shard = expected_shard(label)
+        asked = settings_of(label)
+        shard = {"seed": config["seed"], "code": SHARD_CODE, **asked}
         for path in shard_files(SimpleNamespace(r=label)):
             found = table_differences(path, shard)
             if found:
@@ -43,7 +39,7 @@ def stale_simulation():
             "seed": config["seed"],
             "simulation_code": SHARD_CODE,
             "code": code(stages.MERGE, "merge_shards.py"),
-            **settings_of(label),
+            **asked,
         }
         for table in SIMULATION_TABLES:
             path = f"results/simulation/r{label}/{table}.parquet"
