@@ -37,12 +37,12 @@ SQRT2_3 = math.sqrt(2.0 / 3.0)
 SQRT3_2 = math.sqrt(1.5)
 SQRT1_2 = math.sqrt(0.5)
 
-# Rational fits (see largest_safe_step) to the positive root of the cubic
+# Rational fits (see _fitted_root) to the positive root of the cubic
 # c s^3 = x + v s^2, in units of a = (x/c)^(1/3), with t = |v| / (c a).
 # The forms have the right limits (s/a -> 1 at t = 0; s/a -> t, resp.
 # t^(-1/2), for t -> inf); the constants are least-squares fits of the
-# relative error over a log grid of t.  They only set Halley's starting
-# point: any start within a few per cent gives the same root.
+# relative error over a log grid of t.  They only set the root's start
+# where no previous root is at hand (criterion_root).
 #   v >= 0:  s / a ~ t + (1 + P t) / (1 + (P + 2/3) t + Q t^2 + P t^3)   (0.2 %)
 #   v < 0:   s / a ~ (t + (1 + N3 t) / (1 + N1 t + N2 t^2))^(-1/2)      (0.04 %)
 _P, _Q = 0.44356066, 0.56163652
@@ -67,50 +67,89 @@ def free_flight_step(x, v, dt, normal_r, normal_s):
 
 
 @njit(cache=True, inline="always")
-def largest_safe_step(x, v, c):
-    """The largest step D(x, v) allowed by eq. (criterion).
+def _floor_root(v, c):
+    """s* at x = 0: the root of s^2 (v - c s - s^2/2), 0 for v <= 0."""
+    if v <= 0.0:
+        return 0.0
+    return 2.0 * v / (c + math.sqrt(c * c + 2.0 * v))
 
-    With s = sqrt(Delta) the criterion reads f(s) = x + v s^2 - c s^3 - s^4/2 > 0.
-    By Descartes' rule f has exactly one positive root s*, where f' < 0;
-    returns s*^2 (0 when x <= 0 and v <= 0; x below the smallest normal
-    double counts as 0).
 
-    At x = 0 the root is that of a quadratic.  Otherwise the start is the
-    root of the cubic without the s^4/2 term, from the rational fits above
-    (homogeneous in a and v/c, one division); near the floor, where most
-    steps are taken, that term is a small correction.  Halley's method then
-    converges cubically: two iterations from a start good to ~1 %, and a
-    last step of relative size <= 1e-5 leaves s* good to ~1e-14.  A Newton
-    step stands in where the Halley denominator is not positive (only far
-    from s*), and the iteration stops where f' >= 0 (only on underflow).
-    """
-    if x < _SMALLEST_NORMAL:
-        if v <= 0.0:
-            return 0.0
-        s = 2.0 * v / (c + math.sqrt(c * c + 2.0 * v))  # s^2 (v - c s - s^2/2) = 0
-        return s * s
+@njit(cache=True, inline="always")
+def _fitted_root(x, v, c):
+    """The root of the cubic x + v s^2 - c s^3 (no s^4/2 term), from the rational fits above
+    (homogeneous in a = (x/c)^(1/3) and v/c, one division); x > 0."""
     a3 = x / c
     a = np.cbrt(a3)
     b = v / c
+    a2 = a * a
     if b >= 0.0:
-        a2 = a * a
-        s = b + a * (
+        return b + a * (
             (a3 + _P * a2 * b) / (a3 + b * (a2 * (_P + 2.0 / 3.0) + b * (_Q * a + _P * b)))
         )
-    else:
-        a2 = a * a
-        s = math.sqrt(a3 / (-b + a2 * (a - _N3 * b) / (a2 - b * (_N1 * a - _N2 * b))))
-    for _ in range(100):
-        f = x + s * s * (v - s * (c + 0.5 * s))
-        fp = s * (2.0 * v - s * (3.0 * c + 2.0 * s))
-        if not fp < 0.0:
-            break
-        fpp = 2.0 * v - s * (6.0 * c + 6.0 * s)
-        denominator = 2.0 * fp * fp - f * fpp
-        step = 2.0 * f * fp / denominator if denominator > 0.0 else f / fp
+    return math.sqrt(a3 / (-b + a2 * (a - _N3 * b) / (a2 - b * (_N1 * a - _N2 * b))))
+
+
+ROOT_TOLERANCE = 2.0e-3  # a last Householder step below this (relative) leaves ~its 4th power
+
+
+@njit(cache=True, inline="always")
+def criterion_root(x, v, c, start):
+    """The positive root s* of f(s) = x + v s^2 - c s^3 - s^4/2, eq. (criterion) with
+    s = sqrt(Delta), and the slope f' there: (s*, f'(s*)).
+
+    By Descartes' rule f has exactly one positive root, where f' < 0 (and f' < 0,
+    f'' < 0 on [s*, inf)).  At x = 0 (x below the smallest normal double counts as
+    0) it is that of a quadratic.  Otherwise Householder's third-order step,
+        s -= f (6 f1^2 - 3 f f2) / (6 f1^3 - 6 f f1 f2 + f^2 f3)
+    (f1, f2, f3 the derivatives of f) converges quartically from ``start``: after
+    a step of relative size e about e^4 is left, so it stops after a step
+    <= ROOT_TOLERANCE s (s* to ~1e-11; tests/unit/test_free_flight.py checks the
+    step D = s*^2 to 1e-9 against brentq).  The simulation starts from a
+    prediction off the previous step's root (about two iterations a step, no
+    cube root).  ``start`` <= 0, a start left of the maximum of f (where
+    f1 >= 0) or 60 iterations without convergence restart from the rational
+    fits above (``_fitted_root``).  A Newton step stands in where the
+    Householder denominator is not negative (far from s*), and a step past 0
+    is replaced by halving s.
+    """
+    if x < _SMALLEST_NORMAL:
+        s = _floor_root(v, c)
+        return s, s * (2.0 * v - s * (3.0 * c + 2.0 * s))
+    fitted = not start > 0.0
+    s = _fitted_root(x, v, c) if fitted else start
+    i = 0
+    while True:
+        s2 = s * s
+        f = x + s2 * (v - s * (c + 0.5 * s))
+        f1 = s * (2.0 * v - s * (3.0 * c + 2.0 * s))
+        if not f1 < 0.0 or i == 60:
+            if fitted:  # from the fitted start: only on underflow
+                return s, f1
+            s = _fitted_root(x, v, c)
+            fitted = True
+            i = 0
+            continue
+        f2 = 2.0 * v - s * (6.0 * c + 6.0 * s)
+        f3 = -6.0 * c - 12.0 * s
+        f_f2 = f * f2
+        f1_squared = f1 * f1
+        denominator = f1 * (6.0 * f1_squared - 6.0 * f_f2) + f * f * f3
+        # Householder where its denominator is negative, else Newton
+        step = f * (6.0 * f1_squared - 3.0 * f_f2) / denominator if denominator < 0.0 else f / f1
+        i += 1
+        if not s - step > 0.0:  # overshot past 0: halve instead (f(0) = x > 0)
+            s *= 0.5
+            continue
         s -= step
-        if abs(step) <= 1e-5 * s:
-            break
+        if abs(step) <= ROOT_TOLERANCE * s:
+            return s, f1
+
+
+@njit(cache=True, inline="always")
+def largest_safe_step(x, v, c):
+    """The largest step D(x, v) allowed by eq. (criterion): s*^2 of ``criterion_root``
+    from the fitted start (0 when x <= 0 and v <= 0)."""
+    s, _ = criterion_root(x, v, c, 0.0)
     return s * s
 
 
@@ -229,27 +268,51 @@ def quintic_antiderivative_value(s1, s2, s3, s4, s5, t):
 
 
 @njit(cache=True, inline="always")
-def cubic_level_time(a0, a1, a2, a3, level, t_lo, t_hi, f_lo, f_hi):
-    """The t in [t_lo, t_hi] where m(t) = level, m monotone there and bracketing.
-
-    ``f_lo`` and ``f_hi`` are m - level at the two ends (opposite signs, or
-    f_lo = 0).  Safeguarded Halley iteration from the linear interpolation of
-    the ends: a step that leaves the bracket is replaced by bisection, so it
-    always converges.  It stops after a Halley step below 1e-5 of the bracket
-    where the slope there is at least 0.1 of the bracket's mean slope: then m'
-    changes by < 1e-3 over the step, the step measures the distance to the
-    root and the error left is at rounding (most crossings need one or two
-    steps from the linear start).  Next to a zero of m' (a piece ends where
-    the path turns) a Halley step is short because m' is small, not because
-    the root is near; such a step is replaced by bisection, which stops when
-    the bracket is 1e-10 of its start.
-    """
-    if f_lo == 0.0:
-        return t_lo
-    rising = f_lo < 0.0
+def piece_inverse(t_lo, t_hi, x_lo, x_hi, d_lo, d_hi):
+    """What ``level_time`` needs of a monotone piece [t_lo, t_hi] of the mean path, from
+    x_lo, x_hi and the slopes d_lo, d_hi at its ends (its divisions, done once a piece):
+    (t_lo, width, x_lo, rise, 1 / rise, m0, m1), where m0 and m1 are the end slopes of
+    the inverse t(m) on [0, 1] x [0, 1] (0, 0 where an end slope is below 0.1 of the
+    piece's mean slope, next to a zero of m': the start is then linear)."""
     width = t_hi - t_lo
-    lo, hi = t_lo, t_hi
-    t = t_lo + width * f_lo / (f_lo - f_hi)
+    rise = x_hi - x_lo
+    inv_rise = 1.0 / rise
+    m0 = m1 = 0.0
+    if d_lo * rise * width > 0.1 * rise * rise and d_hi * rise * width > 0.1 * rise * rise:
+        inv = rise / (d_lo * d_hi * width)
+        m0 = d_hi * inv  # (rise / width) / m'(t_lo)
+        m1 = d_lo * inv
+    return t_lo, width, x_lo, rise, inv_rise, m0, m1
+
+
+@njit(cache=True, inline="always")
+def level_time(a0, a1, a2, a3, level, inverse):
+    """The t where the mean path m(t) = level on a monotone piece that brackets it
+    (``inverse``: the piece's ``piece_inverse``).
+
+    The start is the inverse cubic Hermite interpolant t(m) through the piece's
+    ends (their values and slopes 1/m'), or the linear one next to a zero of m'.
+    Safeguarded Halley iteration follows: a step that leaves the bracket is
+    replaced by bisection, so it always converges.  It stops after a Halley
+    step below 1e-3 of the piece where the slope there is at least 0.1 of the
+    piece's mean slope: the error before that step was about the step, and
+    Halley's cubic convergence leaves about its cube, ~1e-9 of the piece
+    (tests/unit/test_free_flight.py checks 1e-8).  Most crossings need one step
+    from the Hermite start.  Next to a zero of m' (a piece ends where the path
+    turns) a Halley step is short because m' is small, not because the root is
+    near; such a step is replaced by bisection, which stops when the bracket is
+    1e-10 of the piece.  The crossings of one piece do not depend on each other,
+    so the processor overlaps them.
+    """
+    t_lo, width, x_lo, rise, inv_rise, m0, m1 = inverse
+    u = (level - x_lo) * inv_rise
+    if u <= 0.0:
+        return t_lo
+    rising = rise > 0.0
+    lo, hi = t_lo, t_lo + width
+    t = t_lo + width * (u * u * (3.0 - 2.0 * u) + u * (1.0 - u) * ((1.0 - u) * m0 - u * m1))
+    if m0 == 0.0:
+        t = t_lo + width * u
     for _ in range(200):
         f = cubic_value(a0, a1, a2, a3, t) - level
         if f == 0.0:
@@ -261,9 +324,9 @@ def cubic_level_time(a0, a1, a2, a3, level, t_lo, t_hi, f_lo, f_hi):
         d1 = cubic_slope(a1, a2, a3, t)
         d2 = 2.0 * a2 + 6.0 * a3 * t
         t_new = t - 2.0 * f * d1 / (2.0 * d1 * d1 - f * d2)
-        short = abs(t_new - t) <= 1e-5 * width
+        short = abs(t_new - t) <= 1e-3 * width
         # not lo < t_new < hi: outside the bracket, or a zero or NaN denominator
-        if not lo < t_new < hi or (short and abs(d1) * width < 0.1 * abs(f_hi - f_lo)):
+        if not lo < t_new < hi or (short and abs(d1) * width < 0.1 * abs(rise)):
             t_new = 0.5 * (lo + hi)  # bisect (also where a step is short only because m' is small)
             if hi - lo <= 1e-10 * width:
                 return t_new
@@ -271,6 +334,13 @@ def cubic_level_time(a0, a1, a2, a3, level, t_lo, t_hi, f_lo, f_hi):
             return t_new
         t = t_new
     return t
+
+
+@njit(cache=True, inline="always")
+def cubic_level_time(a0, a1, a2, a3, level, t_lo, t_hi, x_lo, x_hi, d_lo, d_hi):
+    """The t in [t_lo, t_hi] where m(t) = level, m monotone there from x_lo to x_hi with
+    slopes d_lo, d_hi at the ends, and bracketing (``level_time`` for one crossing)."""
+    return level_time(a0, a1, a2, a3, level, piece_inverse(t_lo, t_hi, x_lo, x_hi, d_lo, d_hi))
 
 
 @njit(cache=True)
@@ -333,7 +403,19 @@ def first_crossing_time(a0, a1, a2, a3, t_end, x_end):
         stop = monotone_piece_end(k, n, t1, t2, t_end)
         m_stop = x_end if stop == t_end else cubic_value(a0, a1, a2, a3, stop)
         if m_stop <= 0.0:
-            return cubic_level_time(a0, a1, a2, a3, 0.0, start, stop, m_start, m_stop)
+            return cubic_level_time(
+                a0,
+                a1,
+                a2,
+                a3,
+                0.0,
+                start,
+                stop,
+                m_start,
+                m_stop,
+                cubic_slope(a1, a2, a3, start),
+                cubic_slope(a1, a2, a3, stop),
+            )
         start = stop
         m_start = m_stop
     return t_end

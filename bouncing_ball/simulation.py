@@ -77,15 +77,16 @@ import numpy as np
 from . import stages
 from .free_flight import (
     bridge_sample,
-    cubic_level_time,
+    criterion_root,
     cubic_slope,
     cubic_value,
     first_crossing_time,
     free_flight_step,
     hermite_cubic,
-    largest_safe_step,
+    level_time,
     mean_path_integrals,
     monotone_piece_end,
+    piece_inverse,
     quintic_antiderivative_value,
     slope_zeros,
     speed_squared_coefficients,
@@ -161,20 +162,23 @@ def _linear_bin_index(value, lo, per_unit, n, edges):
 
 
 @njit(cache=True, inline="always")
-def _tally_position(a, sq, t_a, t_b, x_a, x_b, k, edges, time_in, v2_in):
+def _tally_position(a, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, edges, time_in, v2_in):
     """Add the time and int v^2 dt of the monotone piece [t_a, t_b] to x bins.
 
     ``a`` are the mean path's coefficients, ``sq`` those of S(t) (see
-    ``speed_squared_coefficients``), x_a and x_b the path at the piece's ends
-    and ``k`` the bin of x_a.  The walk crosses one bin edge at a time (no
-    logarithms) and returns the bin of x_b.
+    ``speed_squared_coefficients``), x_a, x_b and d_a, d_b the path and its
+    slope at the piece's ends and ``k`` the bin of x_a.  The walk crosses one
+    bin edge at a time (no logarithms) and returns the bin of x_b.  Each
+    crossing is solved on the whole piece's bracket, not from the last one,
+    so the crossings of a piece are independent of each other and the
+    processor overlaps them.
     """
     a0, a1, a2, a3 = a
     s1, s2, s3, s4, s5 = sq
     n = edges.shape[0] - 1
     t_prev = t_a
-    x_prev = x_a
     s_prev = quintic_antiderivative_value(s1, s2, s3, s4, s5, t_a)
+    inverse = piece_inverse(t_a, t_b, x_a, x_b, d_a, d_b)
     while True:
         if k <= n and x_b >= edges[k]:  # leaves bin k through its upper edge
             level = edges[k]
@@ -184,11 +188,11 @@ def _tally_position(a, sq, t_a, t_b, x_a, x_b, k, edges, time_in, v2_in):
             k_next = k - 1
         else:
             break
-        t_e = cubic_level_time(a0, a1, a2, a3, level, t_prev, t_b, x_prev - level, x_b - level)
+        t_e = level_time(a0, a1, a2, a3, level, inverse)
         s_e = quintic_antiderivative_value(s1, s2, s3, s4, s5, t_e)
         time_in[k] += t_e - t_prev
         v2_in[k] += s_e - s_prev
-        t_prev, x_prev, s_prev = t_e, level, s_e
+        t_prev, s_prev = t_e, s_e
         k = k_next
     s_b = quintic_antiderivative_value(s1, s2, s3, s4, s5, t_b)
     time_in[k] += t_b - t_prev
@@ -229,13 +233,31 @@ def _tally_step(a, dt, tau, x_tau, slope_tau, k, edges, bin_lower, bin_upper, ti
         n_zero, t1, t2 = slope_zeros(a1, a2, a3, tau)
     t_a = 0.0
     x_a = a0
+    d_a = a1
     for piece in range(n_zero + 1):
         t_b = monotone_piece_end(piece, n_zero, t1, t2, tau)
-        x_b = x_tau if t_b == tau else cubic_value(a0, a1, a2, a3, t_b)
-        k = _tally_position(a, sq, t_a, t_b, x_a, x_b, k, edges, time_in, v2_in)
-        t_a = t_b
-        x_a = x_b
+        if t_b == tau:
+            x_b, d_b = x_tau, slope_tau
+        else:  # a zero of m'
+            x_b, d_b = cubic_value(a0, a1, a2, a3, t_b), 0.0
+        k = _tally_position(a, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, edges, time_in, v2_in)
+        t_a, x_a, d_a = t_b, x_b, d_b
     return k
+
+
+# a step this short only happens in a collapse (v ~ 1e-37); much shorter ones overflow the bridge's
+# cubic coefficients (~ x / dt^2) before the speed underflows to zero
+COLLAPSED_STEP = 1.0e-80
+
+
+# What the compiled loop records, by bit of its ``parts`` argument: the benchmark leaves
+# them out one at a time to time each (``python -m benchmarks``); a shard records them all.
+# The collisions, their outgoing speeds, the time and the steps are always recorded.
+MEAN_PATH_INTEGRALS = 1  # int x dt and int x^2 dt
+POSITION = 2  # P(x) and <v^2>_x on the mean path
+JOINT = 4  # P(x, v) from the bridge sample
+FLIGHTS = 8  # flight times and (outgoing, return) speed pairs
+EVERY_TALLY = MEAN_PATH_INTEGRALS | POSITION | JOINT | FLIGHTS
 
 
 # a step this short only happens in a collapse (v ~ 1e-37); much shorter ones overflow the bridge's
@@ -265,6 +287,7 @@ def _run(
     position_velocity_time,
     return_speed_counts,
     scalars,
+    parts,
 ):
     # v_edges: speeds (log); x_edges: heights (log); u_edges: velocities of P(x, v) (linear);
     # f_edges: flight times (log)
@@ -291,6 +314,7 @@ def _run(
     # start at rest one unit above the floor; equilibration forgets this
     x = 1.0
     v = 0.0
+    root, slope_at_root = criterion_root(x, v, c, 0.0)  # s* of eq. (criterion) and f'(s*)
     x_bin = _bin_index(x, x_log_lo, x_per_ln, nx, x_edges)  # kept while recording
     min_root_2delta = 1.0 / min_step_divisor
     delta = max(0.5 * min_root_2delta * min_root_2delta, min_step_floor)
@@ -322,12 +346,18 @@ def _run(
         if steps >= max_steps:
             exhausted = 1
             break
-        dt = largest_safe_step(x, v, c) + delta  # eq. (criterion) plus delta
+        dt = root * root + delta  # eq. (criterion) plus delta
         if not dt > COLLAPSED_STEP:  # below r_c without a floor on delta: the speed is going to 0
             exhausted = 1
             break
         if t + dt > t_stop:
             dt = t_stop - t
+        # the next root starts from a first-order prediction off this one: f(s; x, v) is linear
+        # in x and v and f(root; x, v) = 0, so s ~ root - (x1 - x + root^2 (v1 - v)) / f'(root)
+        # = k0 - k1 x1 - k2 v1, with coefficients ready (division included) before the step
+        k1 = 1.0 / slope_at_root if slope_at_root < 0.0 else 0.0
+        k2 = k1 * root * root
+        k0 = root + k1 * x + k2 * v
         normal_r = rng.standard_normal()
         normal_s = rng.standard_normal()
         x1, v1 = free_flight_step(x, v, dt, normal_r, normal_s)
@@ -343,31 +373,34 @@ def _run(
         steps += 1
         if recording:
             recorded_steps += 1
-            ix, ix2 = mean_path_integrals(a0, a1, a2, a3, dt, tau)
-            int_x += ix
-            int_x2 += ix2
-            x_bin = _tally_step(
-                a,
-                dt,
-                tau,
-                x_tau,
-                v_tau,
-                x_bin,
-                x_edges,
-                x_bin_lower,
-                x_bin_upper,
-                position_time,
-                position_v2_time,
-            )
-            # P(x, v): tau to the cell of (x(s), v(s)) on the bridge, s uniform in [0, tau]
-            s = rng_tally.random() * tau
-            normal_1 = rng_tally.standard_normal()
-            normal_2 = rng_tally.standard_normal()
-            x_s, v_s = bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2)
-            position_velocity_time[
-                _bin_index(x_s, x_log_lo, x_per_ln, nx, x_edges),
-                _linear_bin_index(v_s, u_lo, u_per_unit, nu, u_edges),
-            ] += tau
+            if parts & MEAN_PATH_INTEGRALS:
+                ix, ix2 = mean_path_integrals(a0, a1, a2, a3, dt, tau)
+                int_x += ix
+                int_x2 += ix2
+            if parts & POSITION:
+                x_bin = _tally_step(
+                    a,
+                    dt,
+                    tau,
+                    x_tau,
+                    v_tau,
+                    x_bin,
+                    x_edges,
+                    x_bin_lower,
+                    x_bin_upper,
+                    position_time,
+                    position_v2_time,
+                )
+            if parts & JOINT:
+                # P(x, v): tau to the cell of (x(s), v(s)) on the bridge, s uniform in [0, tau]
+                s = rng_tally.random() * tau
+                normal_1 = rng_tally.standard_normal()
+                normal_2 = rng_tally.standard_normal()
+                x_s, v_s = bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2)
+                position_velocity_time[
+                    _bin_index(x_s, x_log_lo, x_per_ln, nx, x_edges),
+                    _linear_bin_index(v_s, u_lo, u_per_unit, nu, u_edges),
+                ] += tau
         t += tau
         since_collision += tau
         if collided:
@@ -377,7 +410,7 @@ def _run(
             if recording:
                 collisions += 1
                 speed_counts[out_bin] += 1
-                if collided_before:  # the flight that ends here
+                if collided_before and parts & FLIGHTS:  # the flight that ends here
                     flights += 1
                     flight_time_sum += since_collision
                     flight_time_squared_sum += since_collision * since_collision
@@ -395,9 +428,12 @@ def _run(
             v = v_out
             root_2delta = v_out * min_root_2delta
             delta = max(0.5 * root_2delta * root_2delta, min_step_floor)  # below r_c: regularises
+            root, slope_at_root = criterion_root(x, v, c, 0.0)  # closed form at x = 0
         else:
             x = x1
             v = v1
+            predicted = k0 - k1 * x1 - k2 * v1
+            root, slope_at_root = criterion_root(x, v, c, predicted if predicted > 0.0 else root)
 
     scalars[_TIME] = t if recording else 0.0
     scalars[_COLLISIONS] = collisions
@@ -411,12 +447,16 @@ def _run(
 
 
 def simulate_shard(
-    restitution: float, seed_sequence: np.random.SeedSequence, settings: ShardSettings
+    restitution: float,
+    seed_sequence: np.random.SeedSequence,
+    settings: ShardSettings,
+    parts: int = EVERY_TALLY,
 ) -> ShardTallies:
     """Run one shard of r = ``restitution`` and return its tallies (pure: no I/O).
 
     ``settings.min_step_floor`` is a lower bound on delta (0: the paper's rule
     alone); below r_c it is what keeps the simulation going (module docstring).
+    ``parts`` leaves tallies out (for the benchmark's breakdown); a shard records them all.
     """
     if not 0.0 < restitution < 1.0:
         raise ValueError(f"restitution must lie in (0, 1), got {restitution}")
@@ -444,5 +484,6 @@ def simulate_shard(
         arrays["position_velocity_time"],
         arrays["return_speed_counts"],
         arrays["scalars"],
+        parts,
     )
     return ShardTallies.from_loop(settings, arrays)
