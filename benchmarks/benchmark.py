@@ -5,6 +5,11 @@ Measured here (about 1 minute; ``--scaling`` adds about 2.5 more, outside that b
     config's c and delta rule (c = 3, 1/500) and with the paper's c = 5:
     collisions and simulated time per CPU second, steps per collision, ns per
     step, and the CPU per simulated time the default c saves;
+  * where a step's time goes at r = 1/2 and c = 5, 3 (``breakdown``): ns per step of the
+    stepping and of each tally, of the criterion root and of the normals, and collisions
+    per CPU second against issue 18's hand-tuned C loop (its figures, and the loop itself,
+    ``reference/hand_tuned.c``, measured in the same run; targets: 0.9 of it stepping,
+    0.8 with every tally);
   * the same loop in plain C (``reference/shard_loop.c``, gcc -O3, numpy's
     own ziggurat on the same PCG64 stream, so the tallies must be identical):
     numba's speed over C's at r = 1/2, with the tallies and stepping only
@@ -37,6 +42,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+from .breakdown import breakdown, print_breakdown
 
 SINGLE_THREAD = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
@@ -491,6 +498,8 @@ def _print_all(results):
             for r in THROUGHPUT_TIMES
         )
         print(f"CPU per simulated time, c = {default:g} against c = {paper:g}: {saving} less")
+    print()
+    print_breakdown(results["breakdown"])
     ref = results["reference"]
     print()
     if "skipped" in ref:
@@ -578,6 +587,7 @@ def main(argv=None):
     solver_result = solver_benchmark()  # first: timed in a process that has run nothing else
     results = {
         "simulation": simulation_benchmark(),
+        "breakdown": breakdown(SHARD_SETTINGS),
         "reference": reference_benchmark(),
         "efficiency": efficiency_benchmark(),
         "efficiency_paper_c": efficiency_benchmark({"criterion_c": PAPER_CRITERION_C}),

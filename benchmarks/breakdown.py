@@ -1,0 +1,209 @@
+"""Where a step of the shard loop spends its time, and how it compares with issue 18's
+hand-tuned C loop (``hand_tuned_loop``): part of ``python -m benchmarks``.
+
+Two kinds of measurement, both CPU time on one core, best of ``repeats``:
+  * the shard loop itself (``simulation.simulate_shard``) with its tallies switched on
+    one at a time (its ``parts`` argument): "stepping" records what the hand-tuned C loop
+    records (collisions, their outgoing speeds, time, steps, int x dt and int x^2 dt),
+    and each tally's cost is the loop's ns per step with it minus without it;
+  * the two pieces of a step that cannot be switched off, timed on their own: the step-size
+    root of eq. (criterion) (``free_flight.criterion_root``, from the loop's warm start and
+    from the cold start, over the states of a real trajectory, which ``_trajectory``
+    records) and the two normals a step draws from numpy's Generator.  These run
+    alongside the step's other arithmetic in the loop, so they bound, not add up to, the
+    stepping time.
+"""
+
+import time
+
+import numpy as np
+
+from bouncing_ball.free_flight import (
+    criterion_root,
+    cubic_slope,
+    first_crossing_time,
+    free_flight_step,
+    hermite_cubic,
+)
+from bouncing_ball.jit import njit
+from bouncing_ball.simulation import (
+    FLIGHTS,
+    JOINT,
+    MEAN_PATH_INTEGRALS,
+    POSITION,
+    shard_seed_sequence,
+    simulate_shard,
+)
+
+# issue 18's figures for its hand-tuned C loop at r = 1/2, measured on this project's 2-core
+# machine: collisions per CPU second, by c
+ISSUE_HAND_TUNED = {5.0: 8.6e5, 3.0: 1.09e6}
+TARGET_EVERY_TALLY = 0.8  # of the hand-tuned loop's collisions per CPU second
+TARGET_STEPPING = 0.9
+
+PARTS = (
+    ("stepping (collisions, P(0,v), int x, int x^2)", MEAN_PATH_INTEGRALS),
+    ("+ P(x) and <v^2>_x", MEAN_PATH_INTEGRALS | POSITION),
+    ("+ P(x, v)", MEAN_PATH_INTEGRALS | JOINT),
+    ("+ flight times and return speeds", MEAN_PATH_INTEGRALS | FLIGHTS),
+    ("every tally", MEAN_PATH_INTEGRALS | POSITION | JOINT | FLIGHTS),
+)
+
+
+def _best_cpu(function, repeats):
+    best, result = float("inf"), None
+    for _ in range(repeats):
+        started = time.process_time()
+        result = function()
+        best = min(best, time.process_time() - started)
+    return best, result
+
+
+def loop_parts(settings, r=0.5, recorded_time=1.0e6, repeats=3):
+    """ns per step and collisions per CPU s of the loop with each set of ``PARTS``."""
+    stream = shard_seed_sequence(1, "0.5", 0)
+    shard = settings.replace(shard_time=recorded_time)
+    simulate_shard(r, stream, shard.replace(shard_time=10.0))  # compile or load
+    rows = []
+    for name, parts in PARTS:
+        seconds, tallies = _best_cpu(lambda p=parts: simulate_shard(r, stream, shard, p), repeats)
+        rows.append(
+            {
+                "part": name,
+                "parts": parts,
+                "ns_per_step": 1e9 * seconds / tallies.steps,
+                "collisions_per_cpu_second": tallies.collisions / seconds,
+            }
+        )
+    stepping = rows[0]["ns_per_step"]
+    for row in rows[1:]:
+        row["extra_ns_per_step"] = row["ns_per_step"] - stepping
+    return rows
+
+
+@njit(cache=True)
+def _trajectory(rng, steps, r, c, min_step_divisor):
+    """The states (x, v) and the loop's warm starts of ``steps`` steps of the stepping
+    alone (the loop's eq. (criterion), free flight and collision rule), for timing the root."""
+    xs = np.empty(steps)
+    vs = np.empty(steps)
+    starts = np.empty(steps)
+    x, v = 1.0, 0.0
+    root, slope = criterion_root(x, v, c, 0.0)
+    min_root_2delta = 1.0 / min_step_divisor
+    delta = 0.5 * min_root_2delta * min_root_2delta
+    start = 0.0
+    for i in range(steps):
+        xs[i], vs[i], starts[i] = x, v, start
+        dt = root * root + delta
+        k1 = 1.0 / slope if slope < 0.0 else 0.0
+        k2 = k1 * root * root
+        k0 = root + k1 * x + k2 * v
+        x1, v1 = free_flight_step(x, v, dt, rng.standard_normal(), rng.standard_normal())
+        if x1 < 0.0:
+            a0, a1, a2, a3 = hermite_cubic(x, v, x1, v1, dt)
+            tau = first_crossing_time(a0, a1, a2, a3, dt, x1)
+            x, v = 0.0, r * abs(cubic_slope(a1, a2, a3, tau))
+            root_2delta = v * min_root_2delta
+            delta = 0.5 * root_2delta * root_2delta
+            start = 0.0
+        else:
+            x, v = x1, v1
+            predicted = k0 - k1 * x1 - k2 * v1
+            start = predicted if predicted > 0.0 else root
+        root, slope = criterion_root(x, v, c, start)
+    return xs, vs, starts
+
+
+@njit(cache=True)
+def _roots(xs, vs, starts, c):
+    total = 0.0
+    for i in range(xs.shape[0]):
+        total += criterion_root(xs[i], vs[i], c, starts[i])[0]
+    return total
+
+
+@njit(cache=True)
+def _normals(rng, steps):
+    total = 0.0
+    for _ in range(steps):
+        total += rng.standard_normal() + rng.standard_normal()
+    return total
+
+
+def step_pieces(settings, r=0.5, steps=2_000_000, repeats=3):
+    """ns per step of the criterion root (warm and cold start) and of two normals."""
+    c = settings.criterion_c
+    rng = np.random.Generator(np.random.PCG64(1))
+    xs, vs, starts = _trajectory(rng, steps, r, c, settings.min_step_divisor)
+    cold = np.zeros(steps)
+    _roots(xs[:10], vs[:10], starts[:10], c)
+    _normals(rng, 10)
+    warm_seconds, _ = _best_cpu(lambda: _roots(xs, vs, starts, c), repeats)
+    cold_seconds, _ = _best_cpu(lambda: _roots(xs, vs, cold, c), repeats)
+    normal_seconds, _ = _best_cpu(lambda: _normals(rng, steps), repeats)
+    return {
+        "criterion_root_ns": 1e9 * warm_seconds / steps,
+        "criterion_root_cold_start_ns": 1e9 * cold_seconds / steps,
+        "two_normals_ns": 1e9 * normal_seconds / steps,
+    }
+
+
+def breakdown(settings, criterion_cs=(5.0, 3.0), r=0.5):
+    """Per c: the loop's parts, the root and the normals, and the comparison with the
+    hand-tuned C loop (the issue's figures, and the loop itself measured here when gcc is
+    at hand)."""
+    from . import hand_tuned_loop
+
+    results = []
+    for c in criterion_cs:
+        shard = settings.replace(criterion_c=c)
+        rows = loop_parts(shard, r)
+        row = {"r": r, "criterion_c": c, "parts": rows, **step_pieces(shard, r)}
+        ours = {"stepping": rows[0], "every tally": rows[-1]}
+        references = {"issue": ISSUE_HAND_TUNED[c]}
+        try:
+            measured = min(
+                (hand_tuned_loop.run(r, c, 2.0e6) for _ in range(3)),
+                key=lambda result: result["cpu_seconds"],
+            )
+            references["measured here"] = measured["collisions_per_cpu_second"]
+        except (RuntimeError, OSError) as error:  # no compiler
+            row["hand_tuned_skipped"] = str(error).splitlines()[0]
+        row["against_hand_tuned"] = {
+            source: {
+                case: ours[case]["collisions_per_cpu_second"] / rate
+                for case in ("stepping", "every tally")
+            }
+            for source, rate in references.items()
+        }
+        row["hand_tuned_collisions_per_cpu_second"] = references
+        results.append(row)
+    return results
+
+
+def print_breakdown(results):
+    print("Where a step goes, r = 1/2 (ns per step, CPU, one core; 'extra': over stepping)")
+    for row in results:
+        print(f"  c = {row['criterion_c']:g}")
+        for part in row["parts"]:
+            extra = part.get("extra_ns_per_step")
+            print(
+                f"    {part['part']:<48} {part['ns_per_step']:6.1f} ns/step"
+                + (f" (extra {extra:5.1f})" if extra is not None else "")
+                + f"  {part['collisions_per_cpu_second']:.3g} collisions/CPU s"
+            )
+        print(
+            f"    on their own: the criterion root {row['criterion_root_ns']:.1f} ns/step from the loop's "
+            f"warm start ({row['criterion_root_cold_start_ns']:.1f} from the cold start), two normals "
+            f"{row['two_normals_ns']:.1f} ns/step"
+        )
+        for source, rate in row["hand_tuned_collisions_per_cpu_second"].items():
+            ratios = row["against_hand_tuned"][source]
+            print(
+                f"    against the hand-tuned C loop ({source}: {rate:.3g} collisions/CPU s): stepping "
+                f"{ratios['stepping']:.2f} (target {TARGET_STEPPING}), every tally "
+                f"{ratios['every tally']:.2f} (target {TARGET_EVERY_TALLY})"
+            )
+        if "hand_tuned_skipped" in row:
+            print(f"    hand-tuned C loop not measured here: {row['hand_tuned_skipped']}")
