@@ -4,9 +4,11 @@
 and the free-flight functions it calls, operation for operation, and draws its
 normals with numpy's own C ziggurat (``random_standard_normal`` of
 libnpyrandom.a) from the same PCG64 stream as ``simulate_shard``; so on the
-same seed sequence ``reference_shard`` returns the same tallies.  It is the
-yardstick of the performance target (numba at >= 90 % of a plain C loop) and a
-cross-check of the compiled code; the workflow does not use it.
+same seed sequence ``reference_shard`` returns the same tallies.  It records
+every tally, as ``simulate_shard`` does by default (``parts=EVERY_TALLY``; the
+C loop has no ``parts`` mask).  It is the yardstick of the performance target
+(numba at >= 90 % of a plain C loop) and a cross-check of the compiled code;
+the workflow does not use it.
 
 ``build`` compiles it with gcc (-O3 -march=native, and -ffp-contract=off:
 numba does not fuse multiply-adds, so the C must not either) into a folder
@@ -150,8 +152,8 @@ def reference_shard(
     settings: ShardSettings,
     library=None,
 ) -> ShardTallies:
-    """``simulation.simulate_shard``, run by the C reference (``library``: a built
-    shared library, by default ``build()``)."""
+    """``simulation.simulate_shard`` with every tally (its default ``parts``), run by the C
+    reference (``library``: a built shared library, by default ``build()``)."""
     if not 0.0 < restitution < 1.0:
         raise ValueError(f"restitution must lie in (0, 1), got {restitution}")
     function = _load(str(library if library is not None else build()))

@@ -4,9 +4,10 @@
  * What it is: a line-by-line translation of the numba-compiled shard loop
  * ``bouncing_ball.simulation._run`` and of every numba function it calls:
  *
- *   bouncing_ball/free_flight.py: free_flight_step, largest_safe_step,
- *       hermite_cubic, cubic_value, cubic_slope, mean_path_integrals,
- *       speed_squared_coefficients, quintic_antiderivative_value,
+ *   bouncing_ball/free_flight.py: free_flight_step, _floor_root, _fitted_root,
+ *       criterion_root, hermite_cubic, cubic_value, cubic_slope,
+ *       mean_path_integrals, speed_squared_coefficients,
+ *       quintic_antiderivative_value, piece_inverse, level_time,
  *       cubic_level_time, slope_zeros, monotone_piece_end, first_crossing_time,
  *       bridge_sample
  *   bouncing_ball/simulation.py: _bin_index, _linear_bin_index, _tally_position,
@@ -17,12 +18,20 @@
  * parenthesisation, same constants, ``np.cbrt`` -> cbrt, ``math.log`` -> log,
  * Python's min/max -> py_min/py_max, which keep Python's choice between equal
  * arguments), so with the FMA contraction switched off (numba does not fuse
- * multiply-adds) it gives bit-identical tallies.  The normals come from numpy's
- * own C generator, ``random_standard_normal`` of libnpyrandom.a, called on the
- * bit generator that Python passes in (``np.random.PCG64(seed).ctypes.bit_generator``),
- * i.e. the same ziggurat that numba's ``Generator.standard_normal`` ports, on
- * the same stream.  The P(x, v) draws (a uniform and two normals per recorded step)
- * come likewise from a second bit generator, ``simulation.tally_seed_sequence``'s,
+ * multiply-adds) it gives bit-identical tallies.  Where Python returns a tuple
+ * the C returns a struct (piece_inverse) or the first value with the second
+ * through a pointer (criterion_root, whose (s*, f'(s*)) the loop carries from
+ * step to step as root, slope_at_root, with the predictor k0, k1, k2 of the next
+ * step's start computed before the step, as in ``_run``).  ``_run``'s last
+ * argument ``parts`` (a bitmask of the tallies, for the benchmark's breakdown)
+ * has no counterpart: this loop always records everything, i.e. it is
+ * ``_run`` with parts = EVERY_TALLY, which is what ``simulate_shard`` passes
+ * by default.  The normals come from numpy's own C generator,
+ * ``random_standard_normal`` of libnpyrandom.a, called on the bit generator that
+ * Python passes in (``np.random.PCG64(seed).ctypes.bit_generator``), i.e. the
+ * same ziggurat that numba's ``Generator.standard_normal`` ports, on the same
+ * stream.  The P(x, v) draws (a uniform and two normals per recorded step) come
+ * likewise from a second bit generator, ``tallies.tally_seed_sequence``'s,
  * with numpy's ``random_standard_uniform`` (= numba's ``Generator.random``).
  *
  * What it is for: the yardstick of the performance target "the numba simulation
@@ -30,15 +39,15 @@
  * (gcc -O3, a fast generator)", and a cross-check of the compiled loop.  It is
  * not used by the workflow.
  *
- * How it is built and run: ``bouncing_ball.reference_loop.build()`` compiles it with
+ * How it is built and run: ``benchmarks.reference_loop.build()`` compiles it with
  *
  *   gcc -O3 -march=native -ffp-contract=off -fPIC -shared -std=c99
  *       -I<numpy.get_include()> -I<Python include> shard_loop.c
  *       <numpy>/random/lib/libnpyrandom.a -lm -o shard_loop.so
  *
  * into a cache folder keyed on this file's hash and the flags, and
- * ``reference_loop.reference_shard`` (same arguments as
- * ``simulation.simulate_shard``) calls ``bouncing_ball_shard_loop`` via ctypes.
+ * ``reference_loop.reference_shard`` (the arguments of ``simulation.simulate_shard``
+ * but ``parts``, and the library) calls ``bouncing_ball_shard_loop`` via ctypes.
  * No allocation happens inside the loop (the two bin-bound arrays are
  * allocated once before it, as np.empty is in ``_run``).
  */
@@ -62,6 +71,7 @@
 #define FIT_N2 0.00211799
 #define FIT_N3 0.06071102
 #define SMALLEST_NORMAL DBL_MIN /* np.finfo(np.float64).tiny */
+#define ROOT_TOLERANCE 2.0e-3
 
 /* simulation.py */
 #define COLLAPSED_STEP 1.0e-80
@@ -91,39 +101,72 @@ static inline void free_flight_step(double x, double v, double dt, double normal
     *v_new = v - dt + root_2dt * normal_r;
 }
 
-static inline double largest_safe_step(double x, double v, double c)
+/* _floor_root: s* at x = 0, the root of s^2 (v - c s - s^2/2), 0 for v <= 0 */
+static inline double floor_root(double v, double c)
 {
-    double s;
-    if (x < SMALLEST_NORMAL) {
-        if (v <= 0.0)
-            return 0.0;
-        s = 2.0 * v / (c + sqrt(c * c + 2.0 * v));
-        return s * s;
-    }
+    if (v <= 0.0)
+        return 0.0;
+    return 2.0 * v / (c + sqrt(c * c + 2.0 * v));
+}
+
+/* _fitted_root: the root of the cubic x + v s^2 - c s^3 from the rational fits; x > 0 */
+static inline double fitted_root(double x, double v, double c)
+{
     double a3 = x / c;
     double a = cbrt(a3);
     double b = v / c;
+    double a2 = a * a;
     if (b >= 0.0) {
-        double a2 = a * a;
-        s = b + a * ((a3 + FIT_P * a2 * b)
-                     / (a3 + b * (a2 * (FIT_P + 2.0 / 3.0) + b * (FIT_Q * a + FIT_P * b))));
-    } else {
-        double a2 = a * a;
-        s = sqrt(a3 / (-b + a2 * (a - FIT_N3 * b) / (a2 - b * (FIT_N1 * a - FIT_N2 * b))));
+        return b + a * ((a3 + FIT_P * a2 * b)
+                        / (a3 + b * (a2 * (FIT_P + 2.0 / 3.0) + b * (FIT_Q * a + FIT_P * b))));
     }
-    for (int i = 0; i < 100; i++) {
-        double f = x + s * s * (v - s * (c + 0.5 * s));
-        double fp = s * (2.0 * v - s * (3.0 * c + 2.0 * s));
-        if (!(fp < 0.0))
-            break;
-        double fpp = 2.0 * v - s * (6.0 * c + 6.0 * s);
-        double denominator = 2.0 * fp * fp - f * fpp;
-        double step = denominator > 0.0 ? 2.0 * f * fp / denominator : f / fp;
+    return sqrt(a3 / (-b + a2 * (a - FIT_N3 * b) / (a2 - b * (FIT_N1 * a - FIT_N2 * b))));
+}
+
+/* criterion_root: returns the positive root s* of f(s) = x + v s^2 - c s^3 - s^4/2 and
+   sets *slope_out to f'(s*) (Python returns the pair) */
+static inline double criterion_root(double x, double v, double c, double start, double *slope_out)
+{
+    if (x < SMALLEST_NORMAL) {
+        double s = floor_root(v, c);
+        *slope_out = s * (2.0 * v - s * (3.0 * c + 2.0 * s));
+        return s;
+    }
+    int fitted = !(start > 0.0);
+    double s = fitted ? fitted_root(x, v, c) : start;
+    int i = 0;
+    for (;;) {
+        double s2 = s * s;
+        double f = x + s2 * (v - s * (c + 0.5 * s));
+        double f1 = s * (2.0 * v - s * (3.0 * c + 2.0 * s));
+        if (!(f1 < 0.0) || i == 60) {
+            if (fitted) { /* from the fitted start: only on underflow */
+                *slope_out = f1;
+                return s;
+            }
+            s = fitted_root(x, v, c);
+            fitted = 1;
+            i = 0;
+            continue;
+        }
+        double f2 = 2.0 * v - s * (6.0 * c + 6.0 * s);
+        double f3 = -6.0 * c - 12.0 * s;
+        double f_f2 = f * f2;
+        double f1_squared = f1 * f1;
+        double denominator = f1 * (6.0 * f1_squared - 6.0 * f_f2) + f * f * f3;
+        /* Householder where its denominator is negative, else Newton */
+        double step = denominator < 0.0 ? f * (6.0 * f1_squared - 3.0 * f_f2) / denominator : f / f1;
+        i += 1;
+        if (!(s - step > 0.0)) { /* overshot past 0: halve instead (f(0) = x > 0) */
+            s *= 0.5;
+            continue;
+        }
         s -= step;
-        if (fabs(step) <= 1e-5 * s)
-            break;
+        if (fabs(step) <= ROOT_TOLERANCE * s) {
+            *slope_out = f1;
+            return s;
+        }
     }
-    return s * s;
 }
 
 static inline void hermite_cubic(double x0, double v0, double x1, double v1, double dt,
@@ -204,15 +247,42 @@ static inline double quintic_antiderivative_value(double s1, double s2, double s
     return t * (s1 + t * (s2 + t * (s3 + t * (s4 + t * s5))));
 }
 
-static inline double cubic_level_time(double a0, double a1, double a2, double a3, double level,
-                                      double t_lo, double t_hi, double f_lo, double f_hi)
+/* piece_inverse: what level_time needs of a monotone piece (Python returns the 7-tuple
+   (t_lo, width, x_lo, rise, inv_rise, m0, m1)) */
+typedef struct {
+    double t_lo, width, x_lo, rise, inv_rise, m0, m1;
+} piece_inverse_t;
+
+static inline piece_inverse_t piece_inverse(double t_lo, double t_hi, double x_lo, double x_hi,
+                                            double d_lo, double d_hi)
 {
-    if (f_lo == 0.0)
-        return t_lo;
-    int rising = f_lo < 0.0;
     double width = t_hi - t_lo;
-    double lo = t_lo, hi = t_hi;
-    double t = t_lo + width * f_lo / (f_lo - f_hi);
+    double rise = x_hi - x_lo;
+    double inv_rise = 1.0 / rise;
+    double m0, m1;
+    m0 = m1 = 0.0;
+    if (d_lo * rise * width > 0.1 * rise * rise && d_hi * rise * width > 0.1 * rise * rise) {
+        double inv = rise / (d_lo * d_hi * width);
+        m0 = d_hi * inv; /* (rise / width) / m'(t_lo) */
+        m1 = d_lo * inv;
+    }
+    piece_inverse_t inverse = {t_lo, width, x_lo, rise, inv_rise, m0, m1};
+    return inverse;
+}
+
+static inline double level_time(double a0, double a1, double a2, double a3, double level,
+                                piece_inverse_t inverse)
+{
+    double t_lo = inverse.t_lo, width = inverse.width, x_lo = inverse.x_lo, rise = inverse.rise;
+    double inv_rise = inverse.inv_rise, m0 = inverse.m0, m1 = inverse.m1;
+    double u = (level - x_lo) * inv_rise;
+    if (u <= 0.0)
+        return t_lo;
+    int rising = rise > 0.0;
+    double lo = t_lo, hi = t_lo + width;
+    double t = t_lo + width * (u * u * (3.0 - 2.0 * u) + u * (1.0 - u) * ((1.0 - u) * m0 - u * m1));
+    if (m0 == 0.0)
+        t = t_lo + width * u;
     for (int i = 0; i < 200; i++) {
         double f = cubic_value(a0, a1, a2, a3, t) - level;
         if (f == 0.0)
@@ -224,9 +294,9 @@ static inline double cubic_level_time(double a0, double a1, double a2, double a3
         double d1 = cubic_slope(a1, a2, a3, t);
         double d2 = 2.0 * a2 + 6.0 * a3 * t;
         double t_new = t - 2.0 * f * d1 / (2.0 * d1 * d1 - f * d2);
-        int is_short = fabs(t_new - t) <= 1e-5 * width;
+        int is_short = fabs(t_new - t) <= 1e-3 * width;
         /* !(lo < t_new < hi): outside the bracket, or a zero or NaN denominator */
-        if (!(lo < t_new && t_new < hi) || (is_short && fabs(d1) * width < 0.1 * fabs(f_hi - f_lo))) {
+        if (!(lo < t_new && t_new < hi) || (is_short && fabs(d1) * width < 0.1 * fabs(rise))) {
             t_new = 0.5 * (lo + hi); /* bisect (also where a step is short only because m' is small) */
             if (hi - lo <= 1e-10 * width)
                 return t_new;
@@ -236,6 +306,13 @@ static inline double cubic_level_time(double a0, double a1, double a2, double a3
         t = t_new;
     }
     return t;
+}
+
+static inline double cubic_level_time(double a0, double a1, double a2, double a3, double level,
+                                      double t_lo, double t_hi, double x_lo, double x_hi,
+                                      double d_lo, double d_hi)
+{
+    return level_time(a0, a1, a2, a3, level, piece_inverse(t_lo, t_hi, x_lo, x_hi, d_lo, d_hi));
 }
 
 /* the zeros of m'(t) strictly inside (0, t_end): returns their count, sets t1 < t2 */
@@ -308,7 +385,8 @@ static inline double first_crossing_time(double a0, double a1, double a2, double
         double stop = monotone_piece_end(k, n, t1, t2, t_end);
         double m_stop = stop == t_end ? x_end : cubic_value(a0, a1, a2, a3, stop);
         if (m_stop <= 0.0)
-            return cubic_level_time(a0, a1, a2, a3, 0.0, start, stop, m_start, m_stop);
+            return cubic_level_time(a0, a1, a2, a3, 0.0, start, stop, m_start, m_stop,
+                                    cubic_slope(a1, a2, a3, start), cubic_slope(a1, a2, a3, stop));
         start = stop;
         m_start = m_stop;
     }
@@ -370,13 +448,13 @@ static inline int64_t bin_index(double value, double log_lo, double per_ln, int6
 
 /* edges has n + 1 entries */
 static inline int64_t tally_position(double a0, double a1, double a2, double a3, quintic sq,
-                                     double t_a, double t_b, double x_a, double x_b, int64_t k,
-                                     const double *edges, int64_t n, double *time_in,
-                                     double *v2_in)
+                                     double t_a, double t_b, double x_a, double x_b, double d_a,
+                                     double d_b, int64_t k, const double *edges, int64_t n,
+                                     double *time_in, double *v2_in)
 {
     double t_prev = t_a;
-    double x_prev = x_a;
     double s_prev = quintic_antiderivative_value(sq.s1, sq.s2, sq.s3, sq.s4, sq.s5, t_a);
+    piece_inverse_t inverse = piece_inverse(t_a, t_b, x_a, x_b, d_a, d_b);
     for (;;) {
         double level;
         int64_t k_next;
@@ -389,12 +467,11 @@ static inline int64_t tally_position(double a0, double a1, double a2, double a3,
         } else {
             break;
         }
-        double t_e = cubic_level_time(a0, a1, a2, a3, level, t_prev, t_b, x_prev - level, x_b - level);
+        double t_e = level_time(a0, a1, a2, a3, level, inverse);
         double s_e = quintic_antiderivative_value(sq.s1, sq.s2, sq.s3, sq.s4, sq.s5, t_e);
         time_in[k] += t_e - t_prev;
         v2_in[k] += s_e - s_prev;
         t_prev = t_e;
-        x_prev = level;
         s_prev = s_e;
         k = k_next;
     }
@@ -434,12 +511,22 @@ static inline int64_t tally_step(double a0, double a1, double a2, double a3, dou
     }
     double t_a = 0.0;
     double x_a = a0;
+    double d_a = a1;
     for (int piece = 0; piece < n_zero + 1; piece++) {
         double t_b = monotone_piece_end(piece, n_zero, t1, t2, tau);
-        double x_b = t_b == tau ? x_tau : cubic_value(a0, a1, a2, a3, t_b);
-        k = tally_position(a0, a1, a2, a3, sq, t_a, t_b, x_a, x_b, k, edges, n, time_in, v2_in);
+        double x_b, d_b;
+        if (t_b == tau) {
+            x_b = x_tau;
+            d_b = slope_tau;
+        } else { /* a zero of m' */
+            x_b = cubic_value(a0, a1, a2, a3, t_b);
+            d_b = 0.0;
+        }
+        k = tally_position(a0, a1, a2, a3, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, edges, n, time_in,
+                           v2_in);
         t_a = t_b;
         x_a = x_b;
+        d_a = d_b;
     }
     return k;
 }
@@ -488,6 +575,8 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
     /* start at rest one unit above the floor; equilibration forgets this */
     double x = 1.0;
     double v = 0.0;
+    double slope_at_root;
+    double root = criterion_root(x, v, c, 0.0, &slope_at_root); /* s* of eq. (criterion), f'(s*) */
     int64_t x_bin = bin_index(x, x_log_lo, x_per_ln, nx, x_edges); /* kept while recording */
     double min_root_2delta = 1.0 / min_step_divisor;
     double delta = py_max(0.5 * min_root_2delta * min_root_2delta, min_step_floor);
@@ -521,13 +610,19 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
             exhausted = 1;
             break;
         }
-        double dt = largest_safe_step(x, v, c) + delta; /* eq. (criterion) plus delta */
+        double dt = root * root + delta; /* eq. (criterion) plus delta */
         if (!(dt > COLLAPSED_STEP)) { /* below r_c without a floor on delta */
             exhausted = 1;
             break;
         }
         if (t + dt > t_stop)
             dt = t_stop - t;
+        /* the next root starts from a first-order prediction off this one: f(s; x, v) is linear
+           in x and v and f(root; x, v) = 0, so s ~ root - (x1 - x + root^2 (v1 - v)) / f'(root)
+           = k0 - k1 x1 - k2 v1, with coefficients ready (division included) before the step */
+        double k1 = slope_at_root < 0.0 ? 1.0 / slope_at_root : 0.0;
+        double k2 = k1 * root * root;
+        double k0 = root + k1 * x + k2 * v;
         double normal_r = random_standard_normal(rng);
         double normal_s = random_standard_normal(rng);
         double x1, v1;
@@ -548,6 +643,7 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
         steps += 1;
         if (recording) {
             recorded_steps += 1;
+            /* every part of parts = EVERY_TALLY: MEAN_PATH_INTEGRALS, POSITION, JOINT */
             double ix, ix2;
             mean_path_integrals(a0, a1, a2, a3, dt, tau, &ix, &ix2);
             int_x += ix;
@@ -573,7 +669,7 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
             if (recording) {
                 collisions += 1;
                 speed_counts[out_bin] += 1;
-                if (collided_before) { /* the flight that ends here */
+                if (collided_before) { /* the flight that ends here (parts & FLIGHTS: always) */
                     flights += 1;
                     flight_time_sum += since_collision;
                     flight_time_squared_sum += since_collision * since_collision;
@@ -590,9 +686,12 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
             v = v_out;
             double root_2delta = v_out * min_root_2delta;
             delta = py_max(0.5 * root_2delta * root_2delta, min_step_floor); /* below r_c: regularises */
+            root = criterion_root(x, v, c, 0.0, &slope_at_root); /* closed form at x = 0 */
         } else {
             x = x1;
             v = v1;
+            double predicted = k0 - k1 * x1 - k2 * v1;
+            root = criterion_root(x, v, c, predicted > 0.0 ? predicted : root, &slope_at_root);
         }
     }
 
