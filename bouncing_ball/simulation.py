@@ -245,11 +245,6 @@ def _tally_step(a, dt, tau, x_tau, slope_tau, k, edges, bin_lower, bin_upper, ti
     return k
 
 
-# a step this short only happens in a collapse (v ~ 1e-37); much shorter ones overflow the bridge's
-# cubic coefficients (~ x / dt^2) before the speed underflows to zero
-COLLAPSED_STEP = 1.0e-80
-
-
 # What the compiled loop records, by bit of its ``parts`` argument: the benchmark leaves
 # them out one at a time to time each (``python -m benchmarks``); a shard records them all.
 # The collisions, their outgoing speeds, the time and the steps are always recorded.
