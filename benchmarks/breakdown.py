@@ -27,6 +27,8 @@ from bouncing_ball.free_flight import (
 )
 from bouncing_ball.jit import njit
 from bouncing_ball.simulation import (
+    CONTROL_VARIATES,
+    EVERY_TALLY,
     FLIGHTS,
     JOINT,
     MEAN_PATH_INTEGRALS,
@@ -46,7 +48,8 @@ PARTS = (
     ("+ P(x) and <v^2>_x", MEAN_PATH_INTEGRALS | POSITION),
     ("+ P(x, v)", MEAN_PATH_INTEGRALS | JOINT),
     ("+ flight times and return speeds", MEAN_PATH_INTEGRALS | FLIGHTS),
-    ("every tally", MEAN_PATH_INTEGRALS | POSITION | JOINT | FLIGHTS),
+    ("+ control variates (noise sums)", MEAN_PATH_INTEGRALS | CONTROL_VARIATES),
+    ("every tally", EVERY_TALLY),
 )
 
 

@@ -11,7 +11,8 @@ A shard is stored as one long table, a row per tally entry:
     return_speed            u_lo   u_hi   v_lo   v_hi   flights leaving the floor at speed u
                                                         and returning at speed v in the cell
     time, collisions, steps, int_x, int_x2, budget_exhausted,
-    flights, flight_time_sum, flight_time_squared_sum
+    flights, flight_time_sum, flight_time_squared_sum,
+    noise_sum, noise_v_sum, noise_scaled_sum, normal_sum
                             NaN    NaN    NaN    NaN    the scalar
 
 A 2-D tally's rows run over its second variable fastest (row-major, the first
@@ -48,6 +49,10 @@ SCALARS = (
     "flights",
     "flight_time_sum",
     "flight_time_squared_sum",
+    "noise_sum",
+    "noise_v_sum",
+    "noise_scaled_sum",
+    "normal_sum",
 )
 _INTEGER = ("collisions", "steps", "budget_exhausted", "flights")
 BINS = ("speed_bins", "position_bins", "velocity_bins", "flight_time_bins")
@@ -84,6 +89,12 @@ class ShardTallies:
     flights: int  # flights recorded: one per recorded collision with an earlier collision
     flight_time_sum: float  # sum of their durations T
     flight_time_squared_sum: float  # sum of T^2
+    # control variates: sums over the recorded steps n (state x_n, v_n and step dt_n at the
+    # step's start, velocity noise xi_n = sqrt(2 dt_n) normal_n of eq. (vstep)), each of mean 0
+    noise_sum: float  # sum xi_n
+    noise_v_sum: float  # sum v_n xi_n
+    noise_scaled_sum: float  # sum v_n xi_n / (x_n + v_n^2 / 2 + 4 dt_n)
+    normal_sum: float  # sum normal_n
 
     @staticmethod
     def loop_arrays(settings) -> dict:

@@ -84,7 +84,11 @@ enum {
     EXHAUSTED,
     FLIGHTS,
     FLIGHT_TIME_SUM,
-    FLIGHT_TIME_SQUARED_SUM
+    FLIGHT_TIME_SQUARED_SUM,
+    NOISE_SUM,
+    NOISE_V_SUM,
+    NOISE_SCALED_SUM,
+    NORMAL_SUM
 };
 
 /* Python's min(a, b) and max(a, b) on floats, as numba compiles them */
@@ -536,7 +540,7 @@ static inline int64_t tally_step(double a0, double a1, double a2, double a3, dou
  * P(x, v)) nu + 1, f_edges (flight times) nf + 1; speed_counts, position_time,
  * position_v2_time and flight_time_counts have nv + 2, nx + 2, nx + 2 and nf + 2 entries,
  * position_velocity_time (nx + 2) x (nu + 2) and return_speed_counts (nv + 2) x (nv + 2),
- * row-major (all zeroed by the caller); scalars has 9.  Returns 0, or -1 if the two small
+ * row-major (all zeroed by the caller); scalars has 13.  Returns 0, or -1 if the two small
  * bin-bound arrays cannot be allocated.
  */
 int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitution, double c,
@@ -595,6 +599,11 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
     double since_collision = 0.0; /* time since the last collision (equilibration included) */
     int collided_before = 0;
     int64_t last_out_bin = 0; /* speed bin of the last collision's outgoing speed */
+    /* the control variates (martingales of mean 0) */
+    double noise_sum = 0.0;
+    double noise_v_sum = 0.0;
+    double noise_scaled_sum = 0.0;
+    double normal_sum = 0.0;
 
     for (;;) {
         if (t >= t_stop) {
@@ -643,7 +652,12 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
         steps += 1;
         if (recording) {
             recorded_steps += 1;
-            /* every part of parts = EVERY_TALLY: MEAN_PATH_INTEGRALS, POSITION, JOINT */
+            /* every part of parts = EVERY_TALLY: CONTROL_VARIATES, MEAN_PATH_INTEGRALS, POSITION, JOINT */
+            double xi = sqrt(2.0 * dt) * normal_r; /* the velocity noise of eq. (vstep) */
+            noise_sum += xi;
+            noise_v_sum += v * xi;
+            noise_scaled_sum += v / (x + 0.5 * v * v + 4.0 * dt) * xi;
+            normal_sum += normal_r;
             double ix, ix2;
             mean_path_integrals(a0, a1, a2, a3, dt, tau, &ix, &ix2);
             int_x += ix;
@@ -704,6 +718,10 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
     scalars[FLIGHTS] = (double)flights;
     scalars[FLIGHT_TIME_SUM] = flight_time_sum;
     scalars[FLIGHT_TIME_SQUARED_SUM] = flight_time_squared_sum;
+    scalars[NOISE_SUM] = noise_sum;
+    scalars[NOISE_V_SUM] = noise_v_sum;
+    scalars[NOISE_SCALED_SUM] = noise_scaled_sum;
+    scalars[NORMAL_SUM] = normal_sum;
     free(x_bin_lower);
     free(x_bin_upper);
     return 0;

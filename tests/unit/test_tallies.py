@@ -31,6 +31,7 @@ SPEED_BINS = LogBins(1e-2, 1e1, 2)
 POSITION_BINS = LogBins(1e-1, 1e2, 1)
 VELOCITY_BINS = LinearBins(-1.0, 2.0, 1.0)
 FLIGHT_TIME_BINS = LogBins(1e-2, 1e1, 1)
+CONTROL_VARIATES = ("noise_sum", "noise_v_sum", "noise_scaled_sum", "normal_sum")
 BIN_SET = SimpleNamespace(
     speed_bins=SPEED_BINS,
     position_bins=POSITION_BINS,
@@ -50,6 +51,7 @@ def shard_tallies(draw):
     nu, nf = VELOCITY_BINS.n + 2, FLIGHT_TIME_BINS.n + 2
     counts = st.integers(0, 10**6)
     times = st.floats(0.0, 1e6, allow_nan=False)
+    noise = st.floats(-1e6, 1e6, allow_nan=False)  # the control variates: sums of mean 0
 
     def array(elements, size, dtype=float, shape=None):
         values = np.array(draw(st.lists(elements, min_size=size, max_size=size)), dtype=dtype)
@@ -71,6 +73,7 @@ def shard_tallies(draw):
         flights=draw(counts),
         flight_time_sum=draw(times),
         flight_time_squared_sum=draw(times),
+        **{name: draw(noise) for name in CONTROL_VARIATES},
     )
 
 
@@ -204,6 +207,10 @@ def test_the_compiled_loop_fills_its_scalars_in_the_order_of_SCALARS():
         simulation._FLIGHTS,
         simulation._FLIGHT_TIME_SUM,
         simulation._FLIGHT_TIME_SQUARED_SUM,
+        simulation._NOISE_SUM,
+        simulation._NOISE_V_SUM,
+        simulation._NOISE_SCALED_SUM,
+        simulation._NORMAL_SUM,
     )
     assert [SCALARS[k] for k in indices] == [
         "time",
@@ -215,6 +222,7 @@ def test_the_compiled_loop_fills_its_scalars_in_the_order_of_SCALARS():
         "flights",
         "flight_time_sum",
         "flight_time_squared_sum",
+        *CONTROL_VARIATES,
     ]
 
 

@@ -1,0 +1,64 @@
+"""The martingale control-variate estimator of a rate (histograms.control_variate_rate), on
+synthetic shards: exact where the control explains everything, the plain estimator where it
+explains nothing, and unbiased where an in-sample slope is not."""
+
+import numpy as np
+import pytest
+
+from bouncing_ball.histograms import control_variate_rate, jackknife
+
+
+def test_a_control_that_explains_everything_leaves_no_error():
+    rng = np.random.default_rng(1)
+    times = rng.uniform(1.0, 2.0, 12)
+    controls = rng.normal(size=(12, 2)) * np.sqrt(times)[:, None]
+    tallies = 0.75 * times + controls @ np.array([-0.4, 2.0])
+    value, error, beta = control_variate_rate(tallies, times, controls)
+    assert value == pytest.approx(0.75, rel=1e-12)
+    assert error == pytest.approx(0.0, abs=1e-12)
+    assert beta == pytest.approx([-0.4, 2.0], rel=1e-10)
+
+
+def test_without_a_usable_control_it_is_the_plain_estimator():
+    """A control that is 0 in every shard (e.g. nothing recorded) changes nothing."""
+    rng = np.random.default_rng(2)
+    times = np.full(10, 3.0)
+    tallies = rng.poisson(30.0, size=(10, 4)).astype(float)
+    value, error, beta = control_variate_rate(tallies, times, np.zeros((10, 1)))
+    plain, plain_error = jackknife(lambda c, t: c / t, tallies, times[:, None])
+    assert np.allclose(value, plain) and np.allclose(error, plain_error)
+    assert beta.shape == (1, 4) and np.all(beta == 0.0)
+
+
+def test_histograms_are_corrected_bin_by_bin():
+    rng = np.random.default_rng(3)
+    noise = rng.normal(size=40)
+    tallies = np.column_stack([10.0 + 3.0 * noise, 5.0 - noise + 0.1 * rng.normal(size=40)])
+    value, error, beta = control_variate_rate(tallies, np.ones(40), noise)
+    assert value.shape == error.shape == (2,) and beta.shape == (1, 2)
+    assert beta[0] == pytest.approx([3.0, -1.0], abs=0.05)
+    assert error[0] < 1e-12 and error[1] < 0.03 < tallies[:, 1].std() / np.sqrt(40)
+
+
+def test_cross_fitting_is_unbiased_where_an_in_sample_slope_is_not():
+    """tally = 1 + (x^2 - 1) with x of mean 0: x predicts nothing linearly, but a slope fitted
+    with shard k picks up x_k^2 x_k and biases the mean by about -2 / shards; the slope
+    fitted without shard k does not (its correction has mean exactly 0)."""
+    rng = np.random.default_rng(4)
+    shards, repeats = 6, 1500
+    x = rng.normal(size=(repeats, shards))
+    tallies = 1.0 + (x**2 - 1.0)
+    times = np.ones(shards)
+    cross_fitted = np.array([control_variate_rate(t, times, c)[0] for t, c in zip(tallies, x)])
+    in_sample = []
+    for t, c in zip(tallies, x):
+        slope = np.polyfit(c, t, 1)[0]
+        in_sample.append(np.mean(t - slope * c))
+    error = np.std(cross_fitted) / np.sqrt(repeats)
+    assert abs(cross_fitted.mean() - 1.0) < 4.0 * error
+    assert np.mean(in_sample) - 1.0 < -0.15  # about -2 / shards
+
+
+def test_too_few_shards_for_the_controls_are_refused():
+    with pytest.raises(ValueError, match="too few"):
+        control_variate_rate(np.ones(4), np.ones(4), np.zeros((4, 2)))
