@@ -191,9 +191,15 @@ def _delta_x(int_x, int_x2, time):
     return np.sqrt(int_x2 / time - (int_x / time) ** 2)
 
 
+# the shards' martingale sums that ``control_variate_rate`` corrects I with
+CONTROL_VARIATE_SUMS = ("noise_sum", "noise_v_sum", "noise_scaled_sum", "normal_sum")
+
+
 def position_moments_summary(shards: list[ShardTallies], restitution: float) -> pd.DataFrame:
     """One row: <x>, Delta x and the collision rate I, eqs. (collrate), (xandDeltax), and the
-    mean and second moment of the flight time per flight."""
+    mean and second moment of the flight time per flight.  I is given twice: the collisions
+    per time, and the same corrected by the control variates (``control_variate_rate``, the
+    same expectation, 3.6-6.7 times less variance; NaN with fewer than 7 shards)."""
     time = np.array([s.time for s in shards])
     int_x = np.array([s.int_x for s in shards])
     int_x2 = np.array([s.int_x2 for s in shards])
@@ -201,6 +207,11 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
     mean_x, mean_x_err = jackknife(_mean_x, int_x, time)
     delta_x, delta_x_err = jackknife(_delta_x, int_x, int_x2, time)
     rate, rate_err = jackknife(lambda c, t: c / t, collisions, time)
+    controls = np.array([[getattr(s, name) for name in CONTROL_VARIATE_SUMS] for s in shards])
+    if len(shards) >= len(CONTROL_VARIATE_SUMS) + 3:  # enough shards to fit the slopes
+        controlled, controlled_err, _ = control_variate_rate(collisions, time, controls)
+    else:
+        controlled = controlled_err = np.nan
     flights = np.array([s.flights for s in shards], dtype=float)
     flight_time = np.array([s.flight_time_sum for s in shards])
     flight_time_squared = np.array([s.flight_time_squared_sum for s in shards])
@@ -216,6 +227,8 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
             "delta_x_err": [float(delta_x_err)],
             "collision_rate": [float(rate)],
             "collision_rate_err": [float(rate_err)],
+            "collision_rate_controlled": [float(controlled)],
+            "collision_rate_controlled_err": [float(controlled_err)],
             "mean_flight_time": [float(mean_t)],
             "mean_flight_time_err": [float(mean_t_err)],
             "flight_time_second_moment": [float(second_t)],
