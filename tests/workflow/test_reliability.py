@@ -151,8 +151,9 @@ def test_a_truncated_batch_of_shards_is_named_and_forcing_its_rule_recovers(
     assert "results/simulation/r0.5/shards2-2.parquet: not a readable Parquet file" in message
     assert "--forcerun results/simulation/r0.5/shards2-2.parquet" in message  # the way out
     assert "pyarrow" not in message.split("shards2-2.parquet: not a readable")[0][-300:]
+    # the targets first: --forcerun takes every file after it (with none left, rule all ran)
     result = snakemake(
-        directory, "--forcerun", "results/simulation/r0.5/shards2-2.parquet", *TABLES
+        directory, *TABLES, "--forcerun", "results/simulation/r0.5/shards2-2.parquet"
     )
     assert result.returncode == 0, result.stderr[-3000:]
     _assert_same_tables(directory, uninterrupted)  # a re-run batch is bit-identical
