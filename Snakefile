@@ -17,6 +17,8 @@ report: "workflow/report/workflow.rst"
 wildcard_constraints:
     r=r"[0-9][0-9.e-]*",
     shard=r"[0-9]+",
+    first=r"[0-9]+",
+    last=r"[0-9]+",
 
 
 # rules with `localrule: True` (the stage targets below, and jobs of a few seconds whose

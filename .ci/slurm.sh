@@ -199,13 +199,13 @@ say "local run"
 
 say "SLURM run: snakemake --profile profiles/slurm with the settings of a cluster without accounting"
 # Site settings of this cluster on the command line (they win over the profile): no
-# accounting, so squeue for job states and no account; all 5 shards of the test config in one
-# SLURM job (a group), run one after the other on one core.
+# accounting, so squeue for job states and no account. The test config's 5 shards are 3
+# SLURM jobs (batches of at most 2 shards: simulation.shards_per_job).
 set +e
 (cd "$WORK/cluster" && timeout --kill-after=15 300 "$PYTHON" -m snakemake --profile profiles/slurm \
     --slurm-status-command squeue --slurm-init-seconds-before-status-checks 2 \
     --slurm-no-account --slurm-keep-successful-logs \
-    --group-components shards=5 --jobs 4 --latency-wait 5 \
+    --jobs 4 --latency-wait 5 \
     "${TARGETS[@]}") >"$WORK/log/slurm-run.log" 2>&1
 status=$?
 set -e

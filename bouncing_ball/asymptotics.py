@@ -6,7 +6,6 @@ for v -> infinity, eqs. (asym3)-(asym6).
 
 import numpy as np
 import pandas as pd
-from scipy import optimize
 
 from . import stages
 
@@ -39,6 +38,8 @@ def _restitution(restitution) -> float:
 
 def small_speed_exponent(restitution) -> float:
     """beta(r) of eq. (asym2): the physical root in (0, 5/2), P(0, v) ~ v^-beta at small v."""
+    from scipy import optimize  # here: the jobs that need only r_c do not load scipy
+
     r = _restitution(restitution)
     target = np.log(r)
     # ln r(beta) decreases from 0 at beta = 0 to -infinity at beta = 5/2

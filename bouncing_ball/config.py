@@ -235,6 +235,26 @@ def shard_count(config: dict, label: str) -> int:
     return int(simulation_settings(config, label)["shards"])
 
 
+def batch_ranges(count: int, per_job: int) -> list[tuple[int, int]]:
+    """Shards 0 .. count - 1 in consecutive batches of ``per_job`` (the last may be smaller),
+    as (first, last) pairs, last included: one workflow job simulates each batch.
+
+    A batch ends at a multiple of ``per_job``, so more shards leave the full batches as
+    they are and add batches after them."""
+    if count < 1 or per_job < 1:
+        raise ValueError(
+            f"need count >= 1 and per_job >= 1, got count = {count}, per_job = {per_job}"
+        )
+    return [(first, min(first + per_job, count) - 1) for first in range(0, count, per_job)]
+
+
+def shard_batches(config: dict, label: str) -> list[tuple[int, int]]:
+    """The batches of the shards of r = ``label`` (``batch_ranges`` of ``simulation.shards``
+    and ``simulation.shards_per_job``, with the per-r overrides)."""
+    settings = simulation_settings(config, label)
+    return batch_ranges(int(settings["shards"]), int(settings["shards_per_job"]))
+
+
 def solver_settings(config: dict) -> dict:
     """What one solve is run with (not the r grid of Fig. 6, which has its own job)."""
     return {
@@ -247,6 +267,7 @@ def solver_settings(config: dict) -> dict:
             "positions",
             "speeds",
             "forces",
+            "weight_panel_nodes",
         )
     }
 

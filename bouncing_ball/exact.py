@@ -6,6 +6,8 @@ are computed here from these distributions (not copied from the paper), so
 that a test can compare them with the paper's closed forms.
 """
 
+import functools
+import math
 from fractions import Fraction
 
 import numpy as np
@@ -15,6 +17,7 @@ from scipy import integrate, special
 from .restitution import EXACT_RESTITUTIONS  # noqa: F401 (re-exported: exact.EXACT_RESTITUTIONS)
 
 
+@functools.lru_cache(maxsize=64)  # called per point by the scalar integrands below
 def _which(restitution) -> Fraction:
     value = Fraction(restitution).limit_denominator(1000)
     if value not in EXACT_RESTITUTIONS or abs(float(value) - float(restitution)) > 1e-12:
@@ -172,12 +175,34 @@ def weight_function(force, restitution):
     return np.sqrt(2.0 / (27.0 * np.pi)) * a * force**-0.5 * special.kve(1.0 / 6.0, z) * np.exp(-z)
 
 
-def _distribution_integrand(log_force, x, v, restitution):
-    # e^{-v/2} w(F) e^{-F x} psi_{1/4,F}(-v) F, eqs. (fpsol), (psi); dF = F d(ln F)
-    f = np.exp(log_force)
+def _scalar_weight_function(restitution):
+    """``weight_function`` for one float F at a time, its constants computed once (quad calls
+    the integrand below hundreds of times per point of P(x, v))."""
+    a = normalization_constant(restitution)
+    if _which(restitution) == Fraction(1, 2):
+        c = 0.5 * a
+
+        def weight(force):
+            return c * force**-0.5 * math.exp(-1.0 / (12.0 * force))
+
+        return weight
+    c = math.sqrt(2.0 / (27.0 * math.pi)) * a
+    kve = special.kve
+
+    def weight(force):
+        z = 1.0 / (12.0 * force)
+        return c * force**-0.5 * float(kve(1.0 / 6.0, z)) * math.exp(-z)
+
+    return weight
+
+
+def _distribution_integrand(log_force, x, v, weight):
+    # e^{-v/2} w(F) e^{-F x} psi_{1/4,F}(-v) F, eqs. (fpsol), (psi); dF = F d(ln F);
+    # ``weight``: _scalar_weight_function
+    f = math.exp(log_force)
     argument = -(f ** (1.0 / 3.0)) * v + 0.25 * f ** (-2.0 / 3.0)
-    airy = special.airy(argument)[0]
-    return np.exp(-0.5 * v - f * x) * weight_function(f, restitution) * f ** (-1.0 / 6.0) * airy * f
+    airy = float(special.airy(argument)[0])
+    return math.exp(-0.5 * v - f * x) * weight(f) * f ** (-1.0 / 6.0) * airy * f
 
 
 def distribution_by_force_integral(x, v, restitution):
@@ -199,7 +224,7 @@ def distribution_by_force_integral(x, v, restitution):
         _distribution_integrand,
         -6.0,
         upper,
-        args=(xi, vi, restitution),
+        args=(xi, vi, _scalar_weight_function(restitution)),
         limit=2000,
         epsabs=0.0,
         epsrel=1e-10,

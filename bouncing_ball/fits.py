@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from scipy import optimize, stats
+from scipy import optimize, special  # not scipy.stats: half a second to import, in every job
 from scipy.interpolate import CubicSpline
 
 from . import stages
@@ -197,15 +197,22 @@ def fit_shards(side, lower, upper, counts, times, errors, restitution, free):
         if shards > exponents:
             t_squared = float(deviation @ np.linalg.solve(covariance[1:, 1:], deviation))
             statistic = (shards - exponents) * t_squared / (exponents * (shards - 1))
-            joint = float(stats.f.sf(statistic, exponents, shards - exponents))
+            joint = _f_survival(statistic, exponents, shards - exponents)
     return AsymptoticFit(
         side, free, fit.parameters, errors_out, fit.chi2, fit.dof, fit.lower, fit.upper, joint
     )
 
 
+def _f_survival(statistic, numerator, denominator) -> float:
+    """P(F > statistic) of Snedecor's F distribution (``scipy.stats.f.sf``: its support starts
+    at 0)."""
+    return 1.0 if statistic < 0.0 else float(special.fdtrc(numerator, denominator, statistic))
+
+
 def interval_factor(shards, level=0.95):
-    """Student t factor of a ``level`` interval from a jackknife over ``shards`` shards."""
-    return float(stats.t.ppf(0.5 + level / 2.0, shards - 1))
+    """Student t factor of a ``level`` interval from a jackknife over ``shards`` shards
+    (``scipy.stats.t.ppf``)."""
+    return float(special.stdtrit(shards - 1, 0.5 + level / 2.0))
 
 
 def asymptotic_window(

@@ -8,8 +8,18 @@ importing numba, scipy or matplotlib.
 
 # "bins" also builds the config's grids; "restitution" parses r and makes the labels
 # that key the random streams; "jit" is how the compiled modules are compiled
-SIMULATION = ("bins", "free_flight", "jit", "restitution", "settings", "simulation", "tallies")
-MERGE = ("bins", "histograms", "io", "restitution", "settings", "shards", "tallies")
+# "batches" is how a job's shards are run and stored (one file per job)
+SIMULATION = (
+    "batches",
+    "bins",
+    "free_flight",
+    "jit",
+    "restitution",
+    "settings",
+    "simulation",
+    "tallies",
+)
+MERGE = ("batches", "bins", "histograms", "io", "restitution", "settings", "shards", "tallies")
 SOLVER = (
     "asymptotics",
     "bins",
@@ -24,6 +34,7 @@ EXACT = ("bins", "exact")
 THEORY = ("asymptotics", "bins")
 FITS = (
     "asymptotics",
+    "batches",
     "bins",
     "fits",
     "histograms",
@@ -37,6 +48,7 @@ PLOTTING = ("io", "plotting", "restitution")
 COMPARISON = ("comparison", "fits", "io", "restitution")
 # the studies' reports (workflow/rules/studies.smk); their shards are SIMULATION's
 STUDIES = (
+    "batches",
     "bins",
     "comparison",
     "exact",

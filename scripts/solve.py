@@ -32,7 +32,9 @@ with job_log(snakemake.log[0]):
     # the whole distribution from P(0, v) (bouncing_ball.distribution): w(F), then P(x), P(x, v)
     started_distribution = time.perf_counter()
     far = distribution.outgoing_speed_solution(float(exact))  # P(0, v) out to ~e^-690
-    weight = distribution.interpolated_weight_function(far)
+    weight = distribution.interpolated_weight_function(
+        far, panel_nodes=settings["weight_panel_nodes"]
+    )
     position = distribution.position_table(weight, log_grid(settings["position_grid"]))
     joint, worst = distribution.distribution_table(
         weight, far, settings["positions"], linear_grid(settings["speeds"])
@@ -50,6 +52,7 @@ with job_log(snakemake.log[0]):
         "r": exact_string(exact),
         "r_label": label,
         "quadrature_step": settings["quadrature_step"],
+        "weight_panel_nodes": settings["weight_panel_nodes"],
         "code": snakemake.params.code,
         "normalisation": "momentum balance M_2 = r / (1 + r)",
     }

@@ -8,9 +8,11 @@ import yaml
 from workflow_support import REPOSITORY
 
 from bouncing_ball.config import (
+    batch_ranges,
     check_config,
     overlay_per_restitution,
     read_yaml,
+    shard_batches,
     shard_count,
     shard_settings,
     simulation_settings,
@@ -195,4 +197,16 @@ def test_an_overlay_clears_the_per_r_overrides(tmp_path, cleared):
     overlay.write_text("simulation:\n  shards: 2\n")
     config = _default_config()
     overlay_per_restitution(config, [base, overlay])
-    assert shard_count(config, "0.25") == 32
+    assert shard_count(config, "0.25") == 64
+
+
+def test_shards_are_batched_into_jobs_and_more_shards_keep_the_full_batches():
+    assert batch_ranges(3, 2) == [(0, 1), (2, 2)]
+    assert batch_ranges(64, 16) == [(0, 15), (16, 31), (32, 47), (48, 63)]
+    assert batch_ranges(80, 16)[:4] == batch_ranges(64, 16)
+    assert batch_ranges(2, 5) == [(0, 1)]
+    config = _default_config()
+    assert shard_batches(config, "0.75") == batch_ranges(64, 16)
+    config["simulation"]["per_restitution"]["0.75"]["shards_per_job"] = 1  # e.g. a cluster
+    assert shard_batches(config, "0.75") == [(k, k) for k in range(64)]
+    assert len(shard_batches(config, "0.25")) == 4

@@ -39,13 +39,15 @@ def test_the_profile_names_only_options_snakemake_and_the_slurm_plugin_know():
     assert profile["slurm-init-seconds-before-status-checks"] > 0
 
 
-def test_shards_are_grouped_and_a_group_asks_for_one_core():
+def test_study_shards_are_grouped_and_a_group_asks_for_one_core():
+    """The pipeline's shards come in batches, one job each (simulation.shards_per_job); the
+    studies' shards, one job each, are grouped."""
     profile = yaml.safe_load(PROFILE.read_text())
     groups = dict(item.split("=") for item in profile["group-components"])
     assert int(groups["shards"]) >= 2
     blocks = rule_blocks()
     grouped = [name for name, body in blocks.items() if re.search(r'group:\n\s+"shards"', body)]
-    assert grouped == ["simulate_shard", "study_shard"]
+    assert grouped == ["study_shard"]
     # the plugin runs a group's jobs one after the other: one core per SLURM job
     assert profile["cores"] == 1
 
@@ -64,7 +66,7 @@ def test_every_submitted_rule_sets_its_resources_and_local_rules_exist():
     }
     assert quick <= local, f"not local: {sorted(quick - local)}"
     submitted = set(blocks) - local
-    assert {"simulate_shard", "merge_shards", "fit", "exact_solution"} <= submitted
+    assert {"simulate_shards", "merge_shards", "fit", "exact_solution"} <= submitted
     for name in submitted:
         resources = re.search(r"resources:\n((?:\s+\w+=.+\n)+)", blocks[name])
         assert resources, f"rule {name} sets no resources"

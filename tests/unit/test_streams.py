@@ -1,24 +1,30 @@
-"""Random streams: one per (r, shard), reproducible, independent of job order."""
+"""Random streams: one per (r, shard), reproducible, independent of job order and of how
+shards are grouped into jobs."""
 
 import numpy as np
 
+from bouncing_ball.batches import batch_to_frame, simulate_batch
 from bouncing_ball.bins import LogBins
+from bouncing_ball.histograms import position_moments_summary
+from bouncing_ball.io import write_table
 from bouncing_ball.settings import ShardSettings
+from bouncing_ball.shards import read_shards
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 from bouncing_ball.tallies import tallies_to_frame
 
+SETTINGS = ShardSettings(
+    shard_time=500.0,
+    equilibration_time=10.0,
+    criterion_c=5.0,
+    min_step_divisor=500.0,
+    max_steps=10**9,
+    speed_bins=LogBins(1e-4, 1e2, 10),
+    position_bins=LogBins(1e-3, 1e3, 5),
+)
+
 
 def _run(label, shard, seed=11):
-    settings = ShardSettings(
-        shard_time=500.0,
-        equilibration_time=10.0,
-        criterion_c=5.0,
-        min_step_divisor=500.0,
-        max_steps=10**9,
-        speed_bins=LogBins(1e-4, 1e2, 10),
-        position_bins=LogBins(1e-3, 1e3, 5),
-    )
-    return simulate_shard(float(label), shard_seed_sequence(seed, label, shard), settings)
+    return simulate_shard(float(label), shard_seed_sequence(seed, label, shard), SETTINGS)
 
 
 def test_same_seed_gives_an_identical_shard():
@@ -40,3 +46,29 @@ def test_other_seed_other_stream():
     assert not tallies_to_frame(_run("0.5", 0, seed=1)).equals(
         tallies_to_frame(_run("0.5", 0, seed=2))
     )
+
+
+def _batch_files(folder, batches, seed=11):
+    """Batch files of r = 1/2 as rule simulate_shards writes them, one per list of shards."""
+    paths = []
+    for shards in batches:
+        path = folder / f"shards{shards[0]}-{shards[-1]}.parquet"
+        batch = dict(simulate_batch(0.5, seed, "0.5", shards, SETTINGS))
+        provenance = {"r": "1/2", "r_label": "0.5", "seed": seed, "code": "test"}
+        provenance.update(first_shard=shards[0], last_shard=shards[-1], **SETTINGS.as_mapping())
+        write_table(batch_to_frame(batch), path, provenance)
+        paths.append(path)
+    return paths
+
+
+def test_a_shard_has_the_same_tallies_whatever_batch_it_is_in(tmp_path):
+    """Shard k draws from its own stream: one job of shards 0-2 or jobs of 0 and of 1-2 give
+    every shard, and so every merged table, bit for bit the same."""
+    (tmp_path / "one").mkdir(), (tmp_path / "two").mkdir()
+    one, _ = read_shards(_batch_files(tmp_path / "one", [[0, 1, 2]]), "0.5")
+    two, provenances = read_shards(_batch_files(tmp_path / "two", [[0], [1, 2]]), "0.5")
+    assert [p["shard"] for p in provenances] == [0, 1, 2]
+    for k, (ours, theirs) in enumerate(zip(one, two, strict=True)):
+        assert tallies_to_frame(ours).equals(tallies_to_frame(theirs))
+        assert tallies_to_frame(ours).equals(tallies_to_frame(_run("0.5", k)))  # as if alone
+    assert position_moments_summary(one, 0.5).equals(position_moments_summary(two, 0.5))

@@ -9,6 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from benchmarks import reference_loop
+from bouncing_ball.batches import batch_to_frame
 from bouncing_ball.bins import LinearBins, LogBins
 from bouncing_ball.histograms import (
     distribution_histogram,
@@ -19,6 +20,7 @@ from bouncing_ball.histograms import (
     return_speed_table,
 )
 from bouncing_ball.io import UnreadableFileError, read_table, write_table
+from bouncing_ball.settings import ShardSettings
 from bouncing_ball.shards import read_shards
 from bouncing_ball.tallies import (
     ShardTallies,
@@ -226,12 +228,35 @@ def test_the_compiled_loop_fills_its_scalars_in_the_order_of_SCALARS():
     ]
 
 
+def _batch_file(path, shards, named=None):
+    """A batch file of r = 1/2 holding ``shards`` (empty ones of one time unit), saying it
+    holds ``named`` (default: those)."""
+    named = shards if named is None else named
+    provenance = {"r": "1/2", "r_label": "0.5", "first_shard": named[0], "last_shard": named[-1]}
+    settings = ShardSettings(1.0, 0.0, 3.0, 500.0, 10, **vars(BIN_SET))
+    provenance.update(settings.as_mapping())
+    write_table(batch_to_frame(dict.fromkeys(shards, _empty_shard())), path, provenance)
+    return path
+
+
 def test_a_single_shard_is_refused_by_every_reader_of_shards(tmp_path):
     """merge_shards wrote NaN errors from one shard: refused, saying errors need two."""
-    path = tmp_path / "shard0.parquet"
-    write_table(tallies_to_frame(_empty_shard()), path, {"r": "1/2", "r_label": "0.5"})
+    path = _batch_file(tmp_path / "shards0-0.parquet", [0])
     with pytest.raises(UnreadableFileError, match=r"r = 0.5: 1 shard .*need two or more"):
         read_shards([path], "0.5")
+
+
+def test_batch_files_are_refused_where_a_shard_is_missing_or_counted_twice(tmp_path):
+    shards, provenances = read_shards([_batch_file(tmp_path / "a.parquet", [0, 1, 2])], "0.5")
+    assert len(shards) == 3 and [p["shard"] for p in provenances] == [0, 1, 2]
+    lying = _batch_file(tmp_path / "b.parquet", [0, 1], named=[0, 1, 2])
+    with pytest.raises(
+        UnreadableFileError, match=r"b.parquet: holds shards \[0, 1\], not shards 0-2"
+    ):
+        read_shards([lying], "0.5")
+    twice = [_batch_file(tmp_path / "c.parquet", [0, 1]), _batch_file(tmp_path / "d.parquet", [1])]
+    with pytest.raises(UnreadableFileError, match="d.parquet: shard 1 is also in .*c.parquet"):
+        read_shards(twice, "0.5")
 
 
 def test_new_merged_tables_on_hand_computed_shards():

@@ -17,6 +17,7 @@ from workflow_support import SMALL, copy_repository, snakemake
 from bouncing_ball.io import read_table
 
 # three shards of r = 1/2 that each compute for a few seconds, so a job can be killed mid-run
+# (two jobs: shards 0-1 and 2-2, simulation.shards_per_job 2)
 LONG = yaml.safe_load(yaml.safe_dump(SMALL)) | {"restitution": [0.5]}
 LONG["simulation"]["per_restitution"] = {"0.5": {"shards": 3, "shard_time": 2.5e6}}
 TABLES = [f"results/simulation/r0.5/{name}.parquet" for name in ("p0v", "position", "summary")]
@@ -31,7 +32,7 @@ def uninterrupted(tmp_path_factory):
 
 
 def _shard_processes(directory):
-    """Pids of the simulate_shard scripts running in ``directory``."""
+    """Pids of the simulate_shards scripts running in ``directory``."""
     found = []
     for entry in Path("/proc").iterdir():
         if not entry.name.isdigit():
@@ -42,7 +43,7 @@ def _shard_processes(directory):
         except OSError:
             continue
         if (
-            b"simulate_shard" in command
+            b"simulate_shards" in command
             and b"snakemake" not in command.split(b"\0")[0]
             and folder == str(directory)
         ):
@@ -75,7 +76,7 @@ def _wait_for_a_computing_shard(directory, running_for=1.2, timeout=120):
             if now - seen[pid] >= running_for:
                 return pid
         time.sleep(0.05)
-    raise AssertionError("no simulate_shard job was seen running")
+    raise AssertionError("no simulate_shards job was seen running")
 
 
 def _press_ctrl_c(run, presses=5, patience=1.0):
@@ -136,21 +137,26 @@ def test_an_interrupted_run_completes_on_rerun_with_the_same_numbers(uninterrupt
     _assert_no_half_files(directory)
 
 
-def test_a_truncated_shard_is_named_and_forcing_its_rule_recovers(uninterrupted, tmp_path):
+def test_a_truncated_batch_of_shards_is_named_and_forcing_its_rule_recovers(
+    uninterrupted, tmp_path
+):
     directory = tmp_path / "copy"
     shutil.copytree(uninterrupted, directory)
-    shard = directory / "results/simulation/r0.5/shard1.parquet"
-    content = shard.read_bytes()
-    shard.write_bytes(content[: len(content) // 2])
+    batch = directory / "results/simulation/r0.5/shards2-2.parquet"
+    content = batch.read_bytes()
+    batch.write_bytes(content[: len(content) // 2])
     result = snakemake(directory, *TABLES)
     assert result.returncode != 0
     message = result.stdout + result.stderr
-    assert "results/simulation/r0.5/shard1.parquet: not a readable Parquet file" in message
-    assert "--forcerun results/simulation/r0.5/shard1.parquet" in message  # the way out
-    assert "pyarrow" not in message.split("shard1.parquet: not a readable")[0][-300:]
-    result = snakemake(directory, "--forcerun", "results/simulation/r0.5/shard1.parquet", *TABLES)
+    assert "results/simulation/r0.5/shards2-2.parquet: not a readable Parquet file" in message
+    assert "--forcerun results/simulation/r0.5/shards2-2.parquet" in message  # the way out
+    assert "pyarrow" not in message.split("shards2-2.parquet: not a readable")[0][-300:]
+    # the targets first: --forcerun takes every file after it (with none left, rule all ran)
+    result = snakemake(
+        directory, *TABLES, "--forcerun", "results/simulation/r0.5/shards2-2.parquet"
+    )
     assert result.returncode == 0, result.stderr[-3000:]
-    _assert_same_tables(directory, uninterrupted)  # a re-run shard is bit-identical
+    _assert_same_tables(directory, uninterrupted)  # a re-run batch is bit-identical
 
 
 def test_a_corrupt_merged_table_is_named_by_the_rule_that_reads_it(finished_run, tmp_path):
@@ -254,14 +260,16 @@ def test_tables_of_another_config_without_snakemakes_record_are_named(finished_r
         text=True,
         timeout=300,
     )
-    assert planned.returncode == 0 and "simulate_shard" in planned.stdout  # Snakemake knows
+    assert planned.returncode == 0 and "simulate_shards" in planned.stdout  # Snakemake knows
     shutil.rmtree(directory / ".snakemake")
     before = {path: path.stat().st_mtime_ns for path in (directory / "results").rglob("*")}
     result = snakemake(directory)
     message = result.stdout + result.stderr
     assert result.returncode != 0
     assert "results made for another config, which Snakemake has no record of" in message
-    assert "results/simulation/r0.5/shard2.parquet: shard_time = 2000.0 (config: 3000.0)" in message
+    assert (
+        "results/simulation/r0.5/shards2-2.parquet: shard_time = 2000.0 (config: 3000.0)" in message
+    )
     assert "results/simulation/r0.333333/summary.parquet: shard_time = 2000.0" in message
     # the rm command lists the stale files sorted: distribution.parquet comes first
     assert "rm results/simulation/r0.333333/distribution.parquet" in message

@@ -79,7 +79,9 @@ def test_criterion_bias_report_has_every_r_and_c(studies_run):
     assert provenance["rule"] == "study_shard" and provenance["seed"] == 7
     assert provenance["criterion_c"] == 5.0 and provenance["shard_time"] == 2.0e3
     assert provenance["equilibration_time"] == SMALL["simulation"]["equilibration_time"]
-    assert provenance["cpu_seconds"] > 0
+    # a batch of one shard (scripts/simulate_shards.py): its cost, one entry per shard
+    assert (provenance["first_shard"], provenance["last_shard"]) == (1, 1)
+    assert len(provenance["cpu_seconds"]) == 1 and provenance["cpu_seconds"][0] > 0
 
 
 def test_r075_report_compares_every_run_and_all_with_the_solver(studies_run):
@@ -103,7 +105,7 @@ def test_r075_report_compares_every_run_and_all_with_the_solver(studies_run):
 def test_the_studies_are_not_part_of_the_default_target(tmp_path):
     directory = copy_with_studies(tmp_path, TINY)
     jobs = planned_jobs(directory)
-    assert "simulate_shard" in jobs
+    assert "simulate_shards" in jobs
     assert not {"study_shard", "criterion_bias_report", "r075_report", "studies"} & set(jobs)
 
 

@@ -29,11 +29,11 @@ from bouncing_ball.io import read_table
 
 
 def test_run_produces_the_documented_tables(finished_run):
-    for label, shards in (("0.5", 3), ("0.333333", 2)):
+    for label, shards, batches in (("0.5", 3, ["0-1", "2-2"]), ("0.333333", 2, ["0-1"])):
         folder = finished_run / "results" / "simulation" / f"r{label}"
         assert sorted(p.name for p in folder.glob("shard*.parquet")) == [
-            f"shard{k}.parquet" for k in range(shards)
-        ]
+            f"shards{batch}.parquet" for batch in batches
+        ]  # simulation.shards_per_job: 2
         p0v, provenance = read_table(folder / "p0v.parquet")
         assert list(p0v.columns) == ["v_lo", "v_hi", "v", "p0v", "p0v_err", "count"]
         assert provenance["r_label"] == label and provenance["shards"] == shards
@@ -63,8 +63,13 @@ def test_run_produces_the_documented_tables(finished_run):
             assert column in summary.columns
         assert summary.total_time.iloc[0] == pytest.approx(shards * 2.0e3)
         assert p0v["count"].sum() == summary.collisions.iloc[0]
-    _, provenance = read_table(finished_run / "results/simulation/r0.333333/shard0.parquet")
+    batch, provenance = read_table(finished_run / "results/simulation/r0.333333/shards0-1.parquet")
     assert provenance["r"] == "1/3" and provenance["seed"] == 5
+    assert (provenance["first_shard"], provenance["last_shard"]) == (0, 1)
+    assert list(batch.columns) == ["shard", "tally", "lo", "hi", "lo2", "hi2", "value"]
+    assert sorted(batch["shard"].unique()) == [0, 1]
+    log = (finished_run / "logs/simulation/r0.333333/shards0-1.log").read_text()
+    assert "shard 0: time 2000," in log and "shard 1: time 2000," in log
     # no measured cost in a pipeline shard's provenance: the same config, the same file
     assert "cpu_seconds" not in provenance
     assert (finished_run / "logs/simulation/r0.5/merge.log").read_text().startswith("r=0.5")
@@ -236,14 +241,16 @@ def test_exact_one_third_does_not_need_one_third_in_the_config(finished_run, tmp
     assert planned_jobs(directory, None, "results/figures/fig5.pdf") == {}
 
 
-def test_adding_a_shard_runs_only_that_shard(finished_run, tmp_path):
+def test_adding_a_shard_runs_only_the_batch_it_joins(finished_run, tmp_path):
+    """Shards 0-1 and 2 of r = 1/2 in batches of 2: a fourth shard re-runs only the batch of
+    shards 2-3 (the full batch 0-1 stays), then what shows r = 1/2."""
     directory = tmp_path / "copy"
     shutil.copytree(finished_run, directory)  # results, logs and .snakemake, mtimes kept
     config = yaml.safe_load(yaml.safe_dump(SMALL))
     config["simulation"]["per_restitution"]["0.5"] = {"shards": 4}
     (directory / "config" / "config.yaml").write_text(yaml.safe_dump(config))
     assert planned_jobs(directory) == {
-        "simulate_shard": 1,
+        "simulate_shards": 1,
         "merge_shards": 1,
         "fit": 1,
         "fig4": 1,
@@ -273,7 +280,7 @@ def test_adding_an_r_runs_only_its_jobs_and_the_aggregates(finished_run, tmp_pat
     (directory / "config" / "config.yaml").write_text(yaml.safe_dump(config))
     planned = planned_jobs(directory)
     assert planned == {
-        "simulate_shard": 3,
+        "simulate_shards": 2,
         "merge_shards": 1,
         "solve": 1,
         "fit": 1,
@@ -297,9 +304,8 @@ def test_adding_an_r_runs_only_its_jobs_and_the_aggregates(finished_run, tmp_pat
             *(
                 f"results/simulation/r0.6/{name}.parquet"
                 for name in (
-                    "shard0",
-                    "shard1",
-                    "shard2",
+                    "shards0-1",
+                    "shards2-2",
                     "p0v",
                     "position",
                     "distribution",
@@ -344,10 +350,10 @@ def test_touching_every_script_reruns_nothing(finished_run, tmp_path):
     for script in (directory / "scripts").rglob("*.py"):
         script.touch()
     assert planned_jobs(directory) == {}
-    with open(directory / "scripts/simulate_shard.py", "a") as handle:
+    with open(directory / "scripts/simulate_shards.py", "a") as handle:
         handle.write("\n# an edit\n")
     planned = planned_jobs(directory)
-    assert planned["simulate_shard"] == 5, planned  # 3 shards of r = 1/2, 2 of 1/3
+    assert planned["simulate_shards"] == 3, planned  # batches 0-1, 2-2 of r = 1/2, 0-1 of 1/3
     assert not {"solve", "solve_grid", "exact_solution", "theory"} & set(planned)
 
 
@@ -366,13 +372,13 @@ def test_editing_a_plotting_script_reruns_only_figures(finished_run, tmp_path):
 def test_one_target_builds_only_what_it_needs(tmp_path):
     directory = copy_repository(tmp_path, SMALL)
     assert planned_jobs(directory, None, "results/figures/fig5.pdf") == {
-        "simulate_shard": 5,
+        "simulate_shards": 3,
         "merge_shards": 2,
         "exact_solution": 2,
         "fig5": 1,
     }
     assert planned_jobs(directory, None, "tables") == {
-        "simulate_shard": 5,
+        "simulate_shards": 3,
         "merge_shards": 2,
         "solve": 2,
         "fit": 2,
@@ -417,7 +423,7 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
     with open(package / "free_flight.py", "a") as handle:
         handle.write("\n# an edit\n")
     assert planned_jobs(finished_run, env) == {
-        "simulate_shard": 5,
+        "simulate_shards": 3,
         "merge_shards": 2,
         "fit": 2,
         **downstream,
@@ -478,9 +484,12 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
         assert planned_jobs(finished_run, env) == {**expected, "all": 1}, module
 
 
-def test_results_do_not_depend_on_cores(finished_run, tmp_path):
-    """The same config with --cores 1 gives bit-identical tables."""
-    directory = copy_repository(tmp_path, SMALL)
+def test_results_do_not_depend_on_cores_or_on_the_batching_of_shards(finished_run, tmp_path):
+    """The same config with --cores 1 and one shard per job (r = 1/2: shards 0-0, 1-1, 2-2,
+    not 0-1 and 2-2) gives bit-identical tables."""
+    config = copy.deepcopy(SMALL)
+    config["simulation"]["shards_per_job"] = 1
+    directory = copy_repository(tmp_path, config)
     result = subprocess.run(
         [
             sys.executable,
@@ -498,6 +507,10 @@ def test_results_do_not_depend_on_cores(finished_run, tmp_path):
         timeout=600,
     )
     assert result.returncode == 0, result.stderr[-3000:]
+    folder = directory / "results/simulation/r0.5"
+    assert sorted(path.name for path in folder.glob("shards*")) == [
+        f"shards{k}-{k}.parquet" for k in range(3)
+    ]
     for table in ("p0v", "position", "distribution", "flight_time", "return_speed", "summary"):
         one, _ = read_table(directory / f"results/simulation/r0.5/{table}.parquet")
         two, _ = read_table(finished_run / f"results/simulation/r0.5/{table}.parquet")

@@ -25,13 +25,20 @@ def settings_of(label):
 
 
 def stale_simulation():
-    """{file: what differs} of the shards and merged tables of every r the config simulates."""
+    """{file: what differs} of the batches of shards and merged tables of every r the config
+    simulates."""
     stale = {}
     for label in KNOWN_RESTITUTION:
         asked = settings_of(label)
-        shard = {"seed": config["seed"], "code": SHARD_CODE, **asked}
-        for path in shard_files(SimpleNamespace(r=label)):
-            found = table_differences(path, shard)
+        batch = {"seed": config["seed"], "code": SHARD_CODE, **asked}
+        for path, (first, last) in zip(
+            batch_files(SimpleNamespace(r=label)),
+            shard_batches(config, label),
+            strict=True,
+        ):
+            found = table_differences(
+                path, {"first_shard": first, "last_shard": last, **batch}
+            )
             if found:
                 stale[path] = found
         merged = {

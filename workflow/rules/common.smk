@@ -1,4 +1,6 @@
-# Helpers for every stage: r labels and exact values, per-r settings, shard lists, targets.
+# Helpers for every stage: r labels and exact values, per-r settings, shard batches, targets.
+from fractions import Fraction
+
 from bouncing_ball import source_digest, stages
 from bouncing_ball.config import (
     check_config,
@@ -7,6 +9,7 @@ from bouncing_ball.config import (
     overlay_per_restitution,
     read_yaml,
     solver_settings,
+    shard_batches,
     shard_count,
     shard_settings,
 )
@@ -46,7 +49,7 @@ def code(modules, script):
     return source_digest(modules, [f"{workflow.basedir}/scripts/{script}"])
 
 
-SHARD_CODE = code(stages.SIMULATION, "simulate_shard.py")  # pipeline and study shards
+SHARD_CODE = code(stages.SIMULATION, "simulate_shards.py")  # pipeline and study shards
 
 # the r values with an exact solution, eq. (P(0,v)): always computed (Figs. 3 and 5)
 EXACT_BY_LABEL = {restitution_label(value): value for value in EXACT_RESTITUTIONS}
@@ -66,6 +69,11 @@ def restitution_value(wildcards):
     return exact_string(exact)
 
 
+def solve_priority(wildcards):
+    """Rule solve: 11 where r > 1/2 (its w(F) takes about twice as long), else 9."""
+    return 11 if parse_restitution(restitution_value(wildcards)) > Fraction(1, 2) else 9
+
+
 def solver_restitution_value(wildcards):
     """``restitution_value``, refused (before any job runs) outside the solver's range."""
     value = restitution_value(wildcards)
@@ -78,12 +86,45 @@ def settings(wildcards):
     return shard_settings(config, wildcards.r).as_mapping()
 
 
-def shard_files(wildcards):
-    return expand(
-        "results/simulation/r{r}/shard{shard}.parquet",
-        r=wildcards.r,
-        shard=range(shard_count(config, wildcards.r)),
-    )
+def batch_files(wildcards):
+    """The files of the shards of r: one per batch of simulation.shards_per_job shards."""
+    return [
+        f"results/simulation/r{wildcards.r}/shards{first}-{last}.parquet"
+        for first, last in shard_batches(config, wildcards.r)
+    ]
+
+
+def batch_shards(wildcards):
+    """The shards of a batch file, shards{first}-{last}: first to last, both included."""
+    first, last = int(wildcards.first), int(wildcards.last)
+    if last < first:
+        raise ValueError(
+            f"results/simulation/r{wildcards.r}/shards{wildcards.first}-{wildcards.last}.parquet: "
+            f"the last shard ({last}) comes before the first ({first})"
+        )
+    return list(range(first, last + 1))
+
+
+def batch_time(label, shards):
+    """The simulated time of a batch of ``shards`` shards of r = ``label``."""
+    return shards * shard_settings(config, label).shard_time
+
+
+# the longest batch of the config's r values: the scale of the batches' priorities
+LONGEST_BATCH = max(
+    batch_time(label, last - first + 1)
+    for label in KNOWN_RESTITUTION
+    for first, last in shard_batches(config, label)
+)
+
+
+def batch_priority(wildcards):
+    """10 times the batch's simulated time over the longest batch's (at most 10): on a few
+    cores the longest batches (r = 0.75's) start first, with the exact solutions (10) and
+    the solver where r > 1/2 (11; solve_priority), so that none runs alone at the end, and
+    the first batch compiles the loop before the shorter batches start."""
+    simulated = batch_time(wildcards.r, len(batch_shards(wildcards)))
+    return round(min(10.0, 10.0 * simulated / LONGEST_BATCH), 2)
 
 
 # the merged tables of each r (rule merge_shards)

@@ -1,35 +1,35 @@
-# The simulation stage: the paper's Sec. IV, one job per (r, shard), merged per r.
+# The simulation stage: the paper's Sec. IV. Per r, one job per batch of shards
+# (simulation.shards_per_job), each shard on its own random stream; merged per r.
 
 
-rule simulate_shard:
+rule simulate_shards:
     output:
-        "results/simulation/r{r}/shard{shard}.parquet",
+        "results/simulation/r{r}/shards{first}-{last}.parquet",
     log:
-        "logs/simulation/r{r}/shard{shard}.log",
-    # one SLURM job runs several shards (profiles/slurm: group-components);
-    # local runs are unaffected
-    group:
-        "shards"
+        "logs/simulation/r{r}/shards{first}-{last}.log",
+    # the batches with the most simulated time first (common.smk)
+    priority: batch_priority
     conda:
         "../envs/bouncing-ball.yaml"
     # minutes: the step budget (simulation.max_steps, 10^9 steps) stops a shard after
-    # about 2-4 CPU minutes; raise runtime with max_steps
+    # about 2-4 CPU minutes, so 20 per shard of the batch; raise runtime with max_steps
     resources:
-        runtime=20,
+        runtime=lambda wildcards: 20 * len(batch_shards(wildcards)),
         mem_mb=500,
         cpus_per_task=1,
     params:
         restitution=restitution_value,
+        shards=batch_shards,
         seed=config["seed"],
         settings=settings,
         code=SHARD_CODE,
     script:
-        "../../scripts/simulate_shard.py"
+        "../../scripts/simulate_shards.py"
 
 
 rule merge_shards:
     input:
-        shard_files,
+        batch_files,
     output:
         p0v="results/simulation/r{r}/p0v.parquet",
         position="results/simulation/r{r}/position.parquet",

@@ -50,7 +50,8 @@ rule study_shard:
     wildcard_constraints:
         study="|".join(STUDY_RUNS),
         run=r"[^/]+",
-    # as rule simulate_shard: several shards per SLURM job (profiles/slurm)
+    # one shard per job (a study shard computes for 10-30 s); several per SLURM job
+    # (profiles/slurm: group-components)
     group:
         "shards"
     conda:
@@ -62,12 +63,13 @@ rule study_shard:
         cpus_per_task=1,
     params:
         restitution=lambda w: exact_string(STUDY_RUNS[w.study][w.run].restitution),
+        shards=lambda w: [int(w.shard)],  # a batch of one (scripts/simulate_shards.py)
         seed=lambda w: STUDY_RUNS[w.study][w.run].seed,
         settings=lambda w: STUDY_RUNS[w.study][w.run].settings.as_mapping(),
         code=SHARD_CODE,
         record_cpu_seconds=True,
     script:
-        "../../scripts/simulate_shard.py"
+        "../../scripts/simulate_shards.py"
 
 
 rule criterion_bias_report:

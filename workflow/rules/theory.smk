@@ -22,7 +22,7 @@ rule theory:
 
 rule fit:
     input:
-        shards=shard_files,
+        shards=batch_files,
         solver="results/solver/r{r}/p0v.parquet",
     output:
         "results/fits/r{r}.parquet",
