@@ -86,8 +86,11 @@ def save_figure(figure, pdf, png, dpi, provenance: dict) -> None:
         {"Software": f"bouncing_ball {__version__}", "Description": description},
     )
     with atomic_paths(pdf, png) as (pdf_temporary, png_temporary), matplotlib.rc_context(STYLE):
-        figure.savefig(pdf_temporary, metadata=pdf_metadata)
         figure.savefig(png_temporary, metadata=png_metadata, dpi=dpi)
+        # laid out by now: the PDF keeps that layout instead of computing it again (a sixth
+        # of the figure's time)
+        figure.set_layout_engine("none")
+        figure.savefig(pdf_temporary, metadata=pdf_metadata)
     logging.info("wrote %s and %s", pdf, png)
 
 

@@ -39,6 +39,8 @@ rule merge_shards:
         summary="results/simulation/r{r}/summary.parquet",
     log:
         "logs/simulation/r{r}/merge.log",
+    # a second or two, and most figures and tables wait for it: before them
+    priority: 1
     conda:
         "../envs/bouncing-ball.yaml"
     resources:

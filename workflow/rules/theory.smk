@@ -6,6 +6,8 @@ rule theory:
         "results/theory/exponents.parquet",
     log:
         "logs/theory/exponents.log",
+    # a second, and Figs. 1 and 2 wait for it: before them
+    priority: 1
     localrule: True
     conda:
         "../envs/bouncing-ball.yaml"
@@ -28,6 +30,8 @@ rule fit:
         "results/fits/r{r}.parquet",
     log:
         "logs/fits/r{r}.log",
+    # a second or two, and Fig. 4 and the tables wait for it: before them
+    priority: 1
     conda:
         "../envs/bouncing-ball.yaml"
     resources:
