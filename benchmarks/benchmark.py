@@ -287,6 +287,7 @@ def workflow_benchmark():
     config = yaml.safe_load((REPOSITORY / "config" / "config.yaml").read_text())
     config["restitution"] = [round(0.2 + 0.0375 * k, 4) for k in range(20)]
     config["simulation"]["shards"] = 16
+    config["simulation"]["shards_per_job"] = 1  # a job per shard: the largest plan
     config["simulation"]["per_restitution"] = {}
     config["figures"].update({"fig4": [0.5], "fig5": [0.5]})  # panels from the grid: 320 shard jobs
     with tempfile.TemporaryDirectory() as folder:
@@ -318,7 +319,10 @@ def scaling_benchmark(shards=16, shard_time=5.0e6):
 
     config = yaml.safe_load((REPOSITORY / "config" / "config.yaml").read_text())
     config["restitution"] = [0.5]
-    config["simulation"].update({"shards": shards, "shard_time": shard_time, "per_restitution": {}})
+    config["simulation"].update(
+        # 8 jobs of 2 shards: work that 2 cores can share
+        {"shards": shards, "shard_time": shard_time, "shards_per_job": 2, "per_restitution": {}}
+    )
     times = {}
     for cores in (1, 2):
         with tempfile.TemporaryDirectory() as folder:
