@@ -289,7 +289,8 @@ def workflow_benchmark():
     config["simulation"]["shards"] = 16
     config["simulation"]["shards_per_job"] = 1  # a job per shard: the largest plan
     config["simulation"]["per_restitution"] = {}
-    config["figures"].update({"fig4": [0.5], "fig5": [0.5]})  # panels from the grid: 320 shard jobs
+    # every figure's panels from the grid: 320 shard jobs
+    config["figures"].update({name: [0.5] for name in ("fig4", "fig5", "fig8", "fig10", "fig11")})
     with tempfile.TemporaryDirectory() as folder:
         _workflow_copy(Path(folder), config)
         dry_run, result = _timed_snakemake(folder, "--cores", "2", "--dry-run", "--quiet", "rules")

@@ -93,6 +93,32 @@ ROOT_TOLERANCE = 2.0e-3  # a last Householder step below this (relative) leaves 
 
 
 @njit(cache=True, inline="always")
+def _householder_root(x, v, c, s, iterations):
+    """Householder iterations for ``criterion_root`` from s: (s, f'(s), converged)."""
+    f1 = -1.0
+    for _ in range(iterations):
+        s2 = s * s
+        f = x + s2 * (v - s * (c + 0.5 * s))
+        f1 = s * (2.0 * v - s * (3.0 * c + 2.0 * s))
+        if not f1 < 0.0:
+            return s, f1, False
+        f2 = 2.0 * v - s * (6.0 * c + 6.0 * s)
+        f3 = -6.0 * c - 12.0 * s
+        f_f2 = f * f2
+        f1_squared = f1 * f1
+        denominator = f1 * (6.0 * f1_squared - 6.0 * f_f2) + f * f * f3
+        # Householder where its denominator is negative, else Newton
+        step = f * (6.0 * f1_squared - 3.0 * f_f2) / denominator if denominator < 0.0 else f / f1
+        if not s - step > 0.0:  # overshot past 0: halve instead (f(0) = x > 0)
+            s *= 0.5
+            continue
+        s -= step
+        if abs(step) <= ROOT_TOLERANCE * s:
+            return s, f1, True
+    return s, f1, False
+
+
+@njit(cache=True, inline="always")
 def criterion_root(x, v, c, start):
     """The positive root s* of f(s) = x + v s^2 - c s^3 - s^4/2, eq. (criterion) with
     s = sqrt(Delta), and the slope f' there: (s*, f'(s*)).
@@ -115,34 +141,12 @@ def criterion_root(x, v, c, start):
     if x < _SMALLEST_NORMAL:
         s = _floor_root(v, c)
         return s, s * (2.0 * v - s * (3.0 * c + 2.0 * s))
-    fitted = not start > 0.0
-    s = _fitted_root(x, v, c) if fitted else start
-    i = 0
-    while True:
-        s2 = s * s
-        f = x + s2 * (v - s * (c + 0.5 * s))
-        f1 = s * (2.0 * v - s * (3.0 * c + 2.0 * s))
-        if not f1 < 0.0 or i == 60:
-            if fitted:  # from the fitted start: only on underflow
-                return s, f1
-            s = _fitted_root(x, v, c)
-            fitted = True
-            i = 0
-            continue
-        f2 = 2.0 * v - s * (6.0 * c + 6.0 * s)
-        f3 = -6.0 * c - 12.0 * s
-        f_f2 = f * f2
-        f1_squared = f1 * f1
-        denominator = f1 * (6.0 * f1_squared - 6.0 * f_f2) + f * f * f3
-        # Householder where its denominator is negative, else Newton
-        step = f * (6.0 * f1_squared - 3.0 * f_f2) / denominator if denominator < 0.0 else f / f1
-        i += 1
-        if not s - step > 0.0:  # overshot past 0: halve instead (f(0) = x > 0)
-            s *= 0.5
-            continue
-        s -= step
-        if abs(step) <= ROOT_TOLERANCE * s:
+    if start > 0.0:
+        s, f1, converged = _householder_root(x, v, c, start, 60)
+        if converged:
             return s, f1
+    s, f1, _ = _householder_root(x, v, c, _fitted_root(x, v, c), 60)
+    return s, f1
 
 
 @njit(cache=True, inline="always")
