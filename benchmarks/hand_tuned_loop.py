@@ -27,7 +27,7 @@ against the exact one (chi^2 about 60 on 52 bins at r = 1/2); ``normals`` and
 ``criterion_root`` expose the generator and the root for their own checks.
 
 ``build`` compiles it into ``__pycache__/hand-tuned-<key>/`` keyed on the hash of the source
-and the compiler command (``reference_loop.cache_key``); ``run`` runs one shard and returns
+and the compiler command (``reference_loop.build_shared_library``); ``run`` runs one shard and returns
 its tallies with the CPU time measured inside the C call.  ``python -m
 benchmarks.hand_tuned_loop`` prints its throughput at r = 0.25, 0.5, 0.75 and c = 3, 5;
 ``--check`` adds the physics check (``--check-r``: its r, default 1/2).
@@ -36,11 +36,7 @@ benchmarks.hand_tuned_loop`` prints its throughput at r = 0.25, 0.5, 0.75 and c 
 import argparse
 import ctypes
 import functools
-import os
-import shutil
-import subprocess
 import sys
-import tempfile
 from fractions import Fraction
 from pathlib import Path
 
@@ -48,7 +44,7 @@ import numpy as np
 
 from bouncing_ball.bins import LogBins
 
-from .reference_loop import COMPILER, cache_key
+from .reference_loop import COMPILER, build_shared_library
 
 HERE = Path(__file__).resolve().parent
 SOURCE = HERE / "reference" / "hand_tuned.c"
@@ -62,7 +58,6 @@ FLAGS = (
     "-fPIC",
     "-shared",
 )
-LIBRARY_NAME = "hand_tuned.so"
 # the default config's speed bins: outgoing speeds of P(0, v)
 SPEED_BINS = LogBins(1.0e-4, 1.0e2, 10)
 OUTPUTS = (
@@ -86,33 +81,10 @@ def compile_command(source: Path, output: Path) -> list[str]:
 
 
 def build(directory=None) -> Path:
-    """Compile the hand-tuned loop (if not cached yet) and return the shared library's path.
-
-    Raises RuntimeError where gcc is missing or the compile fails.
-    """
-    base = Path(directory) if directory is not None else HERE / "__pycache__"
-    if shutil.which(COMPILER) is None:
-        raise RuntimeError(
-            f"the C compiler '{COMPILER}' was not found on PATH; it is needed to build {SOURCE.name}"
-        )
-    text = SOURCE.read_bytes()
-    key = cache_key(text, compile_command(Path(SOURCE.name), Path(LIBRARY_NAME)))
-    folder = base / f"hand-tuned-{key}"
-    library = folder / LIBRARY_NAME
-    if library.is_file():
-        return library
-    folder.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(dir=folder, prefix=".build-") as scratch:
-        snapshot = Path(scratch) / SOURCE.name
-        snapshot.write_bytes(text)
-        temporary = Path(scratch) / LIBRARY_NAME
-        result = subprocess.run(
-            compile_command(snapshot, temporary), capture_output=True, text=True
-        )
-        if result.returncode != 0:
-            raise RuntimeError(f"compiling {SOURCE} failed:\n{result.stderr}")
-        os.replace(temporary, library)
-    return library
+    """Compile the hand-tuned loop (if not cached yet) and return the shared library's path
+    (``reference_loop.build_shared_library``; RuntimeError where gcc is missing or the
+    compile fails)."""
+    return build_shared_library(SOURCE, compile_command, "hand-tuned", directory)
 
 
 _double_array = np.ctypeslib.ndpointer(dtype=np.float64, ndim=1, flags="C_CONTIGUOUS")

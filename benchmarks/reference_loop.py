@@ -73,15 +73,12 @@ def cache_key(source_text: bytes, command: list[str]) -> str:
     return digest.hexdigest()[:16]
 
 
-def build(directory=None, source=None) -> Path:
-    """Compile the C reference (if not cached yet) and return the shared library's path.
-
-    The library goes to ``<directory>/reference-<key>/shard_loop.so``, ``directory``
-    defaulting to this folder's __pycache__ and ``<key>`` hashing the source and
-    the compiler command, so an edit of the C file builds into a new folder.
-    ``source`` defaults to reference/shard_loop.c beside this module.
-    """
-    source = Path(source) if source is not None else SOURCE
+def build_shared_library(source: Path, compile_command, prefix: str, directory=None) -> Path:
+    """Compile ``source`` with ``compile_command(source, output)`` (if not cached yet) and
+    return the shared library's path: ``<directory>/<prefix>-<key>/<LIBRARY_NAME>``,
+    ``directory`` defaulting to this folder's __pycache__ and ``<key>`` hashing the source
+    and the compiler command, so an edit of the C file builds into a new folder.  Raises
+    RuntimeError where the compiler is missing or the compile fails."""
     base = Path(directory) if directory is not None else HERE / "__pycache__"
     if shutil.which(COMPILER) is None:
         raise RuntimeError(
@@ -90,7 +87,7 @@ def build(directory=None, source=None) -> Path:
     text = source.read_bytes()
     # the key is computed on a placeholder output name, so that it does not depend on itself
     key = cache_key(text, compile_command(Path(source.name), Path(LIBRARY_NAME)))
-    folder = base / f"reference-{key}"
+    folder = base / f"{prefix}-{key}"
     library = folder / LIBRARY_NAME
     if library.is_file():
         return library
@@ -107,6 +104,15 @@ def build(directory=None, source=None) -> Path:
             raise RuntimeError(f"compiling {source} failed:\n{result.stderr}")
         os.replace(temporary, library)
     return library
+
+
+def build(directory=None, source=None) -> Path:
+    """Compile the C reference (if not cached yet) and return the shared library's path,
+    ``<directory>/reference-<key>/shard_loop.so`` (``build_shared_library``).
+    ``source`` defaults to reference/shard_loop.c beside this module.
+    """
+    source = Path(source) if source is not None else SOURCE
+    return build_shared_library(source, compile_command, "reference", directory)
 
 
 _double_array = np.ctypeslib.ndpointer(dtype=np.float64, ndim=1, flags="C_CONTIGUOUS")
