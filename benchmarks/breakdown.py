@@ -24,6 +24,8 @@ from bouncing_ball.free_flight import (
     first_crossing_time,
     free_flight_step,
     hermite_cubic,
+    predicted_start,
+    root_predictor,
 )
 from bouncing_ball.jit import njit
 from bouncing_ball.simulation import (
@@ -99,9 +101,7 @@ def _trajectory(rng, steps, r, c, min_step_divisor):
     for i in range(steps):
         xs[i], vs[i], starts[i] = x, v, start
         dt = root * root + delta
-        k1 = 1.0 / slope if slope < 0.0 else 0.0
-        k2 = k1 * root * root
-        k0 = root + k1 * x + k2 * v
+        predictor = root_predictor(root, slope, x, v)
         x1, v1 = free_flight_step(x, v, dt, rng.standard_normal(), rng.standard_normal())
         if x1 < 0.0:
             a0, a1, a2, a3 = hermite_cubic(x, v, x1, v1, dt)
@@ -112,8 +112,7 @@ def _trajectory(rng, steps, r, c, min_step_divisor):
             start = 0.0
         else:
             x, v = x1, v1
-            predicted = k0 - k1 * x1 - k2 * v1
-            start = predicted if predicted > 0.0 else root
+            start = predicted_start(predictor, root, x1, v1)
         root, slope = criterion_root(x, v, c, start)
     return xs, vs, starts
 

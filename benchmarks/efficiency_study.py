@@ -25,11 +25,13 @@ from pathlib import Path
 
 import numpy as np
 
+from bouncing_ball.tallies import CONTROL_VARIATE_SUMS
+
 REPOSITORY = Path(__file__).resolve().parents[1]
 CONTROLS = {
     "cv1": ("noise_sum",),
     "cv3": ("noise_sum", "noise_v_sum", "noise_scaled_sum"),
-    "cv4": ("noise_sum", "noise_v_sum", "noise_scaled_sum", "normal_sum"),
+    "cv4": CONTROL_VARIATE_SUMS,
 }
 EXACT_RATE = {Fraction(1, 2): 1.0 / 3.0, Fraction(1, 3): 0.75}
 

@@ -150,6 +150,27 @@ def criterion_root(x, v, c, start):
 
 
 @njit(cache=True, inline="always")
+def root_predictor(root, slope_at_root, x, v):
+    """The coefficients (k0, k1, k2) of the next step's start for ``criterion_root``,
+    s ~ k0 - k1 x1 - k2 v1 at the step's end (x1, v1): f(s; x, v) is linear in x and v and
+    f(root; x, v) = 0, so to first order s ~ root - (x1 - x + root^2 (v1 - v)) / f'(root).
+    They depend only on the step's start, so they are ready (division included) before
+    the step; ``predicted_start`` finishes the prediction."""
+    k1 = 1.0 / slope_at_root if slope_at_root < 0.0 else 0.0
+    k2 = k1 * root * root
+    return root + k1 * x + k2 * v, k1, k2
+
+
+@njit(cache=True, inline="always")
+def predicted_start(predictor, root, x1, v1):
+    """The start of ``criterion_root`` at (x1, v1): the first-order prediction of
+    ``root_predictor``, or the previous root where the prediction is not positive."""
+    k0, k1, k2 = predictor
+    predicted = k0 - k1 * x1 - k2 * v1
+    return predicted if predicted > 0.0 else root
+
+
+@njit(cache=True, inline="always")
 def largest_safe_step(x, v, c):
     """The largest step D(x, v) allowed by eq. (criterion): s*^2 of ``criterion_root``
     from the fitted start (0 when x <= 0 and v <= 0)."""

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from . import stages
-from .tallies import ShardTallies, merge_shards
+from .tallies import CONTROL_VARIATE_SUMS, ShardTallies, merge_shards
 
 # the modules whose code decides the merged tables (see ``source_digest``)
 SOURCES = stages.MERGE
@@ -189,10 +189,6 @@ def _mean_x(int_x, time):
 
 def _delta_x(int_x, int_x2, time):
     return np.sqrt(int_x2 / time - (int_x / time) ** 2)
-
-
-# the shards' martingale sums that ``control_variate_rate`` corrects I with
-CONTROL_VARIATE_SUMS = ("noise_sum", "noise_v_sum", "noise_scaled_sum", "normal_sum")
 
 
 def position_moments_summary(shards: list[ShardTallies], restitution: float) -> pd.DataFrame:

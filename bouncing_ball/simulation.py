@@ -96,7 +96,9 @@ from .free_flight import (
     mean_path_integrals,
     monotone_piece_end,
     piece_inverse,
+    predicted_start,
     quintic_antiderivative_value,
+    root_predictor,
     slope_zeros,
     speed_squared_coefficients,
 )
@@ -366,12 +368,8 @@ def _run(
             break
         if t + dt > t_stop:
             dt = t_stop - t
-        # the next root starts from a first-order prediction off this one: f(s; x, v) is linear
-        # in x and v and f(root; x, v) = 0, so s ~ root - (x1 - x + root^2 (v1 - v)) / f'(root)
-        # = k0 - k1 x1 - k2 v1, with coefficients ready (division included) before the step
-        k1 = 1.0 / slope_at_root if slope_at_root < 0.0 else 0.0
-        k2 = k1 * root * root
-        k0 = root + k1 * x + k2 * v
+        # the next root starts from a first-order prediction off this one
+        predictor = root_predictor(root, slope_at_root, x, v)
         normal_r = rng.standard_normal()
         normal_s = rng.standard_normal()
         x1, v1 = free_flight_step(x, v, dt, normal_r, normal_s)
@@ -454,8 +452,8 @@ def _run(
         else:
             x = x1
             v = v1
-            predicted = k0 - k1 * x1 - k2 * v1
-            root, slope_at_root = criterion_root(x, v, c, predicted if predicted > 0.0 else root)
+            start = predicted_start(predictor, root, x1, v1)
+            root, slope_at_root = criterion_root(x, v, c, start)
 
     scalars[_TIME] = t if recording else 0.0
     scalars[_COLLISIONS] = collisions

@@ -39,6 +39,8 @@ HISTOGRAMS_2D = {
     "position_velocity_time": (("position_bins", "velocity_bins"), "position_velocity_time", False),
     "return_speed": (("speed_bins", "speed_bins"), "return_speed_counts", True),
 }
+# the martingale sums of mean 0 that correct I (``histograms.control_variate_rate``)
+CONTROL_VARIATE_SUMS = ("noise_sum", "noise_v_sum", "noise_scaled_sum", "normal_sum")
 SCALARS = (
     "time",
     "collisions",
@@ -49,10 +51,7 @@ SCALARS = (
     "flights",
     "flight_time_sum",
     "flight_time_squared_sum",
-    "noise_sum",
-    "noise_v_sum",
-    "noise_scaled_sum",
-    "normal_sum",
+    *CONTROL_VARIATE_SUMS,
 )
 _INTEGER = ("collisions", "steps", "budget_exhausted", "flights")
 BINS = ("speed_bins", "position_bins", "velocity_bins", "flight_time_bins")

@@ -22,7 +22,8 @@
  * the C returns a struct (piece_inverse) or the first value with the second
  * through a pointer (criterion_root, whose (s*, f'(s*)) the loop carries from
  * step to step as root, slope_at_root, with the predictor k0, k1, k2 of the next
- * step's start computed before the step, as in ``_run``).  ``_run``'s last
+ * step's start computed before the step, as in ``_run``; free_flight.root_predictor
+ * and predicted_start are written out inline in the loop).  ``_run``'s last
  * argument ``parts`` (a bitmask of the tallies, for the benchmark's breakdown)
  * has no counterpart: this loop always records everything, i.e. it is
  * ``_run`` with parts = EVERY_TALLY, which is what ``simulate_shard`` passes

@@ -23,6 +23,9 @@ from bouncing_ball.io import UnreadableFileError, read_table, write_table
 from bouncing_ball.settings import ShardSettings
 from bouncing_ball.shards import read_shards
 from bouncing_ball.tallies import (
+    CONTROL_VARIATE_SUMS as CONTROL_VARIATES,
+)
+from bouncing_ball.tallies import (
     ShardTallies,
     merge_shards,
     tallies_from_frame,
@@ -33,7 +36,6 @@ SPEED_BINS = LogBins(1e-2, 1e1, 2)
 POSITION_BINS = LogBins(1e-1, 1e2, 1)
 VELOCITY_BINS = LinearBins(-1.0, 2.0, 1.0)
 FLIGHT_TIME_BINS = LogBins(1e-2, 1e1, 1)
-CONTROL_VARIATES = ("noise_sum", "noise_v_sum", "noise_scaled_sum", "normal_sum")
 BIN_SET = SimpleNamespace(
     speed_bins=SPEED_BINS,
     position_bins=POSITION_BINS,
