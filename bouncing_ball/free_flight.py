@@ -272,6 +272,22 @@ def bridge_sample(a0, a1, a2, a3, dt, t, normal_1, normal_2):
 
 
 @njit(cache=True)
+def bridge_speed_squared_given_position(a1, a2, a3, dt, t, normal_1):
+    """E[v(t)^2 | x(t), ends] for the x(t) that ``bridge_sample`` draws with ``normal_1``.
+
+    In ``bridge_sample``'s factorisation, x(t) fixes normal_1, and v(t) given x(t) is
+    Gaussian with mean m'(t) + (3/2)^(1/2) (dt w)^(1/2) (1 - 2u) normal_1 and variance
+    dt w / 2 (w = u (1 - u), u = t / dt).  Averaged over normal_1 it is E[v(t)^2 | ends],
+    the integrand of ``speed_squared_coefficients``.
+    """
+    u = t * (1.0 / dt)
+    w = max(u * (1.0 - u), 0.0)
+    root = math.sqrt(dt * w)
+    mean = cubic_slope(a1, a2, a3, t) + root * SQRT3_2 * (1.0 - 2.0 * u) * normal_1
+    return mean * mean + 0.5 * dt * w
+
+
+@njit(cache=True)
 def speed_squared_coefficients(a1, a2, a3, dt):
     """S(t) = int_0^t E[v(t')^2 | ends] dt' = t (s1 + t (s2 + t (s3 + t (s4 + t s5)))).
 
@@ -311,6 +327,36 @@ def piece_inverse(t_lo, t_hi, x_lo, x_hi, d_lo, d_hi):
 
 
 @njit(cache=True, inline="always")
+def level_time_estimate(level, inverse):
+    """The start of ``level_time``: the inverse cubic Hermite interpolant t(m) through the
+    ends of the monotone piece (their values and slopes 1/m'), or the linear one next to a
+    zero of m' (``inverse``: the piece's ``piece_inverse``).  No iteration: its error is
+    below 1e-3 of the piece for about 60 % of the crossings of simulated steps and up to
+    a few tenths of it next to a turning point."""
+    t_lo, width, x_lo, rise, inv_rise, m0, m1 = inverse
+    u = (level - x_lo) * inv_rise
+    if m0 == 0.0:
+        return t_lo + width * u
+    return t_lo + width * (u * u * (3.0 - 2.0 * u) + u * (1.0 - u) * ((1.0 - u) * m0 - u * m1))
+
+
+@njit(cache=True, inline="always")
+def level_time_one_step(a0, a1, a2, a3, level, inverse):
+    """``level_time_estimate`` and one Halley step from it, with no test and no iteration
+    (it may leave the piece, or be NaN where m' vanishes: the caller clips it).  On the
+    crossings of simulated steps (r = 1/2, c = 5) its error is below 1e-9 of the piece for
+    about 70 % of them and below 3e-3 for 99 %; next to a turning point it can be a few
+    tenths of the piece.  The P(x) tally uses it: its errors only move time between
+    neighbouring bins of one step's assignment, which the tally's bridge correction
+    undoes in expectation (``simulation``)."""
+    t = level_time_estimate(level, inverse)
+    f = cubic_value(a0, a1, a2, a3, t) - level
+    d1 = cubic_slope(a1, a2, a3, t)
+    d2 = 2.0 * a2 + 6.0 * a3 * t
+    return t - 2.0 * f * d1 / (2.0 * d1 * d1 - f * d2)
+
+
+@njit(cache=True, inline="always")
 def level_time(a0, a1, a2, a3, level, inverse):
     """The t where the mean path m(t) = level on a monotone piece that brackets it
     (``inverse``: the piece's ``piece_inverse``).
@@ -333,14 +379,11 @@ def level_time(a0, a1, a2, a3, level, inverse):
     so the processor overlaps them.
     """
     t_lo, width, x_lo, rise, inv_rise, m0, m1 = inverse
-    u = (level - x_lo) * inv_rise
-    if u <= 0.0:
+    if (level - x_lo) * inv_rise <= 0.0:
         return t_lo
     rising = rise > 0.0
     lo, hi = t_lo, t_lo + width
-    t = t_lo + width * (u * u * (3.0 - 2.0 * u) + u * (1.0 - u) * ((1.0 - u) * m0 - u * m1))
-    if m0 == 0.0:
-        t = t_lo + width * u
+    t = level_time_estimate(level, inverse)
     for _ in range(200):
         f = cubic_value(a0, a1, a2, a3, t) - level
         if f == 0.0:

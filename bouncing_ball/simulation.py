@@ -22,23 +22,35 @@ depends on the state):
   * the time, collisions and steps (all after equilibration);
   * int x dt and int x^2 dt, exact in expectation given the ends (mean path
     plus bridge variance);
-  * the time spent in each log bin of x along the mean path, and int v^2 dt
-    in each bin (slope squared plus bridge variance of v), which give P(x)
-    and <v^2>_x of eq. (moment2).  Assigning time by the mean path ignores
-    the bridge's spread sigma_x ~ (Delta^3 / 96)^(1/2) about it; that
-    changes a bin by about (sigma_x^2 / 2) P''/P, second order, ~1e-4.
+  * one point of each recorded step's bridge: a time s uniform in [0, tau] and
+    (x(s), v(s)) from the bridge's exact conditional Gaussian given both ends
+    (``free_flight.bridge_sample``), drawn from their own generator
+    (``tally_seed_sequence``), so the trajectory and the tallies that do not use
+    the point are those of a shard without it.
   * the time spent in each cell of (x, v), x on the position bins and v on
-    evenly spaced bins, for P(x, v).  Here the bridge's spread of v about the
-    mean path's slope, Var[v(t) | ends] <= Delta / 6, is not negligible (steps
-    away from the floor reach 0.1-1), so each recorded step [0, tau] of a
-    step of length Delta draws one time s uniformly in [0, tau] and (x(s),
-    v(s)) from the bridge's exact conditional Gaussian given both ends
-    (``free_flight.bridge_sample``), and adds tau to that cell.  Given the
-    ends, the expectation of what is added to a cell is
+    evenly spaced bins, for P(x, v): tau added to the cell of (x(s), v(s)).
+    Given the ends, the expectation of what is added to a cell is
     tau * (1/tau) int_0^tau Prob[(x(s), v(s)) in cell | ends] ds, the
-    expected time in the cell: unbiased, with no discretisation error.  The
-    draws come from their own generator (``tally_seed_sequence``), so the
-    trajectory and every other tally are those of a shard without it.
+    expected time in the cell: unbiased, with no discretisation error.
+  * the time spent in each log bin of x, and int v^2 dt in each bin, which give
+    P(x) and <v^2>_x of eq. (moment2), exact in expectation with the variance
+    of the mean path's integrals.  A step's time is first assigned along its
+    mean path, each bin edge crossed at a time estimated by one Halley step
+    (``free_flight.level_time_one_step``), and int v^2 dt integrates E[v^2 |
+    ends] (slope squared plus bridge variance of v).  That assignment alone is
+    biased: it ignores the bridge's spread sigma_x ~ (Delta^3 / 96)^(1/2) about
+    the mean path, which moves about (sigma_x^2 / 2) P''/P of a bin's time,
+    up to 1e-3 where steps are long (measured at r = 0.75: 5-7 sigma of the
+    default run); and a crossing estimate that is off moves time between
+    neighbouring bins.  The bridge correction removes both in expectation: the
+    assignment gives the time s to some bin k_s, the bridge point x(s) lies in
+    bin k_x; when they differ, tau moves from bin k_s to bin k_x, and tau V
+    with it in int v^2 dt, V = E[v(s)^2 | x(s), ends]
+    (``free_flight.bridge_speed_squared_given_position``, whose mean over x(s)
+    is the integrand of the assignment).  In expectation this adds the bridge
+    law's time in each bin minus the assignment's, whatever the assignment, so
+    the sum is exact; it changes nothing when k_s = k_x (most steps), and it
+    raises the errors of P(x) and <v^2>_x by about 5 % (docs/methods.md).
   * the flights: for each recorded collision that has an earlier collision
     (in the recording or in equilibration), the time T since that collision
     (its count on log bins, sum T, sum T^2), and the pair (outgoing speed u
@@ -86,13 +98,14 @@ import numpy as np
 from . import stages
 from .free_flight import (
     bridge_sample,
+    bridge_speed_squared_given_position,
     criterion_root,
     cubic_slope,
     cubic_value,
     first_crossing_time,
     free_flight_step,
     hermite_cubic,
-    level_time,
+    level_time_one_step,
     mean_path_integrals,
     monotone_piece_end,
     piece_inverse,
@@ -177,16 +190,29 @@ def _linear_bin_index(value, lo, per_unit, n, edges):
 
 
 @njit(cache=True, inline="always")
-def _tally_position(a, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, edges, time_in, v2_in):
-    """Add the time and int v^2 dt of the monotone piece [t_a, t_b] to x bins.
+def _walked_bin_index(value, k, bin_lower, bin_upper):
+    """Index of ``value`` in the x bins, walking from bin ``k`` (no logarithm): the same bin
+    as ``_bin_index``, whose answer the edges decide too.  ``bin_lower`` and ``bin_upper``
+    are the ends of each bin, -inf and inf those of the under- and overflow bins, so the
+    walk stops (a NaN stays in bin ``k``)."""
+    while value < bin_lower[k]:
+        k -= 1
+    while value >= bin_upper[k]:
+        k += 1
+    return k
+
+
+@njit(cache=True, inline="always")
+def _tally_position(a, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, s, k_s, edges, time_in, v2_in):
+    """Add the time and int v^2 dt of the monotone piece [t_a, t_b] of the mean path to the
+    x bins, each edge crossing placed by ``level_time_estimate`` (no iteration).
 
     ``a`` are the mean path's coefficients, ``sq`` those of S(t) (see
-    ``speed_squared_coefficients``), x_a, x_b and d_a, d_b the path and its
-    slope at the piece's ends and ``k`` the bin of x_a.  The walk crosses one
-    bin edge at a time (no logarithms) and returns the bin of x_b.  Each
-    crossing is solved on the whole piece's bracket, not from the last one,
-    so the crossings of a piece are independent of each other and the
-    processor overlaps them.
+    ``speed_squared_coefficients``), x_a, x_b and d_a, d_b the path and its slope at the
+    piece's ends and ``k`` the bin of x_a.  The walk crosses one bin edge at a time (no
+    logarithms); each crossing's estimate is clipped to [previous crossing, t_b], so the
+    piece is cut into consecutive intervals, one per bin.  Returns the bin of x_b and the
+    bin of the interval holding the time ``s`` (``k_s`` if s is before the piece).
     """
     a0, a1, a2, a3 = a
     s1, s2, s3, s4, s5 = sq
@@ -203,29 +229,33 @@ def _tally_position(a, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, edges, time_in, v2_i
             k_next = k - 1
         else:
             break
-        t_e = level_time(a0, a1, a2, a3, level, inverse)
+        # clipped to [t_prev, t_b]; max and min keep their first argument against a NaN
+        t_e = min(t_b, max(t_prev, level_time_one_step(a0, a1, a2, a3, level, inverse)))
         s_e = quintic_antiderivative_value(s1, s2, s3, s4, s5, t_e)
         time_in[k] += t_e - t_prev
         v2_in[k] += s_e - s_prev
+        k_s = k if s >= t_prev else k_s
         t_prev, s_prev = t_e, s_e
         k = k_next
     s_b = quintic_antiderivative_value(s1, s2, s3, s4, s5, t_b)
     time_in[k] += t_b - t_prev
     v2_in[k] += s_b - s_prev
-    return k
+    k_s = k if s >= t_prev else k_s
+    return k, k_s
 
 
 @njit(cache=True, inline="always")
-def _tally_step(a, dt, tau, x_tau, slope_tau, k, edges, bin_lower, bin_upper, time_in, v2_in):
-    """Add the mean path's time and int v^2 dt over [0, tau] to the x bins.
+def _tally_step(a, dt, tau, x_tau, slope_tau, k, s, edges, bin_lower, bin_upper, time_in, v2_in):
+    """Add the time and int v^2 dt over [0, tau] of the step's piecewise assignment (the
+    mean path, its edge crossings estimated) to the x bins.
 
-    ``k`` is the bin of m(0); returns the bin of m(tau) = x_tau, where the
-    slope is slope_tau.  The common case is a step that stays in its bin: the
-    cubic on [0, tau] lies inside the hull of its Bernstein control points
-    m(0), m(0) + m'(0) tau/3, m(tau) - m'(tau) tau/3, m(tau), so when those
-    all lie in bin k the whole step is tallied there at once.  Otherwise
-    the path is split at the zeros of m' into monotone pieces (none when the
-    control points of m' share a sign), which are walked edge by edge.
+    ``k`` is the bin of m(0); returns the bin of m(tau) = x_tau, where the slope is
+    slope_tau, and the bin the assignment gives the time ``s``.  The common case is a
+    step that stays in its bin: the cubic on [0, tau] lies inside the hull of its
+    Bernstein control points m(0), m(0) + m'(0) tau/3, m(tau) - m'(tau) tau/3, m(tau), so
+    when those all lie in bin k the whole step is tallied there at once.  Otherwise the
+    path is split at the zeros of m' into monotone pieces (none when the control points of
+    m' share a sign), which are walked edge by edge.
     """
     a0, a1, a2, a3 = a
     sq = speed_squared_coefficients(a1, a2, a3, dt)
@@ -236,7 +266,7 @@ def _tally_step(a, dt, tau, x_tau, slope_tau, k, edges, bin_lower, bin_upper, ti
     if bin_lower[k] <= lowest and highest < bin_upper[k]:
         time_in[k] += tau
         v2_in[k] += quintic_antiderivative_value(sq[0], sq[1], sq[2], sq[3], sq[4], tau)
-        return k
+        return k, k
     # m' is a quadratic with Bernstein control points m'(0), m'(0) + a2 tau,
     # m'(tau): when they share a sign, m is monotone and needs no split
     slope_mid = a1 + a2 * tau
@@ -249,15 +279,18 @@ def _tally_step(a, dt, tau, x_tau, slope_tau, k, edges, bin_lower, bin_upper, ti
     t_a = 0.0
     x_a = a0
     d_a = a1
+    k_s = k
     for piece in range(n_zero + 1):
         t_b = monotone_piece_end(piece, n_zero, t1, t2, tau)
         if t_b == tau:
             x_b, d_b = x_tau, slope_tau
         else:  # a zero of m'
             x_b, d_b = cubic_value(a0, a1, a2, a3, t_b), 0.0
-        k = _tally_position(a, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, edges, time_in, v2_in)
+        k, k_s = _tally_position(
+            a, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, s, k_s, edges, time_in, v2_in
+        )
         t_a, x_a, d_a = t_b, x_b, d_b
-    return k
+    return k, k_s
 
 
 # What the compiled loop records, by bit of its ``parts`` argument: the benchmark leaves
@@ -397,29 +430,43 @@ def _run(
                 ix, ix2 = mean_path_integrals(a0, a1, a2, a3, dt, tau)
                 int_x += ix
                 int_x2 += ix2
+            if parts & (POSITION | JOINT):
+                # one point of the step's bridge, (x(s), v(s)) with s uniform in [0, tau], from
+                # the tally stream: P(x, v), and the bridge-law correction of P(x), <v^2>_x
+                s = rng_tally.random() * tau
+                normal_1 = rng_tally.standard_normal()
+                normal_2 = rng_tally.standard_normal()
+                x_s, v_s = bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2)
             if parts & POSITION:
-                x_bin = _tally_step(
+                x_bin, k_s = _tally_step(
                     a,
                     dt,
                     tau,
                     x_tau,
                     v_tau,
                     x_bin,
+                    s,
                     x_edges,
                     x_bin_lower,
                     x_bin_upper,
                     position_time,
                     position_v2_time,
                 )
+                # the assignment gave the time s to bin k_s, the bridge puts x(s) in x_cell: the
+                # bridge correction (module docstring) makes the tally exact in expectation
+                x_cell = _walked_bin_index(x_s, k_s, x_bin_lower, x_bin_upper)
+                if x_cell != k_s:
+                    v2_s = tau * bridge_speed_squared_given_position(a1, a2, a3, dt, s, normal_1)
+                    position_time[x_cell] += tau
+                    position_time[k_s] -= tau
+                    position_v2_time[x_cell] += v2_s
+                    position_v2_time[k_s] -= v2_s
             if parts & JOINT:
-                # P(x, v): tau to the cell of (x(s), v(s)) on the bridge, s uniform in [0, tau]
-                s = rng_tally.random() * tau
-                normal_1 = rng_tally.standard_normal()
-                normal_2 = rng_tally.standard_normal()
-                x_s, v_s = bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2)
+                # P(x, v): tau to the cell of (x(s), v(s))
+                if not parts & POSITION:
+                    x_cell = _bin_index(x_s, x_log_lo, x_per_ln, nx, x_edges)
                 position_velocity_time[
-                    _bin_index(x_s, x_log_lo, x_per_ln, nx, x_edges),
-                    _linear_bin_index(v_s, u_lo, u_per_unit, nu, u_edges),
+                    x_cell, _linear_bin_index(v_s, u_lo, u_per_unit, nu, u_edges)
                 ] += tau
         t += tau
         since_collision += tau

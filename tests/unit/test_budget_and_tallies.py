@@ -31,6 +31,9 @@ def test_budget_stops_a_shard_and_says_so():
 
 def test_position_tallies_cover_the_recorded_time():
     shard = _run(5000.0, 10.0, 10**9, r=0.75)
+    # the bridge correction moves time between bins and adds none (a bin's total may dip
+    # below 0 where the assignment gave it little; in expectation every bin is >= 0)
     assert shard.position_time.sum() == pytest.approx(shard.time, rel=1e-12)
-    assert shard.position_time.min() >= 0.0 and shard.position_v2_time.min() >= 0.0
+    visited = shard.position_time > 0.05 * shard.time
+    assert visited.sum() >= 3 and (shard.position_v2_time[visited] > 0.0).all()
     assert shard.speed_counts.sum() == shard.collisions
