@@ -359,19 +359,21 @@ def level_time_one_step(a0, a1, a2, a3, level, inverse):
 @njit(cache=True, inline="always")
 def level_time(a0, a1, a2, a3, level, inverse):
     """The t where the mean path m(t) = level on a monotone piece that brackets it
-    (``inverse``: the piece's ``piece_inverse``).
+    (``inverse``: the piece's ``piece_inverse``), to about 1e-9 of the piece: where a
+    collision cuts a step (``first_crossing_time``); the P(x) tally's edge crossings use
+    ``level_time_one_step``.
 
-    The start is the inverse cubic Hermite interpolant t(m) through the piece's
-    ends (their values and slopes 1/m'), or the linear one next to a zero of m'.
+    The start is ``level_time_estimate``: the inverse cubic Hermite interpolant t(m)
+    through the piece's ends (their values and slopes 1/m'), or the linear one next to a
+    zero of m'.
     Safeguarded Halley iteration follows: a step that leaves the bracket is
     replaced by bisection, so it always converges.  It stops after a Halley
     step below 1e-3 of the piece where the slope there is at least 0.1 of the
     piece's mean slope: the error before that step was about the step, and
     Halley's cubic convergence leaves about its cube, ~1e-9 of the piece
     (tests/unit/test_free_flight.py checks 1e-8 on random pieces; on the 2.7
-    million crossings of a simulated trajectory at r = 1/2, c = 5, 1 in 1000 is
-    off by more than 1e-9 of its piece and the worst by 2e-7, moving that
-    fraction of a step's time between neighbouring bins).  Crossings take 1.44
+    million bin-edge crossings of a simulated trajectory at r = 1/2, c = 5, 1 in 1000 is
+    off by more than 1e-9 of its piece and the worst by 2e-7).  Crossings take 1.44
     Halley steps on average from the Hermite start (2.2 from the linear one).  Next to a zero of m' (a piece ends where the path
     turns) a Halley step is short because m' is small, not because the root is
     near; such a step is replaced by bisection, which stops when the bracket is

@@ -186,8 +186,8 @@ def test_flight_tallies_match_a_replay_of_the_trajectory(equilibration_time):
 
 
 def test_distribution_tally_adds_up_to_the_position_tally_and_the_time():
-    """Summed over v, the time in the (x, v) cells is the 1-D P(x) tally (the mean path's
-    time per x bin) within the sampling error; summed over everything, the recorded time."""
+    """Summed over v, the time in the (x, v) cells is the 1-D P(x) tally within the sampling
+    error (both are exact in expectation); summed over everything, the recorded time."""
     shards = [
         simulate_shard(0.5, shard_seed_sequence(5, "0.5", k), SETTINGS.replace(shard_time=5.0e4))
         for k in range(16)

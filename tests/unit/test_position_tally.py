@@ -1,0 +1,176 @@
+"""The P(x) and <v^2>_x tally of one step against the bridge law, integrated exactly.
+
+Given both ends of a step, x(t) is Gaussian about the mean path m(t) with variance
+Var[x(t) | ends] (``free_flight``), so the expected time the step spends in a bin
+[lo, hi) is int_0^tau (Phi((hi - m) / sd) - Phi((lo - m) / sd)) dt, and the expected
+int v^2 dt there is the same integral of E[v(t)^2 1[lo <= x(t) < hi] | ends], which the
+truncated moments of normal_1 give in closed form (``bridge_sample``'s factorisation).
+The loop's tally of a step is its mean-path assignment plus the bridge correction of one
+point (``simulation``'s module docstring): its mean over many points must be that, within
+a z-score of the points' scatter, on a long step where the mean path alone is off by
+many of those z (so the test fails without the correction) and on a step cut by a
+collision.
+"""
+
+import math
+
+import numpy as np
+import pytest
+from numba import njit
+from scipy import integrate, special
+
+from bouncing_ball.bins import LogBins
+from bouncing_ball.free_flight import (
+    bridge_sample,
+    bridge_speed_squared_given_position,
+    cubic_slope,
+    cubic_value,
+    first_crossing_time,
+    hermite_cubic,
+    quintic_antiderivative_value,
+    speed_squared_coefficients,
+)
+from bouncing_ball.simulation import _bin_index, _tally_step, _walked_bin_index
+
+BINS = LogBins(1e-3, 1e3, 5)
+EDGES = BINS.edges
+LOWER = np.concatenate(([-np.inf], EDGES))
+UPPER = np.concatenate((EDGES, [np.inf]))
+POINTS = 400_000
+Z = 5.0  # of ~30 bins, two quantities and two steps: |z| < 5 fails by chance ~1e-4
+
+
+@njit(cache=True)
+def _one_step(a, dt, tau, x_tau, v_tau, k, edges, lower, upper, points, seed):
+    """The loop's tally of one step, its assignment once and its correction for ``points``
+    bridge points (the loop's formula): (assignment time, assignment v^2, mean and mean
+    square of the correction, per bin, for time and for v^2)."""
+    np.random.seed(seed)
+    n = edges.shape[0] + 1
+    time_in = np.zeros(n)
+    v2_in = np.zeros(n)
+    moments = np.zeros((4, n))
+    a0, a1, a2, a3 = a
+    assigned = False
+    for _ in range(points):
+        s = np.random.random() * tau
+        normal_1 = np.random.standard_normal()
+        normal_2 = np.random.standard_normal()
+        x_s, v_s = bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2)
+        scratch_time = np.zeros(n)
+        scratch_v2 = np.zeros(n)
+        k_end, k_s = _tally_step(
+            a, dt, tau, x_tau, v_tau, k, s, edges, lower, upper, scratch_time, scratch_v2
+        )
+        if not assigned:
+            time_in[:] = scratch_time
+            v2_in[:] = scratch_v2
+            assigned = True
+        x_cell = _walked_bin_index(x_s, k_s, lower, upper)
+        if x_cell != k_s:
+            v2_s = tau * bridge_speed_squared_given_position(a1, a2, a3, dt, s, normal_1)
+            for j, sign in ((x_cell, 1.0), (k_s, -1.0)):
+                moments[0, j] += sign * tau
+                moments[1, j] += tau * tau
+                moments[2, j] += sign * v2_s
+                moments[3, j] += v2_s * v2_s
+    return time_in, v2_in, moments / points
+
+
+def _bridge_law(a, dt, tau, lo, hi):
+    """Expected time in [lo, hi) and int v^2 dt there over [0, tau], given the ends."""
+
+    def parts(t):
+        u = t / dt
+        w = max(u * (1.0 - u), 0.0)
+        m = cubic_value(*a, t)
+        slope = cubic_slope(a[1], a[2], a[3], t)
+        sd_x = math.sqrt(2.0 / 3.0) * dt * w * math.sqrt(dt * w)
+        b1 = math.sqrt(dt * w) * math.sqrt(1.5) * (1.0 - 2.0 * u)  # v = m' + b1 n1 + b2 n2
+        b2_squared = 0.5 * dt * w
+        if sd_x == 0.0:
+            inside = float(lo <= m < hi)
+            return inside, inside * (slope * slope + b1 * b1 + b2_squared)
+        alpha = (lo - m) / sd_x if np.isfinite(lo) else -np.inf
+        beta = (hi - m) / sd_x if np.isfinite(hi) else np.inf
+        p0 = special.ndtr(beta) - special.ndtr(alpha)  # truncated moments of n1
+        phi_a = 0.0 if np.isinf(alpha) else math.exp(-0.5 * alpha * alpha) / math.sqrt(2 * math.pi)
+        phi_b = 0.0 if np.isinf(beta) else math.exp(-0.5 * beta * beta) / math.sqrt(2 * math.pi)
+        p1 = phi_a - phi_b
+        p2 = p0 + (alpha * phi_a if phi_a else 0.0) - (beta * phi_b if phi_b else 0.0)
+        v2 = slope * slope * p0 + 2.0 * slope * b1 * p1 + b1 * b1 * p2 + b2_squared * p0
+        return p0, v2
+
+    time = integrate.quad(lambda t: parts(t)[0], 0.0, tau, limit=400, epsabs=1e-13)[0]
+    v2 = integrate.quad(lambda t: parts(t)[1], 0.0, tau, limit=400, epsabs=1e-13)[0]
+    return time, v2
+
+
+def _steps():
+    """A long step through several bins (x from 0.02 to 0.6 and back towards 0.1) and a
+    step cut by a collision at the mean path's first zero."""
+    long_dt = 1.2
+    long = hermite_cubic(0.02, 1.6, 0.1, -0.9, long_dt)
+    cut_dt = 0.3
+    cut = hermite_cubic(0.05, 0.3, -0.04, -1.2, cut_dt)
+    tau = first_crossing_time(*cut, cut_dt, -0.04)
+    return {
+        "long": (long, long_dt, long_dt, 0.1, -0.9),
+        "collision": (cut, cut_dt, tau, 0.0, cubic_slope(cut[1], cut[2], cut[3], tau)),
+    }
+
+
+@pytest.mark.parametrize("name", ["long", "collision"])
+def test_a_step_tallies_the_bridge_law_exactly_in_expectation(name):
+    a, dt, tau, x_tau, v_tau = _steps()[name]
+    k = _bin_index(a[0], math.log(EDGES[0]), BINS.n / math.log(EDGES[-1] / EDGES[0]), BINS.n, EDGES)
+    time_in, v2_in, moments = _one_step(
+        np.array(a), dt, tau, x_tau, v_tau, k, EDGES, LOWER, UPPER, POINTS, 3
+    )
+    # the assignment integrates E[v^2 | ends] over the step
+    sq = speed_squared_coefficients(a[1], a[2], a[3], dt)
+    assert v2_in.sum() == pytest.approx(quintic_antiderivative_value(*sq, tau), rel=1e-12)
+    assert time_in.sum() == pytest.approx(tau, rel=1e-12)
+    exact = np.array([_bridge_law(a, dt, tau, lo, hi) for lo, hi in zip(LOWER, UPPER)])
+    assert exact[:, 0].sum() == pytest.approx(tau, rel=1e-9)
+    visited = exact[:, 0] > 1e-6 * tau
+    assert visited.sum() >= 3
+    # a bin the points rarely reach has no scatter to measure: its variance is at least that
+    # of tau (resp. tau V) times a Bernoulli of the bridge law's probability of the bin
+    exact, time_in, v2_in, moments = (
+        exact[visited],
+        time_in[visited],
+        v2_in[visited],
+        moments[:, visited],
+    )
+    fraction = exact[:, 0] / tau
+    mean_speed_squared = exact[:, 1] / exact[:, 0]
+    for column, assigned, (mean, square), scale in (
+        (0, time_in, (moments[0], moments[1]), tau),
+        (1, v2_in, (moments[2], moments[3]), tau * mean_speed_squared),
+    ):
+        variance = np.maximum(square - mean * mean, scale * scale * fraction)
+        error = np.sqrt(variance / POINTS)
+        z = (assigned + mean - exact[:, column]) / error
+        assert np.all(np.abs(z) < Z), np.round(z, 2)
+        # the assignment alone is far off (the test fails without the correction)
+        z_alone = (assigned - exact[:, column]) / error
+        assert np.max(np.abs(z_alone)) > 10.0 * Z, np.round(z_alone, 1)
+
+
+def test_speed_squared_given_position_averages_to_the_bridge_variance():
+    """Averaged over normal_1 (Gauss-Hermite, exact for this quadratic), E[v^2 | x(t), ends]
+    is E[v(t)^2 | ends] = m'(t)^2 + Var[v(t) | ends], the assignment's integrand."""
+    nodes, weights = np.polynomial.hermite_e.hermegauss(6)
+    weights = weights / weights.sum()
+    dt = 0.7
+    a = hermite_cubic(0.3, 0.4, 0.2, -1.1, dt)
+    for t in (0.0, 0.1, 0.35, 0.6, dt):
+        mean = sum(
+            w * bridge_speed_squared_given_position(a[1], a[2], a[3], dt, t, n)
+            for n, w in zip(nodes, weights)
+        )
+        sq = speed_squared_coefficients(a[1], a[2], a[3], dt)
+        # S'(t) = d/dt t (s1 + t (s2 + ...)) is the integrand
+        derivative = sum((j + 1) * c * t**j for j, c in enumerate(sq))
+        assert mean == pytest.approx(derivative, rel=1e-12, abs=1e-14)
