@@ -205,7 +205,7 @@ def _walked_bin_index(value, k, bin_lower, bin_upper):
 @njit(cache=True, inline="always")
 def _tally_position(a, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, s, k_s, edges, time_in, v2_in):
     """Add the time and int v^2 dt of the monotone piece [t_a, t_b] of the mean path to the
-    x bins, each edge crossing placed by ``level_time_estimate`` (no iteration).
+    x bins, each edge crossing placed by ``level_time_one_step`` (no iteration).
 
     ``a`` are the mean path's coefficients, ``sq`` those of S(t) (see
     ``speed_squared_coefficients``), x_a, x_b and d_a, d_b the path and its slope at the
