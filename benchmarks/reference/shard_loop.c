@@ -7,11 +7,12 @@
  *   bouncing_ball/free_flight.py: free_flight_step, _floor_root, _fitted_root,
  *       criterion_root, hermite_cubic, cubic_value, cubic_slope,
  *       mean_path_integrals, speed_squared_coefficients,
- *       quintic_antiderivative_value, piece_inverse, level_time,
- *       cubic_level_time, slope_zeros, monotone_piece_end, first_crossing_time,
- *       bridge_sample
- *   bouncing_ball/simulation.py: _bin_index, _linear_bin_index, _tally_position,
- *       _tally_step, _run
+ *       quintic_antiderivative_value, piece_inverse, level_time_estimate,
+ *       level_time_one_step, level_time, cubic_level_time, slope_zeros,
+ *       monotone_piece_end, first_crossing_time, bridge_sample,
+ *       bridge_speed_squared_given_position
+ *   bouncing_ball/simulation.py: _bin_index, _linear_bin_index, _walked_bin_index,
+ *       _tally_position, _tally_step, _run
  *
  * (translated from the committed versions of those files).  Every floating-point
  * operation is the same as in the Python source and in the same order (same
@@ -20,19 +21,24 @@
  * arguments), so with the FMA contraction switched off (numba does not fuse
  * multiply-adds) it gives bit-identical tallies.  Where Python returns a tuple
  * the C returns a struct (piece_inverse) or the first value with the second
- * through a pointer (criterion_root, whose (s*, f'(s*)) the loop carries from
+ * through a pointer (tally_position and tally_step, whose (k, k_s) are the bin
+ * of the step's end and the bin its mean-path assignment gives the bridge
+ * point's time s; criterion_root, whose (s*, f'(s*)) the loop carries from
  * step to step as root, slope_at_root, with the predictor k0, k1, k2 of the next
  * step's start computed before the step, as in ``_run``; free_flight.root_predictor
  * and predicted_start are written out inline in the loop).  ``_run``'s last
  * argument ``parts`` (a bitmask of the tallies, for the benchmark's breakdown)
  * has no counterpart: this loop always records everything, i.e. it is
  * ``_run`` with parts = EVERY_TALLY, which is what ``simulate_shard`` passes
- * by default.  The normals come from numpy's own C generator,
+ * by default; in particular the bridge point is drawn before the P(x) tally,
+ * which uses it for its bridge correction, and P(x, v) takes its x cell from
+ * that correction's walk (``_walked_bin_index``), not from ``_bin_index``.
+ * The normals come from numpy's own C generator,
  * ``random_standard_normal`` of libnpyrandom.a, called on the bit generator that
  * Python passes in (``np.random.PCG64(seed).ctypes.bit_generator``), i.e. the
  * same ziggurat that numba's ``Generator.standard_normal`` ports, on the same
- * stream.  The P(x, v) draws (a uniform and two normals per recorded step) come
- * likewise from a second bit generator, ``tallies.tally_seed_sequence``'s,
+ * stream.  The bridge point's draws (a uniform and two normals per recorded
+ * step) come likewise from a second bit generator, ``tallies.tally_seed_sequence``'s,
  * with numpy's ``random_standard_uniform`` (= numba's ``Generator.random``).
  *
  * What it is for: the yardstick of the performance target "the numba simulation
@@ -275,19 +281,40 @@ static inline piece_inverse_t piece_inverse(double t_lo, double t_hi, double x_l
     return inverse;
 }
 
+/* level_time_estimate: the inverse cubic Hermite start of level_time (the linear one next to a
+   zero of m'), no iteration */
+static inline double level_time_estimate(double level, piece_inverse_t inverse)
+{
+    double t_lo = inverse.t_lo, width = inverse.width, x_lo = inverse.x_lo;
+    double inv_rise = inverse.inv_rise, m0 = inverse.m0, m1 = inverse.m1;
+    double u = (level - x_lo) * inv_rise;
+    if (m0 == 0.0)
+        return t_lo + width * u;
+    return t_lo + width * (u * u * (3.0 - 2.0 * u) + u * (1.0 - u) * ((1.0 - u) * m0 - u * m1));
+}
+
+/* level_time_one_step: the estimate and one unconditional Halley step from it (no test: it may
+   leave the piece or be NaN; the caller, tally_position, clips it) */
+static inline double level_time_one_step(double a0, double a1, double a2, double a3, double level,
+                                         piece_inverse_t inverse)
+{
+    double t = level_time_estimate(level, inverse);
+    double f = cubic_value(a0, a1, a2, a3, t) - level;
+    double d1 = cubic_slope(a1, a2, a3, t);
+    double d2 = 2.0 * a2 + 6.0 * a3 * t;
+    return t - 2.0 * f * d1 / (2.0 * d1 * d1 - f * d2);
+}
+
 static inline double level_time(double a0, double a1, double a2, double a3, double level,
                                 piece_inverse_t inverse)
 {
     double t_lo = inverse.t_lo, width = inverse.width, x_lo = inverse.x_lo, rise = inverse.rise;
-    double inv_rise = inverse.inv_rise, m0 = inverse.m0, m1 = inverse.m1;
-    double u = (level - x_lo) * inv_rise;
-    if (u <= 0.0)
+    double inv_rise = inverse.inv_rise;
+    if ((level - x_lo) * inv_rise <= 0.0)
         return t_lo;
     int rising = rise > 0.0;
     double lo = t_lo, hi = t_lo + width;
-    double t = t_lo + width * (u * u * (3.0 - 2.0 * u) + u * (1.0 - u) * ((1.0 - u) * m0 - u * m1));
-    if (m0 == 0.0)
-        t = t_lo + width * u;
+    double t = level_time_estimate(level, inverse);
     for (int i = 0; i < 200; i++) {
         double f = cubic_value(a0, a1, a2, a3, t) - level;
         if (f == 0.0)
@@ -410,6 +437,18 @@ static inline void bridge_sample(double a0, double a1, double a2, double a3, dou
              + root * (SQRT3_2 * (1.0 - 2.0 * u) * normal_1 + SQRT1_2 * normal_2);
 }
 
+/* bridge_speed_squared_given_position: E[v(t)^2 | x(t), ends] for the x(t) that bridge_sample
+   draws with normal_1 */
+static inline double bridge_speed_squared_given_position(double a1, double a2, double a3,
+                                                         double dt, double t, double normal_1)
+{
+    double u = t * (1.0 / dt);
+    double w = py_max(u * (1.0 - u), 0.0);
+    double root = sqrt(dt * w);
+    double mean = cubic_slope(a1, a2, a3, t) + root * SQRT3_2 * (1.0 - 2.0 * u) * normal_1;
+    return mean * mean + 0.5 * dt * w;
+}
+
 /* ---------------------------------------------------------------- simulation.py */
 
 static inline int64_t linear_bin_index(double value, double lo, double per_unit, int64_t n,
@@ -451,11 +490,25 @@ static inline int64_t bin_index(double value, double log_lo, double per_ln, int6
     return k + 1;
 }
 
-/* edges has n + 1 entries */
+/* _walked_bin_index: the bin of value, walking from bin k over the bins' ends (-inf and inf
+   those of the under- and overflow bins); a NaN stays in bin k */
+static inline int64_t walked_bin_index(double value, int64_t k, const double *bin_lower,
+                                       const double *bin_upper)
+{
+    while (value < bin_lower[k])
+        k -= 1;
+    while (value >= bin_upper[k])
+        k += 1;
+    return k;
+}
+
+/* edges has n + 1 entries.  Returns the bin of x_b and sets *k_s to the bin of the interval
+   holding the time s (unchanged if s is before the piece); Python returns the pair (k, k_s) */
 static inline int64_t tally_position(double a0, double a1, double a2, double a3, quintic sq,
                                      double t_a, double t_b, double x_a, double x_b, double d_a,
-                                     double d_b, int64_t k, const double *edges, int64_t n,
-                                     double *time_in, double *v2_in)
+                                     double d_b, int64_t k, double s, int64_t *k_s,
+                                     const double *edges, int64_t n, double *time_in,
+                                     double *v2_in)
 {
     double t_prev = t_a;
     double s_prev = quintic_antiderivative_value(sq.s1, sq.s2, sq.s3, sq.s4, sq.s5, t_a);
@@ -472,10 +525,12 @@ static inline int64_t tally_position(double a0, double a1, double a2, double a3,
         } else {
             break;
         }
-        double t_e = level_time(a0, a1, a2, a3, level, inverse);
+        /* clipped to [t_prev, t_b]; py_max and py_min keep their first argument against a NaN */
+        double t_e = py_min(t_b, py_max(t_prev, level_time_one_step(a0, a1, a2, a3, level, inverse)));
         double s_e = quintic_antiderivative_value(sq.s1, sq.s2, sq.s3, sq.s4, sq.s5, t_e);
         time_in[k] += t_e - t_prev;
         v2_in[k] += s_e - s_prev;
+        *k_s = s >= t_prev ? k : *k_s;
         t_prev = t_e;
         s_prev = s_e;
         k = k_next;
@@ -483,13 +538,16 @@ static inline int64_t tally_position(double a0, double a1, double a2, double a3,
     double s_b = quintic_antiderivative_value(sq.s1, sq.s2, sq.s3, sq.s4, sq.s5, t_b);
     time_in[k] += t_b - t_prev;
     v2_in[k] += s_b - s_prev;
+    *k_s = s >= t_prev ? k : *k_s;
     return k;
 }
 
+/* returns the bin of m(tau) and sets *k_s to the bin the assignment gives the time s (Python
+   returns the pair (k, k_s)) */
 static inline int64_t tally_step(double a0, double a1, double a2, double a3, double dt, double tau,
-                                 double x_tau, double slope_tau, int64_t k, const double *edges,
-                                 int64_t n, const double *bin_lower, const double *bin_upper,
-                                 double *time_in, double *v2_in)
+                                 double x_tau, double slope_tau, int64_t k, double s, int64_t *k_s,
+                                 const double *edges, int64_t n, const double *bin_lower,
+                                 const double *bin_upper, double *time_in, double *v2_in)
 {
     quintic sq = speed_squared_coefficients(a1, a2, a3, dt);
     double c1 = a0 + a1 * tau * (1.0 / 3.0);
@@ -499,6 +557,7 @@ static inline int64_t tally_step(double a0, double a1, double a2, double a3, dou
     if (bin_lower[k] <= lowest && highest < bin_upper[k]) {
         time_in[k] += tau;
         v2_in[k] += quintic_antiderivative_value(sq.s1, sq.s2, sq.s3, sq.s4, sq.s5, tau);
+        *k_s = k;
         return k;
     }
     /* m' is a quadratic with Bernstein control points m'(0), m'(0) + a2 tau, m'(tau):
@@ -517,6 +576,7 @@ static inline int64_t tally_step(double a0, double a1, double a2, double a3, dou
     double t_a = 0.0;
     double x_a = a0;
     double d_a = a1;
+    *k_s = k;
     for (int piece = 0; piece < n_zero + 1; piece++) {
         double t_b = monotone_piece_end(piece, n_zero, t1, t2, tau);
         double x_b, d_b;
@@ -527,8 +587,8 @@ static inline int64_t tally_step(double a0, double a1, double a2, double a3, dou
             x_b = cubic_value(a0, a1, a2, a3, t_b);
             d_b = 0.0;
         }
-        k = tally_position(a0, a1, a2, a3, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, edges, n, time_in,
-                           v2_in);
+        k = tally_position(a0, a1, a2, a3, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, s, k_s, edges, n,
+                           time_in, v2_in);
         t_a = t_b;
         x_a = x_b;
         d_a = d_b;
@@ -663,17 +723,30 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
             mean_path_integrals(a0, a1, a2, a3, dt, tau, &ix, &ix2);
             int_x += ix;
             int_x2 += ix2;
-            x_bin = tally_step(a0, a1, a2, a3, dt, tau, x_tau, v_tau, x_bin, x_edges, nx,
-                               x_bin_lower, x_bin_upper, position_time, position_v2_time);
-            /* P(x, v): tau to the cell of (x(s), v(s)) on the bridge, s uniform in [0, tau] */
+            /* one point of the step's bridge, (x(s), v(s)) with s uniform in [0, tau], from the
+               tally stream: P(x, v), and the bridge-law correction of P(x), <v^2>_x */
             double s = random_standard_uniform(rng_tally) * tau;
             double normal_1 = random_standard_normal(rng_tally);
             double normal_2 = random_standard_normal(rng_tally);
             double x_s, v_s;
             bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2, &x_s, &v_s);
-            int64_t cell_x = bin_index(x_s, x_log_lo, x_per_ln, nx, x_edges);
+            int64_t k_s;
+            x_bin = tally_step(a0, a1, a2, a3, dt, tau, x_tau, v_tau, x_bin, s, &k_s, x_edges, nx,
+                               x_bin_lower, x_bin_upper, position_time, position_v2_time);
+            /* the assignment gave the time s to bin k_s, the bridge puts x(s) in x_cell: the
+               bridge correction makes the tally exact in expectation */
+            int64_t x_cell = walked_bin_index(x_s, k_s, x_bin_lower, x_bin_upper);
+            if (x_cell != k_s) {
+                double v2_s = tau * bridge_speed_squared_given_position(a1, a2, a3, dt, s, normal_1);
+                position_time[x_cell] += tau;
+                position_time[k_s] -= tau;
+                position_v2_time[x_cell] += v2_s;
+                position_v2_time[k_s] -= v2_s;
+            }
+            /* P(x, v): tau to the cell of (x(s), v(s)); with POSITION on, x_cell is the walk's
+               (parts & POSITION: always, so no bin_index) */
             int64_t cell_v = linear_bin_index(v_s, u_lo, u_per_unit, nu, u_edges);
-            position_velocity_time[cell_x * (nu + 2) + cell_v] += tau;
+            position_velocity_time[x_cell * (nu + 2) + cell_v] += tau;
         }
         t += tau;
         since_collision += tau;
