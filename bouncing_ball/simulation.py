@@ -50,7 +50,12 @@ depends on the state):
     is the integrand of the assignment).  In expectation this adds the bridge
     law's time in each bin minus the assignment's, whatever the assignment, so
     the sum is exact; it changes nothing when k_s = k_x (most steps), and it
-    raises the errors of P(x) and <v^2>_x by about 5 % (docs/methods.md).
+    raises the errors of P(x) and <v^2>_x by a few per cent (docs/methods.md).
+    A step cut by a collision is left on its mean path, as its collision is
+    (crossings by ``free_flight.level_time``, no correction): past the mean
+    path's zero the free bridge is not the ball's path, and one point of such
+    a step, long and fast near the floor, could move a whole step's tau V into
+    a small bin (heavy-tailed noise for no gain in exactness).
   * the flights: for each recorded collision that has an earlier collision
     (in the recording or in equilibration), the time T since that collision
     (its count on log bins, sum T, sum T^2), and the pair (outgoing speed u
@@ -105,6 +110,7 @@ from .free_flight import (
     first_crossing_time,
     free_flight_step,
     hermite_cubic,
+    level_time,
     level_time_one_step,
     mean_path_integrals,
     monotone_piece_end,
@@ -203,9 +209,13 @@ def _walked_bin_index(value, k, bin_lower, bin_upper):
 
 
 @njit(cache=True, inline="always")
-def _tally_position(a, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, s, k_s, edges, time_in, v2_in):
+def _tally_position(
+    a, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, s, k_s, exact_crossings, edges, time_in, v2_in
+):
     """Add the time and int v^2 dt of the monotone piece [t_a, t_b] of the mean path to the
-    x bins, each edge crossing placed by ``level_time_one_step`` (no iteration).
+    x bins, each edge crossing placed by ``level_time_one_step`` (no iteration), or by
+    ``level_time`` (to ~1e-9 of the piece) where ``exact_crossings`` (a step cut by a
+    collision, which the bridge correction leaves alone).
 
     ``a`` are the mean path's coefficients, ``sq`` those of S(t) (see
     ``speed_squared_coefficients``), x_a, x_b and d_a, d_b the path and its slope at the
@@ -229,8 +239,10 @@ def _tally_position(a, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, s, k_s, edges, time_
             k_next = k - 1
         else:
             break
-        # clipped to [t_prev, t_b]; max and min keep their first argument against a NaN
-        t_e = min(t_b, max(t_prev, level_time_one_step(a0, a1, a2, a3, level, inverse)))
+        if exact_crossings:
+            t_e = level_time(a0, a1, a2, a3, level, inverse)
+        else:  # clipped to [t_prev, t_b]; max and min keep their first argument against a NaN
+            t_e = min(t_b, max(t_prev, level_time_one_step(a0, a1, a2, a3, level, inverse)))
         s_e = quintic_antiderivative_value(s1, s2, s3, s4, s5, t_e)
         time_in[k] += t_e - t_prev
         v2_in[k] += s_e - s_prev
@@ -245,7 +257,9 @@ def _tally_position(a, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, s, k_s, edges, time_
 
 
 @njit(cache=True, inline="always")
-def _tally_step(a, dt, tau, x_tau, slope_tau, k, s, edges, bin_lower, bin_upper, time_in, v2_in):
+def _tally_step(
+    a, dt, tau, x_tau, slope_tau, k, s, exact_crossings, edges, bin_lower, bin_upper, time_in, v2_in
+):
     """Add the time and int v^2 dt over [0, tau] of the step's piecewise assignment (the
     mean path, its edge crossings estimated) to the x bins.
 
@@ -287,7 +301,7 @@ def _tally_step(a, dt, tau, x_tau, slope_tau, k, s, edges, bin_lower, bin_upper,
         else:  # a zero of m'
             x_b, d_b = cubic_value(a0, a1, a2, a3, t_b), 0.0
         k, k_s = _tally_position(
-            a, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, s, k_s, edges, time_in, v2_in
+            a, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, s, k_s, exact_crossings, edges, time_in, v2_in
         )
         t_a, x_a, d_a = t_b, x_b, d_b
     return k, k_s
@@ -446,6 +460,7 @@ def _run(
                     v_tau,
                     x_bin,
                     s,
+                    collided,
                     x_edges,
                     x_bin_lower,
                     x_bin_upper,
@@ -453,9 +468,10 @@ def _run(
                     position_v2_time,
                 )
                 # the assignment gave the time s to bin k_s, the bridge puts x(s) in x_cell: the
-                # bridge correction (module docstring) makes the tally exact in expectation
+                # bridge correction (module docstring) makes the tally exact in expectation (not
+                # in a step cut by a collision, which keeps the mean path its collision is on)
                 x_cell = _walked_bin_index(x_s, k_s, x_bin_lower, x_bin_upper)
-                if x_cell != k_s:
+                if x_cell != k_s and not collided:
                     v2_s = tau * bridge_speed_squared_given_position(a1, a2, a3, dt, s, normal_1)
                     position_time[x_cell] += tau
                     position_time[k_s] -= tau

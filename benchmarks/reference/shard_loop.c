@@ -507,8 +507,8 @@ static inline int64_t walked_bin_index(double value, int64_t k, const double *bi
 static inline int64_t tally_position(double a0, double a1, double a2, double a3, quintic sq,
                                      double t_a, double t_b, double x_a, double x_b, double d_a,
                                      double d_b, int64_t k, double s, int64_t *k_s,
-                                     const double *edges, int64_t n, double *time_in,
-                                     double *v2_in)
+                                     int exact_crossings, const double *edges, int64_t n,
+                                     double *time_in, double *v2_in)
 {
     double t_prev = t_a;
     double s_prev = quintic_antiderivative_value(sq.s1, sq.s2, sq.s3, sq.s4, sq.s5, t_a);
@@ -525,8 +525,11 @@ static inline int64_t tally_position(double a0, double a1, double a2, double a3,
         } else {
             break;
         }
-        /* clipped to [t_prev, t_b]; py_max and py_min keep their first argument against a NaN */
-        double t_e = py_min(t_b, py_max(t_prev, level_time_one_step(a0, a1, a2, a3, level, inverse)));
+        double t_e;
+        if (exact_crossings)
+            t_e = level_time(a0, a1, a2, a3, level, inverse);
+        else /* clipped to [t_prev, t_b]; py_max and py_min keep their first argument against a NaN */
+            t_e = py_min(t_b, py_max(t_prev, level_time_one_step(a0, a1, a2, a3, level, inverse)));
         double s_e = quintic_antiderivative_value(sq.s1, sq.s2, sq.s3, sq.s4, sq.s5, t_e);
         time_in[k] += t_e - t_prev;
         v2_in[k] += s_e - s_prev;
@@ -546,7 +549,8 @@ static inline int64_t tally_position(double a0, double a1, double a2, double a3,
    returns the pair (k, k_s)) */
 static inline int64_t tally_step(double a0, double a1, double a2, double a3, double dt, double tau,
                                  double x_tau, double slope_tau, int64_t k, double s, int64_t *k_s,
-                                 const double *edges, int64_t n, const double *bin_lower,
+                                 int exact_crossings, const double *edges, int64_t n,
+                                 const double *bin_lower,
                                  const double *bin_upper, double *time_in, double *v2_in)
 {
     quintic sq = speed_squared_coefficients(a1, a2, a3, dt);
@@ -587,8 +591,8 @@ static inline int64_t tally_step(double a0, double a1, double a2, double a3, dou
             x_b = cubic_value(a0, a1, a2, a3, t_b);
             d_b = 0.0;
         }
-        k = tally_position(a0, a1, a2, a3, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, s, k_s, edges, n,
-                           time_in, v2_in);
+        k = tally_position(a0, a1, a2, a3, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, s, k_s,
+                           exact_crossings, edges, n, time_in, v2_in);
         t_a = t_b;
         x_a = x_b;
         d_a = d_b;
@@ -731,12 +735,14 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
             double x_s, v_s;
             bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2, &x_s, &v_s);
             int64_t k_s;
-            x_bin = tally_step(a0, a1, a2, a3, dt, tau, x_tau, v_tau, x_bin, s, &k_s, x_edges, nx,
-                               x_bin_lower, x_bin_upper, position_time, position_v2_time);
+            x_bin = tally_step(a0, a1, a2, a3, dt, tau, x_tau, v_tau, x_bin, s, &k_s, collided,
+                               x_edges, nx, x_bin_lower, x_bin_upper, position_time,
+                               position_v2_time);
             /* the assignment gave the time s to bin k_s, the bridge puts x(s) in x_cell: the
-               bridge correction makes the tally exact in expectation */
+               bridge correction makes the tally exact in expectation (not in a step cut by a
+               collision, which keeps the mean path its collision is placed on) */
             int64_t x_cell = walked_bin_index(x_s, k_s, x_bin_lower, x_bin_upper);
-            if (x_cell != k_s) {
+            if (x_cell != k_s && !collided) {
                 double v2_s = tau * bridge_speed_squared_given_position(a1, a2, a3, dt, s, normal_1);
                 position_time[x_cell] += tau;
                 position_time[k_s] -= tau;
