@@ -450,7 +450,6 @@ def _run(
                 s = rng_tally.random() * tau
                 normal_1 = rng_tally.standard_normal()
                 normal_2 = rng_tally.standard_normal()
-                x_s, v_s = bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2)
             if parts & POSITION:
                 x_bin, k_s = _tally_step(
                     a,
@@ -467,6 +466,9 @@ def _run(
                     position_time,
                     position_v2_time,
                 )
+                # the point itself after the walk: fewer values live across it (numba then
+                # keeps pace with the C reference)
+                x_s, v_s = bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2)
                 # the assignment gave the time s to bin k_s, the bridge puts x(s) in x_cell: the
                 # bridge correction (module docstring) makes the tally exact in expectation (not
                 # in a step cut by a collision, which keeps the mean path its collision is on)
@@ -480,6 +482,7 @@ def _run(
             if parts & JOINT:
                 # P(x, v): tau to the cell of (x(s), v(s))
                 if not parts & POSITION:
+                    x_s, v_s = bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2)
                     x_cell = _bin_index(x_s, x_log_lo, x_per_ln, nx, x_edges)
                 position_velocity_time[
                     x_cell, _linear_bin_index(v_s, u_lo, u_per_unit, nu, u_edges)

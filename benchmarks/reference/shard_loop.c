@@ -732,12 +732,12 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
             double s = random_standard_uniform(rng_tally) * tau;
             double normal_1 = random_standard_normal(rng_tally);
             double normal_2 = random_standard_normal(rng_tally);
-            double x_s, v_s;
-            bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2, &x_s, &v_s);
             int64_t k_s;
             x_bin = tally_step(a0, a1, a2, a3, dt, tau, x_tau, v_tau, x_bin, s, &k_s, collided,
                                x_edges, nx, x_bin_lower, x_bin_upper, position_time,
                                position_v2_time);
+            double x_s, v_s; /* the point itself after the walk, as in numba */
+            bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2, &x_s, &v_s);
             /* the assignment gave the time s to bin k_s, the bridge puts x(s) in x_cell: the
                bridge correction makes the tally exact in expectation (not in a step cut by a
                collision, which keeps the mean path its collision is placed on) */
