@@ -2,12 +2,13 @@
 
 A shard records P(x) twice: the P(x) tally (``position_time``: the mean path's
 assignment with its bridge correction) and, summed over v, the P(x, v) tally
-(``position_velocity_time``: one bridge point a step). Both are exact in expectation,
-except in steps cut by a collision, which the P(x) tally keeps on their mean path, and
-they share the trajectory, so their difference has a small error: a paired jackknife
-z of order 1 in every bin says they agree; a run of the P(x) tally of before issue 18's
-bridge correction (the mean path alone) shows its bias, 4-7 standard errors at r = 0.25
-and 0.75 (docs/methods.md).
+(``position_velocity_time``: one bridge point a step). They share the trajectory, so
+their difference has a small error. With the correction they also share the bridge
+point, and for a step not cut by a collision their difference has mean zero by
+construction: a paired z of order 1 in every bin then checks the bookkeeping and bounds
+what the collision steps (kept on their mean path) leave between them. On a run made
+before issue 18's correction (the mean path alone) it shows that tally's bias, 4-7
+standard errors at r = 0.25 and 0.75 (docs/methods.md).
 
     python -m benchmarks.position_tally_check [results directory]
 

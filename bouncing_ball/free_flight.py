@@ -17,7 +17,8 @@ and their covariance is
 (the factor 2 is the noise strength 2 Lambda of eq. (eqmo)).  The simulation
 uses these to integrate x, x^2 and v^2 over a step exactly in expectation, to
 place a collision inside a step, and to draw (x(t), v(t)) from the bridge
-(``bridge_sample``) for the time-weighted P(x, v).
+(``bridge_sample``) for the time-weighted P(x, v) and for the correction that makes
+the P(x) and <v^2>_x tally exact in expectation.
 
 Everything here is numba-compiled scalar code (no allocation, no division by
 a constant: those are written as products with the reciprocal, which LLVM
@@ -360,8 +361,8 @@ def level_time_one_step(a0, a1, a2, a3, level, inverse):
 def level_time(a0, a1, a2, a3, level, inverse):
     """The t where the mean path m(t) = level on a monotone piece that brackets it
     (``inverse``: the piece's ``piece_inverse``), to about 1e-9 of the piece: where a
-    collision cuts a step (``first_crossing_time``); the P(x) tally's edge crossings use
-    ``level_time_one_step``.
+    collision cuts a step (``first_crossing_time``), and the P(x) tally's edge crossings
+    in such a step; its other crossings use ``level_time_one_step``.
 
     The start is ``level_time_estimate``: the inverse cubic Hermite interpolant t(m)
     through the piece's ends (their values and slopes 1/m'), or the linear one next to a

@@ -75,7 +75,8 @@ def position_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
 
     NaN where a value is undefined: P(x) in the overflow bin, errors and
     <v^2>_x in bins the particle never visited.  The tally is exact in expectation
-    (``simulation``: the mean path corrected by one bridge point a step), so a bin's
+    but in the steps cut by a collision (``simulation``: the mean path corrected by one
+    bridge point a step), so a bin's
     total can come out slightly negative where the particle hardly goes; the underflow
     bin (x below the first edge) also holds the bridge points below x = 0.
     """

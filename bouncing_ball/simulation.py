@@ -33,8 +33,9 @@ depends on the state):
     tau * (1/tau) int_0^tau Prob[(x(s), v(s)) in cell | ends] ds, the
     expected time in the cell: unbiased, with no discretisation error.
   * the time spent in each log bin of x, and int v^2 dt in each bin, which give
-    P(x) and <v^2>_x of eq. (moment2), exact in expectation with the variance
-    of the mean path's integrals.  A step's time is first assigned along its
+    P(x) and <v^2>_x of eq. (moment2), exact in expectation (but in the steps
+    cut by a collision, below), with nearly the errors of the mean path's
+    integrals alone.  A step's time is first assigned along its
     mean path, each bin edge crossed at a time estimated by one Halley step
     (``free_flight.level_time_one_step``), and int v^2 dt integrates E[v^2 |
     ends] (slope squared plus bridge variance of v).  That assignment alone is
@@ -50,7 +51,8 @@ depends on the state):
     is the integrand of the assignment).  In expectation this adds the bridge
     law's time in each bin minus the assignment's, whatever the assignment, so
     the sum is exact; it changes nothing when k_s = k_x (most steps), and it
-    raises the errors of P(x) and <v^2>_x by a few per cent (docs/methods.md).
+    raises the errors of P(x) by 1-3 % and those of <v^2>_x by 5-12 % (medians
+    over the bins of the default run; docs/methods.md).
     A step cut by a collision is left on its mean path, as its collision is
     (crossings by ``free_flight.level_time``, no correction): past the mean
     path's zero the free bridge is not the ball's path, and one point of such
@@ -200,7 +202,8 @@ def _walked_bin_index(value, k, bin_lower, bin_upper):
     """Index of ``value`` in the x bins, walking from bin ``k`` (no logarithm): the same bin
     as ``_bin_index``, whose answer the edges decide too.  ``bin_lower`` and ``bin_upper``
     are the ends of each bin, -inf and inf those of the under- and overflow bins, so the
-    walk stops (a NaN stays in bin ``k``)."""
+    walk stops for a finite value (a NaN stays in bin ``k``; +inf, which a finite step
+    cannot draw, would walk off the end)."""
     while value < bin_lower[k]:
         k -= 1
     while value >= bin_upper[k]:
@@ -307,11 +310,24 @@ def _tally_step(
     return k, k_s
 
 
+@njit(cache=True, inline="always")
+def _bridge_correction(a1, a2, a3, dt, tau, s, normal_1, k_s, k_x, time_in, v2_in):
+    """The bridge correction of a step's P(x) and <v^2>_x (module docstring): the assignment
+    gave the time s to bin k_s, the bridge point x(s) (drawn with ``normal_1``) is in bin
+    k_x; tau moves from k_s to k_x, and tau E[v(s)^2 | x(s), ends] with it in int v^2 dt.
+    Called where k_x != k_s, in steps not cut by a collision."""
+    v2_s = tau * bridge_speed_squared_given_position(a1, a2, a3, dt, s, normal_1)
+    time_in[k_x] += tau
+    time_in[k_s] -= tau
+    v2_in[k_x] += v2_s
+    v2_in[k_s] -= v2_s
+
+
 # What the compiled loop records, by bit of its ``parts`` argument: the benchmark leaves
 # them out one at a time to time each (``python -m benchmarks``); a shard records them all.
 # The collisions, their outgoing speeds, the time and the steps are always recorded.
 MEAN_PATH_INTEGRALS = 1  # int x dt and int x^2 dt
-POSITION = 2  # P(x) and <v^2>_x on the mean path
+POSITION = 2  # P(x) and <v^2>_x: the mean path and its bridge correction
 JOINT = 4  # P(x, v) from the bridge sample
 FLIGHTS = 8  # flight times and (outgoing, return) speed pairs
 CONTROL_VARIATES = 16  # the noise sums of histograms.control_variate_rate
@@ -474,11 +490,19 @@ def _run(
                 # in a step cut by a collision, which keeps the mean path its collision is on)
                 x_cell = _walked_bin_index(x_s, k_s, x_bin_lower, x_bin_upper)
                 if x_cell != k_s and not collided:
-                    v2_s = tau * bridge_speed_squared_given_position(a1, a2, a3, dt, s, normal_1)
-                    position_time[x_cell] += tau
-                    position_time[k_s] -= tau
-                    position_v2_time[x_cell] += v2_s
-                    position_v2_time[k_s] -= v2_s
+                    _bridge_correction(
+                        a1,
+                        a2,
+                        a3,
+                        dt,
+                        tau,
+                        s,
+                        normal_1,
+                        k_s,
+                        x_cell,
+                        position_time,
+                        position_v2_time,
+                    )
             if parts & JOINT:
                 # P(x, v): tau to the cell of (x(s), v(s))
                 if not parts & POSITION:

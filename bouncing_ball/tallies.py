@@ -58,8 +58,9 @@ BINS = ("speed_bins", "position_bins", "velocity_bins", "flight_time_bins")
 
 
 def tally_seed_sequence(seed_sequence: np.random.SeedSequence) -> np.random.SeedSequence:
-    """The stream of the P(x, v) draws of a shard (``simulation.simulate_shard``): the first
-    child of its stream, made without ``spawn`` (which would change the parent's state)."""
+    """The stream of a shard's bridge points (``simulation.simulate_shard``: P(x, v) and the
+    correction of P(x) and <v^2>_x): the first child of its stream, made without ``spawn``
+    (which would change the parent's state)."""
     return np.random.SeedSequence(
         entropy=seed_sequence.entropy,
         spawn_key=(*seed_sequence.spawn_key, 0),
@@ -74,7 +75,7 @@ class ShardTallies:
     velocity_bins: LinearBins
     flight_time_bins: LogBins
     speed_counts: np.ndarray  # outgoing speeds of the recorded collisions
-    position_time: np.ndarray  # time per x bin (along the mean path)
+    position_time: np.ndarray  # time per x bin (the mean path, bridge-corrected)
     position_v2_time: np.ndarray  # int v^2 dt per x bin
     flight_time_counts: np.ndarray  # durations of the recorded flights
     position_velocity_time: np.ndarray  # (x bins, v bins): time per cell (sampled on the bridge)
