@@ -375,10 +375,10 @@ def level_time(a0, a1, a2, a3, level, inverse):
     (tests/unit/test_free_flight.py checks 1e-8 on random pieces; on the 2.7
     million bin-edge crossings of a simulated trajectory at r = 1/2, c = 5, 1 in 1000 is
     off by more than 1e-9 of its piece and the worst by 2e-7).  Crossings take 1.44
-    Halley steps on average from the Hermite start (2.2 from the linear one).  Next to a zero of m' (a piece ends where the path
-    turns) a Halley step is short because m' is small, not because the root is
-    near; such a step is replaced by bisection, which stops when the bracket is
-    1e-10 of the piece.  The crossings of one piece do not depend on each other,
+    Halley steps on average from the Hermite start (2.2 from the linear one).  Next to
+    a zero of m' (a piece ends where the path turns) a Halley step is short because m'
+    is small, not because the root is near; such a step is replaced by bisection, which
+    stops when the bracket is 1e-10 of the piece.  The crossings of one piece do not depend on each other,
     so the processor overlaps them.
     """
     t_lo, width, x_lo, rise, inv_rise, m0, m1 = inverse

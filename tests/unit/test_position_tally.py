@@ -57,21 +57,18 @@ def _one_step(a, dt, tau, x_tau, v_tau, k, edges, lower, upper, points, seed):
     v2_in = np.zeros(n)
     moments = np.zeros((5, n))
     a0, a1, a2, a3 = a
-    assigned = False
+    # the assignment does not depend on s; each point's bin k_s does
+    _tally_step(a, dt, tau, x_tau, v_tau, k, 0.0, False, edges, lower, upper, time_in, v2_in)
+    scratch_time = np.zeros(n)
+    scratch_v2 = np.zeros(n)
     for _ in range(points):
         s = np.random.random() * tau
         normal_1 = np.random.standard_normal()
         normal_2 = np.random.standard_normal()
         x_s, v_s = bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2)
-        scratch_time = np.zeros(n)
-        scratch_v2 = np.zeros(n)
         k_end, k_s = _tally_step(
             a, dt, tau, x_tau, v_tau, k, s, False, edges, lower, upper, scratch_time, scratch_v2
         )
-        if not assigned:
-            time_in[:] = scratch_time
-            v2_in[:] = scratch_v2
-            assigned = True
         x_cell = _walked_bin_index(x_s, k_s, lower, upper)
         if x_cell != k_s:
             scratch_time[:] = 0.0
