@@ -5,7 +5,10 @@ Two kinds of measurement, both CPU time on one core, best of ``repeats``:
   * the shard loop itself (``simulation.simulate_shard``) with its tallies switched on
     one at a time (its ``parts`` argument): "stepping" records what the hand-tuned C loop
     records (collisions, their outgoing speeds, time, steps, int x dt and int x^2 dt),
-    and each tally's cost is the loop's ns per step with it minus without it;
+    and each tally's cost is the loop's ns per step with it minus without it; and every
+    tally with P(x)'s assignment not walked over the mean path's crossings
+    (``simulation.POSITION_WITHOUT_WALK``, not a shard's loop): what the walk costs, as
+    ``position_walk_study`` measures what it buys;
   * the two pieces of a step that cannot be switched off, timed on their own: the step-size
     root of eq. (criterion) (``free_flight.criterion_root``, from the loop's warm start and
     from the cold start, over the states of a real trajectory, which ``_trajectory``
@@ -35,6 +38,7 @@ from bouncing_ball.simulation import (
     JOINT,
     MEAN_PATH_INTEGRALS,
     POSITION,
+    POSITION_WITHOUT_WALK,
     shard_seed_sequence,
     simulate_shard,
 )
@@ -51,6 +55,8 @@ PARTS = (
     ("+ P(x, v)", MEAN_PATH_INTEGRALS | JOINT),
     ("+ flight times and return speeds", MEAN_PATH_INTEGRALS | FLIGHTS),
     ("+ control variates (noise sums)", MEAN_PATH_INTEGRALS | CONTROL_VARIATES),
+    # not a shard's loop: P(x) with no walk over the crossings (position_walk_study)
+    ("every tally, P(x) without its walk", EVERY_TALLY | POSITION_WITHOUT_WALK),
     ("every tally", EVERY_TALLY),
 )
 
@@ -162,7 +168,7 @@ def breakdown(settings, criterion_cs=(5.0, 3.0), r=0.5):
         shard = settings.replace(criterion_c=c)
         rows = loop_parts(shard, r)
         row = {"r": r, "criterion_c": c, "parts": rows, **step_pieces(shard, r)}
-        ours = {"stepping": rows[0], "every tally": rows[-1]}
+        ours = {"stepping": rows[0], "every tally": rows[-1], "no walk": rows[-2]}
         references = {"issue": ISSUE_HAND_TUNED[c]}
         try:
             measured = min(
@@ -173,10 +179,7 @@ def breakdown(settings, criterion_cs=(5.0, 3.0), r=0.5):
         except (RuntimeError, OSError) as error:  # no compiler
             row["hand_tuned_skipped"] = str(error).splitlines()[0]
         row["against_hand_tuned"] = {
-            source: {
-                case: ours[case]["collisions_per_cpu_second"] / rate
-                for case in ("stepping", "every tally")
-            }
+            source: {case: ours[case]["collisions_per_cpu_second"] / rate for case in ours}
             for source, rate in references.items()
         }
         row["hand_tuned_collisions_per_cpu_second"] = references
@@ -205,7 +208,8 @@ def print_breakdown(results):
             print(
                 f"    against the hand-tuned C loop ({source}: {rate:.3g} collisions/CPU s): stepping "
                 f"{ratios['stepping']:.2f} (target {TARGET_STEPPING}), every tally "
-                f"{ratios['every tally']:.2f} (target {TARGET_EVERY_TALLY})"
+                f"{ratios['every tally']:.2f} (target {TARGET_EVERY_TALLY}); every tally with P(x) "
+                f"not walked {ratios['no walk']:.2f}"
             )
         if "hand_tuned_skipped" in row:
             print(f"    hand-tuned C loop not measured here: {row['hand_tuned_skipped']}")
