@@ -12,7 +12,7 @@
  *       monotone_piece_end, first_crossing_time, bridge_sample,
  *       bridge_speed_squared_given_position
  *   bouncing_ball/simulation.py: _bin_index, _linear_bin_index, _walked_bin_index,
- *       _tally_position, _tally_step, _run
+ *       _tally_position, _tally_step, _bridge_correction, floor_stratum_end, _run
  *
  * (translated from the committed versions of those files).  Every floating-point
  * operation is the same as in the Python source and in the same order (same
@@ -21,9 +21,9 @@
  * arguments), so with the FMA contraction switched off (numba does not fuse
  * multiply-adds) it gives bit-identical tallies.  Where Python returns a tuple
  * the C returns a struct (piece_inverse) or the first value with the second
- * through a pointer (tally_position and tally_step, whose (k, k_s) are the bin
- * of the step's end and the bin its mean-path assignment gives the bridge
- * point's time s; criterion_root, whose (s*, f'(s*)) the loop carries from
+ * through a pointer (tally_position and tally_step, whose (k, k_s, k_s2) are the
+ * bin of the step's end and the bins its mean-path assignment gives the bridge
+ * points' times s, s2; criterion_root, whose (s*, f'(s*)) the loop carries from
  * step to step as root, slope_at_root, with the predictor k0, k1, k2 of the next
  * step's start computed before the step, as in ``_run``; free_flight.root_predictor
  * and predicted_start are written out inline in the loop).  ``_run``'s last
@@ -82,6 +82,7 @@
 
 /* simulation.py */
 #define COLLAPSED_STEP 1.0e-80
+#define FLOOR_STRATUM_HEIGHT 0.1
 enum {
     TIME,
     COLLISIONS,
@@ -490,6 +491,28 @@ static inline int64_t bin_index(double value, double log_lo, double per_ln, int6
     return k + 1;
 }
 
+/* floor_stratum_end: t_low = FLOOR_STRATUM_HEIGHT / v in a step that starts at the floor with
+   v tau > FLOOR_STRATUM_HEIGHT (two bridge points, one in [0, t_low], one in [t_low, tau]);
+   else tau (one point) */
+static inline double floor_stratum_end(double tau, double x, double v)
+{
+    if (x == 0.0 && v * tau > FLOOR_STRATUM_HEIGHT)
+        return FLOOR_STRATUM_HEIGHT / v;
+    return tau;
+}
+
+/* _bridge_correction: the point's weight (and weight E[v(s)^2 | x(s), ends]) from bin k_s to k_x */
+static inline void bridge_correction(double a1, double a2, double a3, double dt, double weight,
+                                     double s, double normal_1, int64_t k_s, int64_t k_x,
+                                     double *time_in, double *v2_in)
+{
+    double v2_s = weight * bridge_speed_squared_given_position(a1, a2, a3, dt, s, normal_1);
+    time_in[k_x] += weight;
+    time_in[k_s] -= weight;
+    v2_in[k_x] += v2_s;
+    v2_in[k_s] -= v2_s;
+}
+
 /* _walked_bin_index: the bin of value, walking from bin k over the bins' ends (-inf and inf
    those of the under- and overflow bins); a NaN stays in bin k */
 static inline int64_t walked_bin_index(double value, int64_t k, const double *bin_lower,
@@ -502,12 +525,14 @@ static inline int64_t walked_bin_index(double value, int64_t k, const double *bi
     return k;
 }
 
-/* edges has n + 1 entries.  Returns the bin of x_b and sets *k_s to the bin of the interval
-   holding the time s (unchanged if s is before the piece); Python returns the pair (k, k_s) */
+/* edges has n + 1 entries.  Returns the bin of x_b and sets *k_s, *k_s2 to the bins of the
+   intervals holding the times s, s2 (unchanged if before the piece); Python returns the triple
+   (k, k_s, k_s2) */
 static inline int64_t tally_position(double a0, double a1, double a2, double a3, quintic sq,
                                      double t_a, double t_b, double x_a, double x_b, double d_a,
-                                     double d_b, int64_t k, double s, int64_t *k_s,
-                                     int exact_crossings, const double *edges, int64_t n,
+                                     double d_b, int64_t k, double s, int64_t *k_s, double s2,
+                                     int64_t *k_s2, int exact_crossings, const double *edges,
+                                     int64_t n,
                                      double *time_in, double *v2_in)
 {
     double t_prev = t_a;
@@ -534,6 +559,7 @@ static inline int64_t tally_position(double a0, double a1, double a2, double a3,
         time_in[k] += t_e - t_prev;
         v2_in[k] += s_e - s_prev;
         *k_s = s >= t_prev ? k : *k_s;
+        *k_s2 = s2 >= t_prev ? k : *k_s2;
         t_prev = t_e;
         s_prev = s_e;
         k = k_next;
@@ -542,14 +568,15 @@ static inline int64_t tally_position(double a0, double a1, double a2, double a3,
     time_in[k] += t_b - t_prev;
     v2_in[k] += s_b - s_prev;
     *k_s = s >= t_prev ? k : *k_s;
+    *k_s2 = s2 >= t_prev ? k : *k_s2;
     return k;
 }
 
-/* returns the bin of m(tau) and sets *k_s to the bin the assignment gives the time s (Python
-   returns the pair (k, k_s)) */
+/* returns the bin of m(tau) and sets *k_s, *k_s2 to the bins the assignment gives the times s,
+   s2 (Python returns the triple (k, k_s, k_s2)) */
 static inline int64_t tally_step(double a0, double a1, double a2, double a3, double dt, double tau,
                                  double x_tau, double slope_tau, int64_t k, double s, int64_t *k_s,
-                                 int exact_crossings, const double *edges, int64_t n,
+                                 double s2, int64_t *k_s2, int exact_crossings, const double *edges, int64_t n,
                                  const double *bin_lower,
                                  const double *bin_upper, double *time_in, double *v2_in)
 {
@@ -562,6 +589,7 @@ static inline int64_t tally_step(double a0, double a1, double a2, double a3, dou
         time_in[k] += tau;
         v2_in[k] += quintic_antiderivative_value(sq.s1, sq.s2, sq.s3, sq.s4, sq.s5, tau);
         *k_s = k;
+        *k_s2 = k;
         return k;
     }
     /* m' is a quadratic with Bernstein control points m'(0), m'(0) + a2 tau, m'(tau):
@@ -581,6 +609,7 @@ static inline int64_t tally_step(double a0, double a1, double a2, double a3, dou
     double x_a = a0;
     double d_a = a1;
     *k_s = k;
+    *k_s2 = k;
     for (int piece = 0; piece < n_zero + 1; piece++) {
         double t_b = monotone_piece_end(piece, n_zero, t1, t2, tau);
         double x_b, d_b;
@@ -591,7 +620,7 @@ static inline int64_t tally_step(double a0, double a1, double a2, double a3, dou
             x_b = cubic_value(a0, a1, a2, a3, t_b);
             d_b = 0.0;
         }
-        k = tally_position(a0, a1, a2, a3, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, s, k_s,
+        k = tally_position(a0, a1, a2, a3, sq, t_a, t_b, x_a, x_b, d_a, d_b, k, s, k_s, s2, k_s2,
                            exact_crossings, edges, n, time_in, v2_in);
         t_a = t_b;
         x_a = x_b;
@@ -727,32 +756,53 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
             mean_path_integrals(a0, a1, a2, a3, dt, tau, &ix, &ix2);
             int_x += ix;
             int_x2 += ix2;
-            /* one point of the step's bridge, (x(s), v(s)) with s uniform in [0, tau], from the
-               tally stream: P(x, v), and the bridge-law correction of P(x), <v^2>_x */
-            double s = random_standard_uniform(rng_tally) * tau;
+            /* the step's bridge points, (x(s), v(s)), from the tally stream: P(x, v), and the
+               bridge-law correction of P(x), <v^2>_x.  One, s uniform in [0, tau] with weight
+               tau; two in a step from the floor, one in each stratum of floor_stratum_end */
+            double t_low = floor_stratum_end(tau, x, v);
+            int points = t_low < tau ? 2 : 1;
+            double u = random_standard_uniform(rng_tally);
             double normal_1 = random_standard_normal(rng_tally);
             double normal_2 = random_standard_normal(rng_tally);
-            int64_t k_s;
-            x_bin = tally_step(a0, a1, a2, a3, dt, tau, x_tau, v_tau, x_bin, s, &k_s, collided,
-                               x_edges, nx, x_bin_lower, x_bin_upper, position_time,
-                               position_v2_time);
-            double x_s, v_s; /* the point itself after the walk, as in numba */
-            bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2, &x_s, &v_s);
-            /* the assignment gave the time s to bin k_s, the bridge puts x(s) in x_cell: the
-               bridge correction makes the tally exact in expectation (not in a step cut by a
-               collision, which keeps the mean path its collision is placed on) */
-            int64_t x_cell = walked_bin_index(x_s, k_s, x_bin_lower, x_bin_upper);
-            if (x_cell != k_s && !collided) {
-                double v2_s = tau * bridge_speed_squared_given_position(a1, a2, a3, dt, s, normal_1);
-                position_time[x_cell] += tau;
-                position_time[k_s] -= tau;
-                position_v2_time[x_cell] += v2_s;
-                position_v2_time[k_s] -= v2_s;
+            double s = u * tau;
+            double weight = tau;
+            double s2 = s;
+            double weight2 = 0.0;
+            double normal_1b = 0.0, normal_2b = 0.0;
+            if (points == 2) {
+                s = t_low + u * (tau - t_low);
+                weight = tau - t_low;
+                s2 = random_standard_uniform(rng_tally) * t_low;
+                weight2 = t_low;
+                normal_1b = random_standard_normal(rng_tally);
+                normal_2b = random_standard_normal(rng_tally);
             }
-            /* P(x, v): tau to the cell of (x(s), v(s)); with POSITION on, x_cell is the walk's
-               (parts & POSITION: always, so no bin_index) */
-            int64_t cell_v = linear_bin_index(v_s, u_lo, u_per_unit, nu, u_edges);
-            position_velocity_time[x_cell * (nu + 2) + cell_v] += tau;
+            int64_t k_s, k_s2;
+            x_bin = tally_step(a0, a1, a2, a3, dt, tau, x_tau, v_tau, x_bin, s, &k_s, s2, &k_s2,
+                               collided, x_edges, nx, x_bin_lower, x_bin_upper, position_time,
+                               position_v2_time);
+            for (int point = 0; point < points; point++) {
+                if (point == 1) {
+                    s = s2;
+                    weight = weight2;
+                    normal_1 = normal_1b;
+                    normal_2 = normal_2b;
+                    k_s = k_s2;
+                }
+                double x_s, v_s; /* the point itself after the walk, as in numba */
+                bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2, &x_s, &v_s);
+                /* the assignment gave the time s to bin k_s, the bridge puts x(s) in x_cell: the
+                   bridge correction makes the tally exact in expectation (not in a step cut by a
+                   collision, which keeps the mean path its collision is placed on) */
+                int64_t x_cell = walked_bin_index(x_s, k_s, x_bin_lower, x_bin_upper);
+                if (x_cell != k_s && !collided)
+                    bridge_correction(a1, a2, a3, dt, weight, s, normal_1, k_s, x_cell,
+                                      position_time, position_v2_time);
+                /* P(x, v): the point's weight to the cell of (x(s), v(s)); with POSITION on,
+                   x_cell is the walk's (parts & POSITION: always, so no bin_index) */
+                int64_t cell_v = linear_bin_index(v_s, u_lo, u_per_unit, nu, u_edges);
+                position_velocity_time[x_cell * (nu + 2) + cell_v] += weight;
+            }
         }
         t += tau;
         since_collision += tau;
