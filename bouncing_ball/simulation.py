@@ -26,12 +26,15 @@ depends on the state):
     (x(s), v(s)) from the bridge's exact conditional Gaussian given both ends
     (``free_flight.bridge_sample``), drawn from their own generator
     (``tally_seed_sequence``), so the trajectory and the tallies that do not use
-    the point are those of a shard without it.
+    the point are those of a shard without it.  A step from the floor draws two,
+    one in each stratum [0, t_low], [t_low, tau] of ``floor_stratum_end``, each
+    weighing its stratum's length (the weights add up to tau).
   * the time spent in each cell of (x, v), x on the position bins and v on
-    evenly spaced bins, for P(x, v): tau added to the cell of (x(s), v(s)).
-    Given the ends, the expectation of what is added to a cell is
-    tau * (1/tau) int_0^tau Prob[(x(s), v(s)) in cell | ends] ds, the
-    expected time in the cell: unbiased, with no discretisation error.
+    evenly spaced bins, for P(x, v): the point's weight (tau, or its stratum's
+    length) added to the cell of (x(s), v(s)).  Given the ends, the expectation
+    of what is added to a cell is the expected time in the cell,
+    int Prob[(x(s), v(s)) in cell | ends] ds over the step: unbiased, with no
+    discretisation error.
   * the time spent in each log bin of x, and int v^2 dt in each bin, which give
     P(x) and <v^2>_x of eq. (moment2), exact in expectation (but in the steps
     cut by a collision, below), with nearly the errors of the mean path's
