@@ -416,6 +416,49 @@ EVERY_TALLY = MEAN_PATH_INTEGRALS | POSITION | JOINT | FLIGHTS | CONTROL_VARIATE
 POSITION_WITHOUT_WALK = 32
 
 
+@njit(cache=True)
+def _tally_second_bridge_point(
+    rng_tally,
+    a,
+    dt,
+    s,
+    weight,
+    k_s,
+    collided,
+    parts,
+    x_log_lo,
+    x_per_ln,
+    x_edges,
+    x_bin_lower,
+    x_bin_upper,
+    u_lo,
+    u_per_unit,
+    u_edges,
+    position_time,
+    position_v2_time,
+    position_velocity_time,
+):
+    """The second bridge point of a step from the floor (``floor_stratum_end``), at time s
+    in [0, t_low] with ``weight`` t_low, its normals drawn here: the bridge correction (with
+    POSITION; k_s is the bin the assignment gives s) and P(x, v) (with JOINT), as the loop
+    does for the first point."""
+    a0, a1, a2, a3 = a
+    normal_1 = rng_tally.standard_normal()
+    normal_2 = rng_tally.standard_normal()
+    x_s, v_s = bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2)
+    if parts & POSITION:
+        x_cell = _walked_bin_index(x_s, k_s, x_bin_lower, x_bin_upper)
+        if x_cell != k_s and not collided:
+            _bridge_correction(
+                a1, a2, a3, dt, weight, s, normal_1, k_s, x_cell, position_time, position_v2_time
+            )
+    else:
+        x_cell = _bin_index(x_s, x_log_lo, x_per_ln, x_edges.shape[0] - 1, x_edges)
+    if parts & JOINT:
+        cell_v = _linear_bin_index(v_s, u_lo, u_per_unit, u_edges.shape[0] - 1, u_edges)
+        position_velocity_time[x_cell, cell_v] += weight
+
+
 # a step this short only happens in a collapse (v ~ 1e-37); much shorter ones overflow the bridge's
 # cubic coefficients (~ x / dt^2) before the speed underflows to zero
 COLLAPSED_STEP = 1.0e-80
@@ -554,15 +597,10 @@ def _run(
                 s = u * tau
                 weight = tau
                 s2 = s
-                weight2 = 0.0
-                normal_1b = normal_2b = 0.0
                 if points == 2:
                     s = t_low + u * (tau - t_low)
                     weight = tau - t_low
                     s2 = rng_tally.random() * t_low
-                    weight2 = t_low
-                    normal_1b = rng_tally.standard_normal()
-                    normal_2b = rng_tally.standard_normal()
             if parts & POSITION and parts & POSITION_WITHOUT_WALK and not collided:
                 k_s = k_s2 = x_bin
                 sq = speed_squared_coefficients(a1, a2, a3, dt)
@@ -588,42 +626,59 @@ def _run(
                     position_time,
                     position_v2_time,
                 )
-            if parts & (POSITION | JOINT):
-                for point in range(points):
-                    if point == 1:
-                        s, weight, normal_1, normal_2 = s2, weight2, normal_1b, normal_2b
-                        if parts & POSITION:
-                            k_s = k_s2
-                    # the point itself after the walk: fewer values live across it (numba then
-                    # keeps pace with the C reference)
+            if parts & POSITION:
+                # the point itself after the walk: fewer values live across it (numba then
+                # keeps pace with the C reference)
+                x_s, v_s = bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2)
+                # the assignment gave the time s to bin k_s, the bridge puts x(s) in x_cell: the
+                # bridge correction (module docstring) makes the tally exact in expectation (not
+                # in a step cut by a collision, which keeps the mean path its collision is on)
+                x_cell = _walked_bin_index(x_s, k_s, x_bin_lower, x_bin_upper)
+                if x_cell != k_s and not collided:
+                    _bridge_correction(
+                        a1,
+                        a2,
+                        a3,
+                        dt,
+                        weight,
+                        s,
+                        normal_1,
+                        k_s,
+                        x_cell,
+                        position_time,
+                        position_v2_time,
+                    )
+            if parts & JOINT:
+                # P(x, v): the point's weight to the cell of (x(s), v(s))
+                if not parts & POSITION:
                     x_s, v_s = bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2)
-                    if parts & POSITION:
-                        # the assignment gave the time s to bin k_s, the bridge puts x(s) in
-                        # x_cell: the bridge correction (module docstring) makes the tally exact
-                        # in expectation (not in a step cut by a collision, which keeps the mean
-                        # path its collision is on)
-                        x_cell = _walked_bin_index(x_s, k_s, x_bin_lower, x_bin_upper)
-                        if x_cell != k_s and not collided:
-                            _bridge_correction(
-                                a1,
-                                a2,
-                                a3,
-                                dt,
-                                weight,
-                                s,
-                                normal_1,
-                                k_s,
-                                x_cell,
-                                position_time,
-                                position_v2_time,
-                            )
-                    else:
-                        x_cell = _bin_index(x_s, x_log_lo, x_per_ln, nx, x_edges)
-                    if parts & JOINT:
-                        # P(x, v): the point's weight to the cell of (x(s), v(s))
-                        position_velocity_time[
-                            x_cell, _linear_bin_index(v_s, u_lo, u_per_unit, nu, u_edges)
-                        ] += weight
+                    x_cell = _bin_index(x_s, x_log_lo, x_per_ln, nx, x_edges)
+                position_velocity_time[
+                    x_cell, _linear_bin_index(v_s, u_lo, u_per_unit, nu, u_edges)
+                ] += weight
+            if parts & (POSITION | JOINT) and points == 2:
+                # the second point of a step from the floor, in [0, t_low] (rare: its own function)
+                _tally_second_bridge_point(
+                    rng_tally,
+                    a,
+                    dt,
+                    s2,
+                    t_low,
+                    k_s2,
+                    collided,
+                    parts,
+                    x_log_lo,
+                    x_per_ln,
+                    x_edges,
+                    x_bin_lower,
+                    x_bin_upper,
+                    u_lo,
+                    u_per_unit,
+                    u_edges,
+                    position_time,
+                    position_v2_time,
+                    position_velocity_time,
+                )
         t += tau
         since_collision += tau
         if collided:

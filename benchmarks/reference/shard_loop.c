@@ -12,7 +12,8 @@
  *       monotone_piece_end, first_crossing_time, bridge_sample,
  *       bridge_speed_squared_given_position
  *   bouncing_ball/simulation.py: _bin_index, _linear_bin_index, _walked_bin_index,
- *       _tally_position, _tally_step, _bridge_correction, floor_stratum_end, _run
+ *       _tally_position, _tally_step, _bridge_correction, floor_stratum_end,
+ *       _tally_second_bridge_point, _run
  *
  * (translated from the committed versions of those files).  Every floating-point
  * operation is the same as in the Python source and in the same order (same
@@ -767,26 +768,21 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
             double s = u * tau;
             double weight = tau;
             double s2 = s;
-            double weight2 = 0.0;
-            double normal_1b = 0.0, normal_2b = 0.0;
             if (points == 2) {
                 s = t_low + u * (tau - t_low);
                 weight = tau - t_low;
                 s2 = random_standard_uniform(rng_tally) * t_low;
-                weight2 = t_low;
-                normal_1b = random_standard_normal(rng_tally);
-                normal_2b = random_standard_normal(rng_tally);
             }
             int64_t k_s, k_s2;
             x_bin = tally_step(a0, a1, a2, a3, dt, tau, x_tau, v_tau, x_bin, s, &k_s, s2, &k_s2,
                                collided, x_edges, nx, x_bin_lower, x_bin_upper, position_time,
                                position_v2_time);
             for (int point = 0; point < points; point++) {
-                if (point == 1) {
+                if (point == 1) { /* _tally_second_bridge_point: its normals drawn after the first */
                     s = s2;
-                    weight = weight2;
-                    normal_1 = normal_1b;
-                    normal_2 = normal_2b;
+                    weight = t_low;
+                    normal_1 = random_standard_normal(rng_tally);
+                    normal_2 = random_standard_normal(rng_tally);
                     k_s = k_s2;
                 }
                 double x_s, v_s; /* the point itself after the walk, as in numba */
