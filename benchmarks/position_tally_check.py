@@ -29,6 +29,12 @@ from bouncing_ball.shards import read_shards
 LOW, HIGH = 1e-3, 50.0  # the bins of the validation table's P(x) checks
 
 
+def checked_bins(bins):
+    """Which x bins lie in [LOW, HIGH] (a boolean mask over ``bins``' under-, regular and
+    overflow bins)."""
+    return (bins.lower >= LOW * (1 - 1e-9)) & (bins.upper <= HIGH * (1 + 1e-9))
+
+
 def paired_difference(shards):
     """Per x bin: (x, P(x) from the P(x) tally, the relative difference of the P(x, v)
     marginal from it, the paired z of that difference, and each estimate's error)."""
@@ -40,14 +46,15 @@ def paired_difference(shards):
     p_tally, e_tally = jackknife(rate, tally, times)
     p_marginal, e_marginal = jackknife(rate, marginal, times)
     difference, e_difference = jackknife(rate, tally - marginal, times)
-    inside = (bins.lower >= LOW * (1 - 1e-9)) & (bins.upper <= HIGH * (1 + 1e-9))
+    inside = checked_bins(bins)  # the other bins may be empty: divide only these
     x = np.sqrt(bins.lower * bins.upper)
+    p_tally, p_marginal, difference = p_tally[inside], p_marginal[inside], difference[inside]
     return {
         "x": x[inside],
-        "relative_difference": (difference / p_tally)[inside],
-        "z": (difference / e_difference)[inside],
-        "error_tally": (e_tally / p_tally)[inside],
-        "error_marginal": (e_marginal / p_marginal)[inside],
+        "relative_difference": difference / p_tally,
+        "z": difference / e_difference[inside],
+        "error_tally": e_tally[inside] / p_tally,
+        "error_marginal": e_marginal[inside] / p_marginal,
     }
 
 

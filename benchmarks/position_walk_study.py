@@ -38,13 +38,13 @@ from bouncing_ball.simulation import (
 
 from .benchmark import SHARD_SETTINGS
 from .breakdown import ISSUE_HAND_TUNED
-from .position_tally_check import HIGH, LOW
+from .position_tally_check import checked_bins
 
 LOOPS = {"walk": EVERY_TALLY, "no walk": EVERY_TALLY | POSITION_WITHOUT_WALK}
 
 
 def run_shards(r, c, shards, shard_time, seed=11):
-    """Per loop: the shards' tallies and the loop's CPU seconds and steps."""
+    """Per loop: the shards' tallies and the loop's CPU seconds (from the same streams)."""
     settings = SHARD_SETTINGS.replace(shard_time=shard_time, criterion_c=c)
     results = {}
     for name, parts in LOOPS.items():
@@ -62,50 +62,55 @@ def run_shards(r, c, shards, shard_time, seed=11):
     return results
 
 
-def _estimates(tallies):
-    """P(x) and <v^2>_x with their jackknife errors, per x bin."""
+def _position_tallies(tallies):
+    """Per shard (first axis): the recorded time, the time in each x bin and int v^2 dt there."""
     times = np.array([t.time for t in tallies])[:, None]
     occupied = np.stack([t.position_time for t in tallies])
     speed_squared = np.stack([t.position_v2_time for t in tallies])
-    p, p_error = jackknife(lambda o, t: o / t, occupied, times)
-    v2, v2_error = jackknife(lambda w, o: w / o, speed_squared, occupied)
-    return p, p_error, v2, v2_error
+    return times, occupied, speed_squared
+
+
+def _rate(occupied, time):
+    return occupied / time
+
+
+def _mean_speed_squared(speed_squared, occupied):
+    return speed_squared / occupied
 
 
 def compare(results):
     """Per x bin of [LOW, HIGH]: the estimates with the walk, the error ratios and the
     paired z of (no walk - walk); per loop: ns per step and collisions per CPU s."""
+    times, a_occupied, a_v2 = _position_tallies(results["walk"]["tallies"])
+    _, b_occupied, b_v2 = _position_tallies(results["no walk"]["tallies"])
     with np.errstate(divide="ignore", invalid="ignore"):  # bins that no shard visited
-        return _table(results["walk"]["tallies"], results["no walk"]["tallies"], results)
-
-
-def _table(walk, no_walk, results):
-    bins = walk[0].position_bins
-    p, p_error, v2, v2_error = _estimates(walk)
-    _, p_error_no_walk, _, v2_error_no_walk = _estimates(no_walk)
-    times = np.array([t.time for t in walk])[:, None]
-    a_occupied = np.stack([t.position_time for t in walk])
-    b_occupied = np.stack([t.position_time for t in no_walk])
-    a_v2 = np.stack([t.position_v2_time for t in walk])
-    b_v2 = np.stack([t.position_v2_time for t in no_walk])
-    p_difference, p_difference_error = jackknife(
-        lambda a, b, t: (b - a) / t, a_occupied, b_occupied, times
-    )
-    v2_difference, v2_difference_error = jackknife(
-        lambda wa, oa, wb, ob: wb / ob - wa / oa, a_v2, a_occupied, b_v2, b_occupied
-    )
-    inside = (bins.lower >= LOW * (1 - 1e-9)) & (bins.upper <= HIGH * (1 + 1e-9))
-    table = {
-        "x": np.sqrt(bins.lower * bins.upper)[inside],
-        "P(x)": p[inside],
-        "P(x) error": p_error[inside],
-        "P(x) error ratio": (p_error_no_walk / p_error)[inside],
-        "P(x) paired z": (p_difference / p_difference_error)[inside],
-        "<v^2>_x": v2[inside],
-        "<v^2>_x error": v2_error[inside],
-        "<v^2>_x error ratio": (v2_error_no_walk / v2_error)[inside],
-        "<v^2>_x paired z": (v2_difference / v2_difference_error)[inside],
-    }
+        p, p_error = jackknife(_rate, a_occupied, times)
+        v2, v2_error = jackknife(_mean_speed_squared, a_v2, a_occupied)
+        _, p_error_no_walk = jackknife(_rate, b_occupied, times)
+        _, v2_error_no_walk = jackknife(_mean_speed_squared, b_v2, b_occupied)
+        p_difference, p_difference_error = jackknife(
+            lambda a, b, t: _rate(b - a, t), a_occupied, b_occupied, times
+        )
+        v2_difference, v2_difference_error = jackknife(
+            lambda wa, oa, wb, ob: _mean_speed_squared(wb, ob) - _mean_speed_squared(wa, oa),
+            a_v2,
+            a_occupied,
+            b_v2,
+            b_occupied,
+        )
+        bins = results["walk"]["tallies"][0].position_bins
+        inside = checked_bins(bins)
+        table = {
+            "x": np.sqrt(bins.lower * bins.upper)[inside],
+            "P(x)": p[inside],
+            "P(x) error": p_error[inside],
+            "P(x) error ratio": (p_error_no_walk / p_error)[inside],
+            "P(x) paired z": (p_difference / p_difference_error)[inside],
+            "<v^2>_x": v2[inside],
+            "<v^2>_x error": v2_error[inside],
+            "<v^2>_x error ratio": (v2_error_no_walk / v2_error)[inside],
+            "<v^2>_x paired z": (v2_difference / v2_difference_error)[inside],
+        }
     speed = {}
     for name, result in results.items():
         steps = sum(t.steps for t in result["tallies"])

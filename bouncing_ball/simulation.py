@@ -290,7 +290,7 @@ def _tally_step(
     slope_tau,
     k,
     s,
-    s2,
+    s_second,
     exact_crossings,
     edges,
     bin_lower,
@@ -302,12 +302,12 @@ def _tally_step(
     mean path, its edge crossings estimated) to the x bins.
 
     ``k`` is the bin of m(0); returns the bin of m(tau) = x_tau, where the slope is
-    slope_tau, and the bins the assignment gives the times ``s`` and ``s2``.  The common case is a
-    step that stays in its bin: the cubic on [0, tau] lies inside the hull of its
-    Bernstein control points m(0), m(0) + m'(0) tau/3, m(tau) - m'(tau) tau/3, m(tau), so
-    when those all lie in bin k the whole step is tallied there at once.  Otherwise the
-    path is split at the zeros of m' into monotone pieces (none when the control points of
-    m' share a sign), which are walked edge by edge.
+    slope_tau, and the bins the assignment gives the times ``s`` and ``s_second``. The
+    common case is a step that stays in its bin: the cubic on [0, tau] lies inside the hull
+    of its Bernstein control points m(0), m(0) + m'(0) tau/3, m(tau) - m'(tau) tau/3,
+    m(tau), so when those all lie in bin k the whole step is tallied there at once.
+    Otherwise the path is split at the zeros of m' into monotone pieces (none when the
+    control points of m' share a sign), which are walked edge by edge.
     """
     a0, a1, a2, a3 = a
     sq = speed_squared_coefficients(a1, a2, a3, dt)
@@ -331,14 +331,14 @@ def _tally_step(
     t_a = 0.0
     x_a = a0
     d_a = a1
-    k_s = k_s2 = k
+    k_s = k_second = k
     for piece in range(n_zero + 1):
         t_b = monotone_piece_end(piece, n_zero, t1, t2, tau)
         if t_b == tau:
             x_b, d_b = x_tau, slope_tau
         else:  # a zero of m'
             x_b, d_b = cubic_value(a0, a1, a2, a3, t_b), 0.0
-        k, k_s, k_s2 = _tally_position(
+        k, k_s, k_second = _tally_position(
             a,
             sq,
             t_a,
@@ -350,15 +350,15 @@ def _tally_step(
             k,
             s,
             k_s,
-            s2,
-            k_s2,
+            s_second,
+            k_second,
             exact_crossings,
             edges,
             time_in,
             v2_in,
         )
         t_a, x_a, d_a = t_b, x_b, d_b
-    return k, k_s, k_s2
+    return k, k_s, k_second
 
 
 @njit(cache=True, inline="always")
@@ -590,14 +590,13 @@ def _run(
                 # bridge-law correction of P(x), <v^2>_x.  One, s uniform in [0, tau] with weight
                 # tau; two in a step from the floor, one in each stratum of floor_stratum_end
                 t_low = floor_stratum_end(tau, x, v)
-                points = 2 if t_low < tau else 1
                 u = rng_tally.random()
                 normal_1 = rng_tally.standard_normal()
                 normal_2 = rng_tally.standard_normal()
                 s = u * tau
                 weight = tau
                 s2 = s
-                if points == 2:
+                if t_low < tau:
                     s = t_low + u * (tau - t_low)
                     weight = tau - t_low
                     s2 = rng_tally.random() * t_low
@@ -656,7 +655,7 @@ def _run(
                 position_velocity_time[
                     x_cell, _linear_bin_index(v_s, u_lo, u_per_unit, nu, u_edges)
                 ] += weight
-            if parts & (POSITION | JOINT) and points == 2:
+            if parts & (POSITION | JOINT) and t_low < tau:
                 # the second point of a step from the floor, in [0, t_low] (rare: its own function)
                 _tally_second_bridge_point(
                     rng_tally,
