@@ -245,7 +245,7 @@ class _EquilibriumState:
         result[(x == 0.0) & (v == 0.0)] = np.inf
         return _out(result)
 
-    def weight(self, F):  # noqa: N803 (the paper's symbol)
+    def weight(self, F):
         """The weight function w(F) of eq. (weightfunc) (eq. (weightfunc2) for the exact
         solutions): P(x, v) is a superposition of the modes of eq. (fpsol) with weight w(F).
 
@@ -268,7 +268,7 @@ class _EquilibriumState:
         force = _checked(F, "F", low=0.0, strictly=True)
         return _out(np.asarray(self._weight(force), dtype=float))
 
-    def flight_rate_density(self, T):  # noqa: N803
+    def flight_rate_density(self, T):
         """nu(T), flights of duration in dT per unit time, eq. (rate) of ``flight_time``:
         int du u P(0, u) f(T | u); finite for T > 0 at every r (also below r_c).
 
@@ -295,7 +295,7 @@ class _EquilibriumState:
             result[positive] = self._flight_rate(times[positive])
         return _out(result)
 
-    def flight_time_density(self, T):  # noqa: N803
+    def flight_time_density(self, T):
         """rho(T) = nu(T) / I, the density of the time between two collisions (per collision);
         0 for T > 0 below r_c, where I is infinite.
 
