@@ -443,6 +443,8 @@ class Equilibrium(_EquilibriumState):
     [0.404354 0.122626 0.022556]
     >>> eq.accuracy < 1e-8
     True
+    >>> print(eq.px([0.1, 1.0]).round(6))  # builds w(F): a few seconds
+    [0.503776 0.183784]
     >>> Equilibrium("1/2", exact=True)
     ExactEquilibrium(r=1/2): I = 0.3333333333, <x> = 6, ...
     """
@@ -483,6 +485,8 @@ class Equilibrium(_EquilibriumState):
     # --- lazily built
     @functools.cached_property
     def accuracy(self) -> float:
+        """The solver's error estimate (``solver.accuracy_estimate``): the largest relative
+        change of P(0, v) over 1e-3 <= v <= 20 against a finer solve (computed on first use)."""
         from . import solver
 
         return solver.accuracy_estimate(self.solution)
@@ -501,6 +505,8 @@ class Equilibrium(_EquilibriumState):
 
     @functools.cached_property
     def position_accuracy(self) -> float:
+        """max(|int P dx - 1|, |<x>_P / <x> - 1|, |Delta x_P / Delta x - 1|): P(x) of
+        eq. (P(x)1) against the normalisation and the solver's Ito identities (builds w(F))."""
         from . import distribution
 
         averages = distribution.position_averages(self.weight_function)
@@ -546,12 +552,20 @@ class Equilibrium(_EquilibriumState):
     def summary(self) -> dict:
         """The solve stage's summary row: ``solver.solution_summary`` (with the accuracy
         estimate), the collision statistics (``flight_time.flight_time_summary``), <x>, Delta x
-        and the normalisation from P(x), and the measured and predicted exponents of P(x).
+        and the normalisation from P(x) (eqs. (P(x)1), (xandDeltax)), and the measured and
+        predicted exponents of P(x) (``distribution.measured_exponents``).
 
         Returns
         -------
         dict
             One row of ``results/solver/r{r}/summary.parquet``.
+
+        Examples
+        --------
+        >>> from bouncing_ball import Equilibrium
+        >>> row = Equilibrium("1/2").summary()
+        >>> print(f"{row['mean_x']:.8f} {row['mean_x_from_position']:.8f}")
+        6.00000000 6.00000000
         """
         from . import distribution, flight_time, solver
 
@@ -568,23 +582,83 @@ class Equilibrium(_EquilibriumState):
         return row
 
     def p0v_table(self, speeds):
-        """P(0, v) at ``speeds`` (v > 0): columns v, p0v (``results/solver/r{r}/p0v``)."""
+        """P(0, v) of eq. (inteq) as a table (``results/solver/r{r}/p0v``).
+
+        Parameters
+        ----------
+        speeds : array_like
+            Outgoing speeds, v > 0.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns v, p0v.
+
+        Examples
+        --------
+        >>> from bouncing_ball import Equilibrium
+        >>> Equilibrium("1/2").p0v_table([1.0, 2.0]).round(6)
+             v       p0v
+        0  1.0  0.122626
+        1  2.0  0.022556
+        """
         import pandas as pd
 
         speeds = _checked(speeds, "speeds", low=0.0, strictly=True)
         return pd.DataFrame({"v": speeds, "p0v": self.solution.outgoing_speed_density(speeds)})
 
     def position_table(self, positions):
-        """P(x) and <v^2>_x at ``positions`` (x > 0): columns x, px, v2_given_x
-        (``results/solver/r{r}/position``)."""
+        """P(x) and <v^2>_x, eqs. (P(x)1), (moment2), as a table
+        (``results/solver/r{r}/position``).
+
+        Parameters
+        ----------
+        positions : array_like
+            Heights, x > 0.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns x, px, v2_given_x.
+
+        Examples
+        --------
+        >>> from bouncing_ball import Equilibrium
+        >>> Equilibrium("1/2").position_table([0.1, 1.0]).round(6)
+             x        px  v2_given_x
+        0  0.1  0.503776    1.853157
+        1  1.0  0.183784    3.710784
+        """
         from . import distribution
 
         positions = _checked(positions, "positions", low=0.0, strictly=True)
         return distribution.position_table(self.weight_function, positions)
 
     def distribution_table(self, positions, speeds):
-        """P(x, v) for every x of ``positions`` and v of ``speeds`` (long format: x, v, pxv) and
-        the largest relative error quad estimates for it (``results/solver/r{r}/distribution``)."""
+        """P(x, v), eq. (fpsol), on the grid of ``positions`` and ``speeds``, with the largest
+        relative error quad estimates for it (``results/solver/r{r}/distribution``).
+
+        Parameters
+        ----------
+        positions : array_like
+            Heights, x >= 0.
+        speeds : array_like
+            Velocities (either sign).
+
+        Returns
+        -------
+        table : pandas.DataFrame
+            Columns x, v, pxv, one row per (x, v), v fastest (NaN at x = v = 0).
+        worst : float
+            The largest relative error estimate of the F integrals.
+
+        Examples
+        --------
+        >>> from bouncing_ball import Equilibrium
+        >>> table, worst = Equilibrium("1/2").distribution_table([0.1], [-1.0, 1.0])
+        >>> print(table["pxv"].to_numpy().round(6), worst < 1e-8)
+        [0.074292 0.146809] True
+        """
         from . import distribution
 
         positions = _checked(positions, "positions", low=0.0)
@@ -594,23 +668,80 @@ class Equilibrium(_EquilibriumState):
         )
 
     def weight_table(self, forces):
-        """w(F) at ``forces``: columns F, w, log_w (``results/solver/r{r}/weight``)."""
+        """w(F) of eq. (weightfunc) as a table (``results/solver/r{r}/weight``).
+
+        Parameters
+        ----------
+        forces : array_like
+            F > 0.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns F, w, log_w (log_w stays finite where w over- or underflows).
+
+        Examples
+        --------
+        >>> from bouncing_ball import Equilibrium
+        >>> Equilibrium("1/2").weight_table([1.0]).round(6)
+             F         w     log_w
+        0  1.0  0.153341 -1.875093
+        """
         from . import distribution
 
         forces = _checked(forces, "forces", low=0.0, strictly=True)
         return distribution.weight_table(self.weight_function, forces)
 
     def flight_time_table(self, times):
-        """The flight-time density and its asymptotic forms at ``times`` (T > 0)
-        (``flight_time.flight_time_table``; ``results/solver/r{r}/flight_time``)."""
+        """The flight-time densities of eq. (rate) and their short- and long-time forms,
+        eqs. (short), (long1), (long2) (``flight_time.flight_time_table``;
+        ``results/solver/r{r}/flight_time``).
+
+        Parameters
+        ----------
+        times : array_like
+            Flight times, T > 0.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns t, density, rate_density, time_weighted_density, short_time_form,
+            long_time_form.
+
+        Examples
+        --------
+        >>> from bouncing_ball import Equilibrium
+        >>> Equilibrium("1/2").flight_time_table([1.0])["density"].round(6).tolist()
+        [0.196832]
+        """
         from . import flight_time
 
         times = _checked(times, "times", low=0.0, strictly=True)
         return flight_time.flight_time_table(self.solution, times)
 
     def return_speed_table(self, speed_bins):
-        """The return-speed law on a simulation's speed bins (``bins.LogBins``)
-        (``flight_time.return_speed_table``; ``results/solver/r{r}/return_speed``)."""
+        """The return-speed law v G_g(v, u) of eq. (kernel3) averaged over a simulation's speed
+        bins, with u weighted by the collision rate u P(0, u) in its bin
+        (``flight_time.return_speed_table``; ``results/solver/r{r}/return_speed``).
+
+        Parameters
+        ----------
+        speed_bins : bins.LogBins
+            The bins of the outgoing and return speeds (``settings.ShardSettings.speed_bins``).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns u_lo, u_hi, v_lo, v_hi, probability.
+
+        Examples
+        --------
+        >>> from bouncing_ball import Equilibrium
+        >>> from bouncing_ball.bins import LogBins
+        >>> table = Equilibrium("1/2").return_speed_table(LogBins(0.1, 10.0, 1))
+        >>> table.groupby("u_lo")["probability"].sum().round(12).tolist()
+        [1.0, 1.0]
+        """
         from . import flight_time
 
         return flight_time.return_speed_table(self.solution, speed_bins)
