@@ -30,6 +30,7 @@ from scipy import integrate
 
 from .restitution import (
     EXACT_RESTITUTIONS,
+    SOLVER_RESTITUTION_RANGE,
     check_solver_restitution,
     parse_restitution,
     restitution_label,
@@ -389,6 +390,16 @@ def _weight_function(r: float, panel_nodes: int):
     return far, distribution.interpolated_weight_function(far, panel_nodes=panel_nodes)
 
 
+def _solver_restitution(r) -> Fraction:
+    """r parsed and within the solver's range; the range is named whatever is wrong with r."""
+    try:
+        parse_restitution(r, "r")
+    except ValueError as error:
+        low, high = SOLVER_RESTITUTION_RANGE
+        raise ValueError(f"{error}; the solver answers {low} <= r <= {high}") from None
+    return check_solver_restitution(r, "r")
+
+
 class Equilibrium(_EquilibriumState):
     """The equilibrium state of the bouncing ball at one coefficient of restitution r,
     from the numerical solution of eq. (inteq).
@@ -463,7 +474,7 @@ class Equilibrium(_EquilibriumState):
     ):  # exact=True is handled by __new__
         from . import distribution, flight_time, solver
 
-        self._set_restitution(check_solver_restitution(r, "r"))
+        self._set_restitution(_solver_restitution(r))
         step = solver.DEFAULT_STEP if quadrature_step is None else quadrature_step
         nodes = (
             distribution.PANEL_CHEBYSHEV_NODES if weight_panel_nodes is None else weight_panel_nodes

@@ -225,20 +225,11 @@ def test_bad_arguments_are_refused_with_their_name(kind, call, error, match, hal
 LOW, HIGH = SOLVER_RESTITUTION_RANGE
 
 
-@pytest.mark.parametrize(
-    ("arguments", "match"),
-    [
-        ((1.5,), "r: r = 1.5 is outside"),
-        ((0.0,), "r: r = 0.0 is outside"),
-        ((0.5 * LOW,), f"outside the solver's range {LOW} <= r <= {HIGH}"),
-        ((float("nan"),), "r: nan is not a number"),
-        (("a half",), "r: 'a half' is not a number"),
-        ((None,), "r: None is not a number"),
-    ],
-)
-def test_bad_restitution_is_refused_with_the_range_named(arguments, match):
-    with pytest.raises(ValueError, match=match):
-        bb.Equilibrium(*arguments)
+@pytest.mark.parametrize("r", [1.5, 0.0, -0.2, 0.5 * LOW, float("nan"), "a half", None, [0.5]])
+def test_bad_restitution_is_refused_with_the_range_named(r):
+    with pytest.raises(ValueError, match=r"^r: ") as refused:
+        bb.Equilibrium(r)
+    assert f"{LOW} <= r <= {HIGH}" in str(refused.value)
 
 
 @pytest.mark.parametrize("r", [0.6, 1 / 3, "1/4", 0.51])
@@ -264,7 +255,7 @@ def test_bad_solver_settings_are_refused(settings, match):
 @pytest.mark.parametrize(
     ("changes", "error", "match"),
     [
-        ({"r": 1.5}, ValueError, "r: r = 1.5 is outside"),
+        ({"r": 1.5}, ValueError, "^r: .*1.5"),
         ({"r": 0.1}, ValueError, "min_step_floor"),
         ({"shards": 1}, ValueError, "shards must be >= 2"),
         ({"shards": 2.5}, TypeError, "shards must be a whole number"),
