@@ -457,7 +457,7 @@ class Equilibrium(_EquilibriumState):
     >>> print(eq.px([0.1, 1.0]).round(6))  # builds w(F): a few seconds
     [0.503776 0.183784]
     >>> Equilibrium("1/2", exact=True)
-    ExactEquilibrium(r=1/2): I = 0.3333333333, <x> = 6, ...
+    ExactEquilibrium(r=1/2): I = 0.3333333333, ...
     """
 
     def __new__(cls, r, *, exact=False, **settings):
