@@ -274,3 +274,15 @@ def test_bad_simulate_arguments_are_refused_before_any_shard_runs(changes, error
     arguments = {"r": 0.5, "shards": 2, "shard_time": 10.0, "seed": 1, "progress": False}
     with pytest.raises(error, match=match):
         bb.simulate(**{**arguments, **changes})
+
+
+def test_simulate_defaults_are_the_default_config():
+    """simulate's settings, where not given, are the default config's simulation section."""
+    from workflow_support import REPOSITORY
+
+    from bouncing_ball.monte_carlo import DEFAULT_SETTINGS, _shard_settings
+
+    config = read_config(REPOSITORY / "config" / "config.yaml")
+    default = shard_settings(config, "0.5").replace(shard_time=1.0)
+    assert _shard_settings(1.0, None) == default
+    assert set(DEFAULT_SETTINGS) < set(default.names())
