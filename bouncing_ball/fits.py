@@ -308,7 +308,9 @@ def fit_rows(source, fit, theory, shards=None):
 def asymptotic_fits(
     lower, upper, counts, times, errors, reference, restitution, windows, max_bias=0.5
 ):
-    """Every fit of issue 4 for one r, as a long table.
+    """Every asymptotic fit of P(0, v) for one r, as a long table: each window (small and
+    large v), with the theory's exponents and with free ones, to the simulation and to the
+    solver.
 
     ``counts`` (shards x bins) and ``times`` are the simulation's usable bins, ``errors``
     its standard errors (the weights), ``reference`` the solver's bin averages;

@@ -55,29 +55,45 @@ comes back after a flight time in [t, t + dt] with speed (incoming velocity -v) 
        t v + t^2/2:  E[T^2 | u] = 2 E[T v | u]
        (v + t)^3:    E[(T - v)^3 | u] = u^3 + 3 E[T^2 | u]
 
-   Closed forms.  Through eq. (kernel2), E[v | u] = int dv v^2 G_g(v, u) needs
-   int_0^inf dx x e^(-x cos th) K_(i g)(x) at th = 2 pi / 3 (the th-derivative of
-   int dx e^(-x cos th) K_(i g)(x) = pi sinh(g th) / (sinh(pi g) sin th)); the Kontorovich-Lebedev
-   identities int_0^inf dg cosh(a g) K_(i g)(u) = (pi/2) e^(-u cos a) (|a| < pi/2) and their
-   a-derivatives at a = pi/3 then give u + 4/3, and the one term left,
-   int dg g^2 K_(i g)(u) / cosh(pi g / 3), follows from the Fourier pair
-   int_0^inf dg cos(g w) / cosh(pi g / 3) = (3/2) / cosh(3 w / 2),
-   K_(i g)(u) = int_0^inf dt e^(-u cosh t) cos(g t), two integrations by parts and y = sinh(t/2)
-   (Gaussian integrals of rational functions of y: erfcx).  With E[T | u] = u + E[v | u]:
+   Closed forms, from the Laplace transform of T.  By eq. (0g) the transform at sigma is the
+   free law's at s = sigma + 1/4, and the free law's scaling (t, v, x) -> (l^2 t, l v, l^3 x)
+   takes s = kappa^2 / 4 to s = 1/4, where eq. (GgP) gives G_g of eq. (kernel2) at (kappa v,
+   kappa u).  The v-integral int_0^inf dx e^(-x cos th) K_(i g)(x) = pi sinh(g th) / (sinh(pi g)
+   sin th) then leaves
 
-       E[T | u] = 2u + 4/3 - e^(-u/2) [(2/3) erfcx((2u)^(1/2)) + (2/3 + u) erfcx((u/2)^(1/2))
-                                       - (2u/pi)^(1/2)]                                 (meanT)
+       L(sigma | u) = E[e^(-sigma T) | u] = e^(u/2) J(th, kappa u) / (pi u kappa sin th),
+       kappa = (1 + 4 sigma)^(1/2),  cos th = -1 / (2 kappa),
+       J(th, x) = int_0^inf dg g sinh(g th) K_(i g)(x) / cosh(pi g / 3).              (laplaceT)
 
-   (u -> 0: 3 (2u/pi)^(1/2); u -> inf: 2u + 4/3 + O(e^(-u/2))).  The second moment has the same
-   structure; its coefficients were identified by a least-squares fit of the quadrature on that
-   basis (rational to ~1e-6, then confirmed to 4e-15 over 1e-8 <= u <= 300, not derived):
+   At th = 2 pi/3 + eps, sinh(g th) / cosh(pi g / 3) = 2 sinh(g (pi/3 + eps))
+   - sinh(g eps) / cosh(pi g / 3) exactly, and the Kontorovich-Lebedev identity
+   int_0^inf dg cosh(a g) K_(i g)(x) = (pi/2) e^(-x cos a) (|a| < pi/2), differentiated in a, gives
 
-       E[T^2 | u] = 4u^2 + 32u/3 + 32/3 - e^(-u/2) [(16/3 - 8u/3) erfcx((2u)^(1/2))
+       J(2 pi/3 + eps, x) = pi x sin(pi/3 + eps) e^(-x cos(pi/3 + eps)) - eps S0(x) + O(eps^3),
+       S0(x) = int_0^inf dg g^2 K_(i g)(x) / cosh(pi g / 3)
+             = 3 e^(-x) [pi x (3x + 2)/12 erfcx((x/2)^(1/2)) + (pi x / 6) erfcx((2x)^(1/2))
+                         - (2 pi)^(1/2) x^(3/2) / 4].                                  (S0)
+
+   S0 follows from the Fourier pair int_0^inf dg cos(g w) / cosh(pi g / 3) = (3/2) / cosh(3 w / 2),
+   K_(i g)(x) = int_0^inf dt e^(-x cosh t) cos(g t), two integrations by parts and y = sinh(t/2)
+   (Gaussian integrals of rational functions of y: erfcx).  As eps = -2 sigma / 3^(1/2) + O(sigma^2),
+   the O(eps^3) term is O(sigma^3), and -dL/dsigma, d^2L/dsigma^2 at sigma = 0 are
+
+       E[T | u] = 2u + 4/3 - 4 e^(u/2) S0(u) / (3 pi u)
+                = 2u + 4/3 - e^(-u/2) [(2/3) erfcx((2u)^(1/2)) + (2/3 + u) erfcx((u/2)^(1/2))
+                                       - (2u/pi)^(1/2)],                                (meanT)
+
+       E[T^2 | u] = 4u^2 + 32u/3 + 32/3 - 16 e^(u/2) S0(u) / (pi u) + 16 e^(u/2) S0'(u) / (3 pi)
+                  = 4u^2 + 32u/3 + 32/3 - e^(-u/2) [(16/3 - 8u/3) erfcx((2u)^(1/2))
                     + (16/3 + 16u/3 + 2u^2) erfcx((u/2)^(1/2)) - 2 (2/pi)^(1/2) (u^(1/2) + u^(3/2))]
                                                                                         (meanT2)
 
-   (u -> 0: 18 (2u/pi)^(1/2); u -> inf: Var[T | u] = 16u/3 + 80/9).  Both are evaluated with
-   erfcx(x) - 1 and expm1 so that nothing cancels at small u.
+   (E[T | u]: u -> 0, 3 (2u/pi)^(1/2); u -> inf, 2u + 4/3 + O(e^(-u/2)).  E[T^2 | u]: u -> 0,
+   18 (2u/pi)^(1/2); u -> inf, Var[T | u] = 16u/3 + 80/9.)  Both are evaluated with
+   erfcx(x) - 1 and expm1 so that nothing cancels at small u.  ``sech_bessel_moment`` and
+   ``sech_bessel_moment_derivative`` give S0 and S0'; tests/unit/test_flight_time_laplace.py
+   checks S0 and S0' against quadrature of their g-integrals, (laplaceT) against the Laplace
+   transform of f(t | u), and (meanT), (meanT2) against their S0 forms.
 
 5. The flight-time density f(t | u) = int_0^inf dv p(t, v | u) by Gauss-Legendre in w = v^(1/2)
    over the window |v - v*| < 6.5 t^(1/2) (e^-42 of the Gaussian beyond); the integrand
@@ -149,6 +165,8 @@ TIME_STEP = 0.1  # trapezoidal step in s = ln t + t^(1/2) for integrals over f(t
 SMALLEST_RATIO = 1e-9  # lowest return speed / min(u, 1): (v / u)^(5/2) ~ 1e-22 of the rest
 EXPONENT_CUT = 45.0  # time window: the Gaussian factor of f(t | u) above e^-45
 MOMENT_POWERS = range(4)  # k of (timemoments)
+SECH_SERIES_FROM = 80.0  # x above which S0 and S0' are summed from their asymptotic series
+SECH_SERIES_TERMS = 35  # terms of that series: truncation about 1e-14 relative at x = 80
 
 
 # --- the joint law ------------------------------------------------------------------------------
@@ -257,10 +275,117 @@ def _flight_time_ingredients(u):
     )
 
 
+def _sech_bessel_series():
+    """Coefficients c_j (j = 0..SECH_SERIES_TERMS) of e^x S0(x) = (2 pi)^(1/2) / 4
+    sum_j c_j x^(1/2 - j): the asymptotic series erfcx(y) ~ (pi^(1/2) y)^-1 sum_k (-1)^k
+    (2k - 1)!! / (2 y^2)^k put into eq. (S0); c_j = 3 a_(j+1) + 2 a_j + a_j / 4^j with
+    a_k = (-1)^k (2k - 1)!!, so c_0 = 0 and c_1 = 27/4."""
+    k = np.arange(SECH_SERIES_TERMS + 2)
+    odd_factorial = np.cumprod(np.where(k == 0, 1.0, 2.0 * k - 1.0))  # (2k - 1)!!, (-1)!! = 1
+    a = (-1.0) ** k * odd_factorial
+    return 3.0 * a[1:] + 2.0 * a[:-1] + a[:-1] / 4.0 ** k[:-1]
+
+
+_SECH_SERIES = _sech_bessel_series()
+# S0'(x) e^x = (2 pi)^(1/2) / 4 sum_j d_j x^(1/2 - j), d_j = -c_j + (3/2 - j) c_(j-1)
+_SECH_SERIES_DERIVATIVE = -_SECH_SERIES + (1.5 - np.arange(_SECH_SERIES.size)) * np.concatenate(
+    ([0.0], _SECH_SERIES[:-1])
+)
+
+
+def _sech_series_bracket(x, coefficients):
+    """(2 pi)^(1/2) / 12 x^(1/2) sum_j coefficients_j x^(-j): e^x S0(x) / 3 or e^x S0'(x) / 3 at
+    large x (``_sech_bessel_series``)."""
+    return (
+        np.sqrt(2.0 * np.pi)
+        / 12.0
+        * np.sqrt(x)
+        * np.polynomial.polynomial.polyval(1.0 / x, coefficients)
+    )
+
+
+def _sech_bessel_argument(x, name):
+    """x as a float array, checked to be >= 0 (S0 and S0' are defined for x >= 0)."""
+    x = np.asarray(x, dtype=float)
+    if np.any(~(x >= 0.0)):
+        raise ValueError(f"{name}: the argument x must be >= 0 (and not NaN), got {x}")
+    return x
+
+
+def sech_bessel_moment(x):
+    """S0(x) = int_0^inf dg g^2 K_(i g)(x) / cosh(pi g / 3), eq. (S0) of the module docstring.
+
+    The term linear in eps of J(2 pi/3 + eps, x) in the Laplace transform of the flight time,
+    eq. (laplaceT); E[T | u] and E[T^2 | u], eqs. (meanT) and (meanT2), follow from it.
+
+    Parameters
+    ----------
+    x : array_like
+        Argument, x >= 0.
+
+    Returns
+    -------
+    ndarray
+        S0(x) = 3 e^(-x) [pi x (3x + 2)/12 erfcx((x/2)^(1/2)) + (pi x / 6) erfcx((2x)^(1/2))
+        - (2 pi)^(1/2) x^(3/2) / 4], S0(0) = 0, S0(x) = pi x + O(x^(3/2)) at small x.
+
+    Notes
+    -----
+    At large x the bracket, of order x^(-1/2), is a difference of terms of order x^(3/2): the
+    closed form loses a factor x^2 of relative precision.  Above ``SECH_SERIES_FROM`` the bracket
+    is summed from its asymptotic series instead, S0(x) ~ (27/8) (pi / (2x))^(1/2) e^(-x)
+    [1 + O(1/x)], whose first ``SECH_SERIES_TERMS`` terms are exact to about 1e-14 there.
+    """
+    x = _sech_bessel_argument(x, "sech_bessel_moment")
+    near = np.minimum(x, SECH_SERIES_FROM)
+    far = np.maximum(x, SECH_SERIES_FROM)
+    closed = (
+        np.pi * near * (3.0 * near + 2.0) / 12.0 * special.erfcx(np.sqrt(0.5 * near))
+        + np.pi * near / 6.0 * special.erfcx(np.sqrt(2.0 * near))
+        - np.sqrt(2.0 * np.pi) * near**1.5 / 4.0
+    )
+    series = _sech_series_bracket(far, _SECH_SERIES)
+    return 3.0 * np.exp(-x) * np.where(x < SECH_SERIES_FROM, closed, series)
+
+
+def sech_bessel_moment_derivative(x):
+    """S0'(x), the derivative of eq. (S0) (``sech_bessel_moment``), which enters eq. (meanT2).
+
+    Parameters
+    ----------
+    x : array_like
+        Argument, x >= 0.
+
+    Returns
+    -------
+    ndarray
+        S0'(x) = 3 e^(-x) [pi (4 + 10x - 3x^2)/24 erfcx((x/2)^(1/2))
+        + pi (1 + x)/6 erfcx((2x)^(1/2)) + (2 pi)^(1/2) x^(1/2) (x - 5)/8], S0'(0) = pi
+        (from d erfcx((c x)^(1/2)) / dx = c erfcx((c x)^(1/2)) - (c / (pi x))^(1/2)).
+
+    Notes
+    -----
+    Above ``SECH_SERIES_FROM``, the term-by-term derivative of the asymptotic series of
+    ``sech_bessel_moment``, for the same reason.
+    """
+    x = _sech_bessel_argument(x, "sech_bessel_moment_derivative")
+    near = np.minimum(x, SECH_SERIES_FROM)
+    far = np.maximum(x, SECH_SERIES_FROM)
+    closed = (
+        np.pi * (4.0 + 10.0 * near - 3.0 * near * near) / 24.0 * special.erfcx(np.sqrt(0.5 * near))
+        + np.pi * (1.0 + near) / 6.0 * special.erfcx(np.sqrt(2.0 * near))
+        + np.sqrt(2.0 * np.pi) * np.sqrt(near) * (near - 5.0) / 8.0
+    )
+    series = _sech_series_bracket(far, _SECH_SERIES_DERIVATIVE)
+    return 3.0 * np.exp(-x) * np.where(x < SECH_SERIES_FROM, closed, series)
+
+
 def mean_flight_time_given_speed(u):
     """E[T | u], eq. (meanT): 2u + 4/3 - e^(-u/2) [(2/3) erfcx((2u)^(1/2))
     + (2/3 + u) erfcx((u/2)^(1/2)) - (2u/pi)^(1/2)], written without cancellation at small u
-    (where E[T | u] = 3 (2u/pi)^(1/2) + O(u)).  E[v | u] = E[T | u] - u (Ito on v + t)."""
+    (where E[T | u] = 3 (2u/pi)^(1/2) + O(u)).  E[v | u] = E[T | u] - u (Ito on v + t).  From the
+    Laplace transform of T, eq. (laplaceT): = 2u + 4/3 - 4 e^(u/2) S0(u) / (3 pi u) with S0 of
+    eq. (S0) (``sech_bessel_moment``)."""
     u = np.asarray(u, dtype=float)
     decay, a, b, root = _flight_time_ingredients(u)
     bracket = (2.0 / 3.0) * (a + b) + u * (1.0 + b) - root
@@ -270,8 +395,9 @@ def mean_flight_time_given_speed(u):
 def flight_time_second_moment_given_speed(u):
     """E[T^2 | u], eq. (meanT2): 4u^2 + 32u/3 + 32/3 - e^(-u/2) [(16/3 - 8u/3) erfcx((2u)^(1/2))
     + (16/3 + 16u/3 + 2u^2) erfcx((u/2)^(1/2)) - 2 (2/pi)^(1/2) (u^(1/2) + u^(3/2))], without
-    cancellation at small u (where it is 18 (2u/pi)^(1/2) + O(u)).  Identified, not derived: see
-    the module docstring."""
+    cancellation at small u (where it is 18 (2u/pi)^(1/2) + O(u)).  Derived from the Laplace
+    transform of T, eq. (laplaceT): = 4u^2 + 32u/3 + 32/3 - 16 e^(u/2) S0(u) / (pi u)
+    + 16 e^(u/2) S0'(u) / (3 pi) with S0 of eq. (S0) (``sech_bessel_moment``)."""
     u = np.asarray(u, dtype=float)
     decay, a, b, root = _flight_time_ingredients(u)
     bracket = (

@@ -1,0 +1,20 @@
+"""The Examples of the public API's docstrings run as doctests (cheap ones: the exact solutions,
+the solve at r = 1/2, and tiny simulations)."""
+
+import doctest
+import importlib
+
+import pytest
+
+MODULES = ["bouncing_ball.equilibrium", "bouncing_ball.monte_carlo"]
+
+
+@pytest.mark.parametrize("name", MODULES)
+def test_examples_run(name, capsys):
+    module = importlib.import_module(name)
+    result = doctest.testmod(
+        module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE, verbose=False
+    )
+    report = capsys.readouterr().out
+    assert result.attempted > 0, f"{name} has no Examples"
+    assert result.failed == 0, report

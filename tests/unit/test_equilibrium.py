@@ -1,0 +1,288 @@
+"""The public API (bouncing_ball.Equilibrium, ExactEquilibrium, simulate): the solver's
+equilibrium against the paper's exact r = 1/2 and 1/3 solutions method by method, numpy
+broadcasting, simulate's reproducibility and its agreement with the exact <x> and I, and
+every bad input refused with the argument named."""
+
+import math
+import warnings
+from fractions import Fraction
+
+import numpy as np
+import pytest
+from scipy import integrate
+from workflow_support import TEST_CONFIG
+
+import bouncing_ball as bb
+from bouncing_ball.batches import batch_to_frame, simulate_batch
+from bouncing_ball.config import read_config, shard_settings
+from bouncing_ball.restitution import SOLVER_RESTITUTION_RANGE
+
+EXACT = ["1/2", "1/3"]
+TOLERANCE = 1e-8
+
+
+@pytest.fixture(scope="module", params=EXACT)
+def pair(request):
+    """(Equilibrium, ExactEquilibrium) at r = 1/2 or 1/3; w(F) is built once per r and process."""
+    return bb.Equilibrium(request.param), bb.ExactEquilibrium(request.param)
+
+
+@pytest.fixture(scope="module")
+def half():
+    return bb.Equilibrium("1/2")
+
+
+def _agree(ours, theirs, tolerance=TOLERANCE):
+    ours, theirs = np.asarray(ours, dtype=float), np.asarray(theirs, dtype=float)
+    assert ours.shape == theirs.shape
+    same = ours == theirs  # the infinities (at v = 0, x = 0, T = 0) and the zeros
+    relative = np.abs(ours[~same] / theirs[~same] - 1.0)
+    assert np.all(relative < tolerance), float(np.max(relative))
+
+
+def test_scalars_match_the_exact_ones(pair):
+    ours, theirs = pair
+    for name in ("collision_rate", "mean_x", "delta_x", "mean_flight_time"):
+        _agree(getattr(ours, name), getattr(theirs, name))
+    _agree(ours.flight_time_second_moment, theirs.flight_time_second_moment)
+    for name in ("beta", "m", "q", "r"):
+        assert getattr(ours, name) == pytest.approx(getattr(theirs, name), rel=1e-12)
+    assert ours.restitution == theirs.restitution and ours.label == theirs.label
+    assert set(ours.observables()) == set(theirs.observables())
+
+
+def test_accuracy_is_measured_and_small(pair):
+    ours, theirs = pair
+    assert 0.0 < ours.accuracy < 1e-8
+    assert 0.0 < ours.position_accuracy < 1e-8
+    assert theirs.accuracy == 0.0
+
+
+def test_speed_densities_match_the_exact_ones(pair):
+    ours, theirs = pair
+    v = np.array([0.0, 1e-3, 0.1, 1.0, 5.0, 20.0])
+    _agree(ours.p0v(v), theirs.p0v(v))
+    assert np.isinf(ours.p0v(0.0))
+    u = np.array([[0.01], [1.0], [7.0]])
+    _agree(ours.return_speed_density(v, u), theirs.return_speed_density(v, u))
+
+
+def test_position_quantities_match_the_exact_ones(pair):
+    ours, theirs = pair
+    x = np.array([0.0, 1e-3, 0.1, 1.0, 10.0, 100.0])
+    _agree(ours.px(x), theirs.px(x))
+    _agree(ours.v2_given_x(x), theirs.v2_given_x(x))
+    # beta >= 1 at r = 1/2 and 1/3: P(x) diverges at the floor, and <v^2>_x = 1 / P(0) = 0
+    assert np.isinf(ours.px(0.0)) and ours.v2_given_x(0.0) == 0.0
+    forces = np.geomspace(1e-3, 1e3, 13)
+    _agree(ours.weight(forces), theirs.weight(forces))
+
+
+def test_joint_distribution_matches_the_exact_one(pair):
+    ours, theirs = pair
+    x = np.array([[0.0], [1e-3], [0.1], [1.0], [10.0]])
+    v = np.array([-4.0, -0.5, 0.5, 4.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", integrate.IntegrationWarning)
+        _agree(ours.pxv(x, v), theirs.pxv(x, v))
+        _agree(ours.pxv([1e-3, 0.1, 1.0], 0.0), theirs.pxv([1e-3, 0.1, 1.0], 0.0))
+    assert np.isinf(ours.pxv(0.0, 0.0)) and np.isinf(theirs.pxv(0.0, 0.0))
+
+
+def test_flight_times_match_the_exact_ones(pair):
+    ours, theirs = pair
+    times = np.array([0.0, 1e-3, 0.1, 1.0, 10.0, 30.0])
+    _agree(ours.flight_time_density(times), theirs.flight_time_density(times))
+    _agree(ours.flight_rate_density(times), theirs.flight_rate_density(times))
+
+
+def test_floor_density_is_the_speed_integral_where_it_is_finite():
+    """Above r = 1/2 (beta < 1) P(x) has a finite limit at the floor, (1 + r) int P(0, v) dv;
+    P(x) of eq. (P(x)1) at small x tends to it like x^((1 - beta)/3) (``predicted_exponents``)."""
+    eq = bb.Equilibrium(0.6, weight_panel_nodes=6)  # the test config's: a faster w(F)
+    floor = eq.px(0.0)
+    assert np.isfinite(floor) and floor > eq.px(1e-3)
+    assert eq.v2_given_x(0.0) == pytest.approx(1.0 / floor, rel=1e-14)
+    x = np.array([1e-9, 1e-12])
+    gaps = floor - eq.px(x)
+    slope = math.log(gaps[0] / gaps[1]) / math.log(x[0] / x[1])
+    assert slope == pytest.approx((1.0 - eq.beta) / 3.0, rel=0.05)
+
+
+def test_methods_broadcast_like_numpy():
+    eq = bb.ExactEquilibrium("1/2")
+    assert isinstance(eq.px(1.0), np.floating) and np.ndim(eq.px(1.0)) == 0
+    assert eq.px([[1.0, 2.0]]).shape == (1, 2)
+    assert eq.pxv(np.array([0.1, 1.0])[:, None], [-1.0, 0.0, 1.0]).shape == (2, 3)
+    assert eq.pxv(0.1, [[1.0], [2.0]]).shape == (2, 1)
+    assert eq.return_speed_density([0.5, 1.0], [[1.0], [2.0], [3.0]]).shape == (3, 2)
+    for method in (eq.p0v, eq.v2_given_x, eq.weight, eq.flight_time_density):
+        assert method(np.ones((2, 3))).shape == (2, 3)
+    assert eq.pxv(1.0, [0.5]) == pytest.approx(eq.pxv(1.0, 0.5), rel=1e-15)
+
+
+def test_exact_flag_returns_the_exact_solution():
+    eq = bb.Equilibrium("1/3", exact=True)
+    assert isinstance(eq, bb.ExactEquilibrium) and eq.restitution == Fraction(1, 3)
+    assert "1/3" in repr(eq)
+
+
+# --- simulate
+
+
+def test_simulate_is_reproducible_whatever_the_processes():
+    arguments = {
+        "shards": 3,
+        "shard_time": 300.0,
+        "seed": 11,
+        "settings": {"equilibration_time": 20.0},
+    }
+    one = bb.simulate(0.6, processes=1, progress=False, **arguments)
+    two = bb.simulate(0.6, processes=2, progress=False, **arguments)
+    assert one.batch_frame().equals(two.batch_frame())
+    assert one.summary.equals(two.summary) and one.pxv.equals(two.pxv)
+    again = bb.simulate(0.6, processes=1, progress=False, **{**arguments, "seed": 12})
+    assert not again.batch_frame().equals(one.batch_frame())
+
+
+def test_a_simulated_shard_is_the_workflow_shard():
+    """simulate's shards are scripts/simulate_shards.py's for the same seed, r and settings."""
+    settings = shard_settings(read_config(TEST_CONFIG), "0.5").replace(shard_time=200.0)
+    result = bb.simulate("1/2", shards=2, seed=5, settings=settings, progress=False)
+    workflow = batch_to_frame(dict(simulate_batch(0.5, 5, "0.5", [0, 1], settings)))
+    assert result.batch_frame().equals(workflow)
+
+
+def test_simulate_agrees_with_the_exact_solution_at_one_half():
+    """<x> = 6, Delta x = 3 sqrt(12), I = 1/3 (eq. (xandDeltax)) within 4 jackknife errors of 16
+    shards (a t-variable with 15 degrees of freedom exceeds 4 with probability 1e-3)."""
+    result = bb.simulate("1/2", shards=16, shard_time=2.0e4, seed=3, progress=False)
+    exact = bb.ExactEquilibrium("1/2")
+    for name in ("mean_x", "delta_x", "collision_rate", "mean_flight_time"):
+        value, error = getattr(result, name), getattr(result, f"{name}_err")
+        assert 0.0 < error < 0.1 * abs(value)
+        assert abs(value - getattr(exact, name)) < 4.0 * error, name
+
+
+def test_simulation_result_has_the_observables():
+    result = bb.simulate(
+        "1/3",
+        shards=2,
+        shard_time=100.0,
+        seed=2,
+        settings={"equilibration_time": 5.0},
+        progress=False,
+    )
+    assert result.shards == 2 and result.total_time == pytest.approx(200.0)
+    for name in (
+        "collision_rate",
+        "mean_x",
+        "delta_x",
+        "mean_flight_time",
+        "flight_time_second_moment",
+    ):
+        assert np.isfinite(getattr(result, name)) and np.isfinite(getattr(result, f"{name}_err"))
+    assert {"p0v", "p0v_err"} <= set(result.p0v.columns)
+    assert {"px", "px_err"} <= set(result.px.columns)
+    assert {"v2_given_x", "v2_given_x_err"} <= set(result.v2_given_x.columns)
+    assert {"pxv", "pxv_err"} <= set(result.pxv.columns)
+    assert {"density", "density_err"} <= set(result.flight_time_density.columns)
+    assert result.merged.collisions == sum(t.collisions for t in result.tallies)
+    assert "<x> =" in repr(result)
+
+
+# --- bad input, refused with the argument named
+
+
+@pytest.mark.parametrize(
+    ("call", "error", "match"),
+    [
+        (lambda eq: eq.px(-1.0), ValueError, "x must be >= 0"),
+        (lambda eq: eq.px([1.0, float("nan")]), ValueError, "x contains NaN"),
+        (lambda eq: eq.px(np.inf), ValueError, "x must be finite"),
+        (lambda eq: eq.px("one"), TypeError, "x must be real numbers"),
+        (lambda eq: eq.v2_given_x(-1e-3), ValueError, "x must be >= 0"),
+        (lambda eq: eq.p0v([1.0, -0.5]), ValueError, "v must be >= 0"),
+        (lambda eq: eq.pxv(-1.0, 0.5), ValueError, "x must be >= 0"),
+        (lambda eq: eq.pxv(1.0, float("nan")), ValueError, "v contains NaN"),
+        (lambda eq: eq.pxv([0.1, 1.0, 2.0], [1.0, 2.0]), ValueError, r"x \(shape \(3,\)\) and v"),
+        (lambda eq: eq.weight(-1.0), ValueError, "F must be > 0"),
+        (lambda eq: eq.weight(0.0), ValueError, "F must be > 0"),
+        (lambda eq: eq.flight_time_density(-2.0), ValueError, "T must be >= 0"),
+        (lambda eq: eq.flight_rate_density([np.nan]), ValueError, "T contains NaN"),
+        (lambda eq: eq.return_speed_density(-1.0, 1.0), ValueError, "v must be >= 0"),
+        (lambda eq: eq.return_speed_density(1.0, 0.0), ValueError, "u must be > 0"),
+        (lambda eq: eq.return_speed_density([1.0, 2.0], [1.0, 2.0, 3.0]), ValueError, "v .* and u"),
+    ],
+)
+@pytest.mark.parametrize("kind", ["solver", "exact"])
+def test_bad_arguments_are_refused_with_their_name(kind, call, error, match, half):
+    eq = half if kind == "solver" else bb.ExactEquilibrium("1/2")
+    with pytest.raises(error, match=match):
+        call(eq)
+
+
+LOW, HIGH = SOLVER_RESTITUTION_RANGE
+
+
+@pytest.mark.parametrize("r", [1.5, 0.0, -0.2, 0.5 * LOW, float("nan"), "a half", None, [0.5]])
+def test_bad_restitution_is_refused_with_the_range_named(r):
+    with pytest.raises(ValueError, match=r"^r: ") as refused:
+        bb.Equilibrium(r)
+    assert f"{LOW} <= r <= {HIGH}" in str(refused.value)
+
+
+@pytest.mark.parametrize("r", [0.6, 1 / 3, "1/4", 0.51])
+def test_exact_solutions_exist_only_at_one_half_and_one_third(r):
+    with pytest.raises(ValueError, match=r"r: exact solutions exist only for r = 1/2 and r = 1/3"):
+        bb.ExactEquilibrium(r)
+    with pytest.raises(ValueError, match="exact solutions exist only"):
+        bb.Equilibrium(r, exact=True)
+
+
+@pytest.mark.parametrize(
+    ("settings", "match"),
+    [
+        ({"quadrature_step": 0.0}, "quadrature_step"),
+        ({"weight_panel_nodes": 1}, "weight_panel_nodes"),
+    ],
+)
+def test_bad_solver_settings_are_refused(settings, match):
+    with pytest.raises(ValueError, match=match):
+        bb.Equilibrium(0.5, **settings)
+
+
+@pytest.mark.parametrize(
+    ("changes", "error", "match"),
+    [
+        ({"r": 1.5}, ValueError, "^r: .*1.5"),
+        ({"r": 0.1}, ValueError, "min_step_floor"),
+        ({"shards": 1}, ValueError, "shards must be >= 2"),
+        ({"shards": 2.5}, TypeError, "shards must be a whole number"),
+        ({"shard_time": -1.0}, ValueError, "shard_time must be positive"),
+        ({"shard_time": float("nan")}, ValueError, "shard_time must be positive"),
+        ({"shard_time": None}, TypeError, "shard_time"),
+        ({"seed": -1}, ValueError, "seed must be >= 0"),
+        ({"processes": 0}, ValueError, "processes must be >= 1"),
+        ({"settings": {"shard_tme": 1.0}}, ValueError, "unknown key.*shard_tme"),
+        ({"settings": {"shard_time": 1.0}}, ValueError, "shard_time as simulate's own argument"),
+        ({"settings": {"criterion_c": -1.0}}, ValueError, "criterion_c"),
+        ({"settings": [1, 2]}, TypeError, "settings must be"),
+    ],
+)
+def test_bad_simulate_arguments_are_refused_before_any_shard_runs(changes, error, match):
+    arguments = {"r": 0.5, "shards": 2, "shard_time": 10.0, "seed": 1, "progress": False}
+    with pytest.raises(error, match=match):
+        bb.simulate(**{**arguments, **changes})
+
+
+def test_simulate_defaults_are_the_default_config():
+    """simulate's settings, where not given, are the default config's simulation section."""
+    from workflow_support import REPOSITORY
+
+    from bouncing_ball.monte_carlo import DEFAULT_SETTINGS, _shard_settings
+
+    config = read_config(REPOSITORY / "config" / "config.yaml")
+    default = shard_settings(config, "0.5").replace(shard_time=1.0)
+    assert _shard_settings(1.0, None) == default
+    assert set(DEFAULT_SETTINGS) < set(default.names())
