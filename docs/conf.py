@@ -1,0 +1,83 @@
+"""Sphinx configuration of the documentation site (``python -m sphinx -W -b html docs docs/_build/html``)."""
+
+import re
+from pathlib import Path
+
+import bouncing_ball
+
+DOCS = Path(__file__).resolve().parent
+REPOSITORY = DOCS.parent
+
+project = "bouncing-ball"
+author = "The bouncing-ball developers"
+copyright = "2026, the bouncing-ball developers"
+release = bouncing_ball.__version__
+version = release
+
+extensions = [
+    "myst_nb",  # Markdown pages (MyST) and the tutorial, a text notebook executed at build time
+    "numpydoc",  # the API reference from the numpydoc docstrings
+    "sphinx.ext.autosummary",
+    "sphinx.ext.mathjax",
+]
+
+source_suffix = {".md": "myst-nb", ".rst": "restructuredtext"}
+exclude_patterns = ["_build", "requirements.txt"]
+root_doc = "index"
+
+# anchors for the pages' "#section" links, as GitHub makes them
+myst_heading_anchors = 4
+myst_enable_extensions = ["dollarmath", "colon_fence"]
+
+# the tutorial runs on every build, so it cannot rot; a failing cell fails the build
+nb_execution_mode = "force"
+nb_execution_timeout = 300
+nb_execution_raise_on_error = True
+nb_merge_streams = True
+
+autosummary_generate = True
+numpydoc_show_class_members = False
+numpydoc_class_members_toctree = False
+
+html_theme = "pydata_sphinx_theme"
+html_title = f"bouncing-ball {release}"
+html_theme_options = {"navigation_with_keys": False, "show_toc_level": 2}
+
+
+# Pages kept outside docs/ (so that they read well where they live) and shown on the site through
+# an {include} page; a Markdown link to one of them, from a page or an included file, points to its
+# site page instead.
+SITE_PAGES = {
+    REPOSITORY / "README.md": "index.md",
+    REPOSITORY / "config" / "README.md": "config.md",
+    REPOSITORY / "profiles" / "slurm" / "README.md": "slurm.md",
+    REPOSITORY / "CHANGELOG.md": "changelog.md",
+}
+_LINK = re.compile(r"\]\(([^)#\s]+\.md)(#[^)\s]*)?\)")
+
+
+def _site_links(text: str, folder: Path) -> str:
+    """``text`` (Markdown in ``folder``) with its links to repository pages made site links."""
+
+    def replace(match: re.Match) -> str:
+        target = (folder / match.group(1)).resolve()
+        if target in SITE_PAGES:
+            return f"]({SITE_PAGES[target]}{match.group(2) or ''})"
+        if target.parent == DOCS:
+            return f"]({target.name}{match.group(2) or ''})"
+        return match.group(0)
+
+    return _LINK.sub(replace, text)
+
+
+def _on_source_read(app, docname, source):
+    source[0] = _site_links(source[0], DOCS)
+
+
+def _on_include_read(app, relative_path, parent_docname, content):
+    content[0] = _site_links(content[0], (DOCS / relative_path).parent)
+
+
+def setup(app):
+    app.connect("source-read", _on_source_read)
+    app.connect("include-read", _on_include_read)
