@@ -32,7 +32,13 @@ from pathlib import Path
 import numpy as np
 
 from bouncing_ball.settings import ShardSettings
-from bouncing_ball.tallies import BINS, SCALARS, ShardTallies, tally_seed_sequence
+from bouncing_ball.tallies import (
+    BINS,
+    EARLY_FRACTION,
+    SCALARS,
+    ShardTallies,
+    tally_seed_sequence,
+)
 
 HERE = Path(__file__).resolve().parent
 SOURCE = HERE / "reference" / "shard_loop.c"
@@ -51,9 +57,13 @@ def npyrandom_library() -> Path:
 
 
 def scalar_layout_flags() -> list[str]:
-    """``-DSCALAR_<NAME>=<index>`` for each scalar of ``tallies.SCALARS``: the C reference
-    reads the layout of its scalar array from these, so it has one definition."""
-    return [f"-DSCALAR_{name.upper()}={index}" for index, name in enumerate(SCALARS)]
+    """``-DSCALAR_<NAME>=<index>`` for each scalar of ``tallies.SCALARS``, and
+    ``-DEARLY_FRACTION``: the C reference reads the layout of its scalar array from these, so
+    it has one definition (``float.hex``: the same double)."""
+    return [
+        *(f"-DSCALAR_{name.upper()}={index}" for index, name in enumerate(SCALARS)),
+        f"-DEARLY_FRACTION={EARLY_FRACTION.hex()}",
+    ]
 
 
 def compile_command(source: Path, output: Path) -> list[str]:

@@ -80,9 +80,10 @@ depends on the state):
     subtracts their fitted share from the collision count: the same
     expectation, 3.5-7 times less variance of I (docs/performance.md).
   * the time, collisions, int x dt and int x^2 dt of the steps that start in the
-    first half of the recording (t < shard_time / 2): the shard's own evidence of
-    equilibration, its two halves compared by ``equilibration``.  Taken as the
-    running sums when the first step starts past the half, so no step is cut there.
+    early part of the recording (t < EARLY_FRACTION x shard_time, tallies): the
+    shard's own evidence of equilibration, that part against the rest compared by
+    ``equilibration``.  Taken as the running sums when the first step starts past
+    it, so no step is cut there.
 
 A shard's work is bounded: it stops after ``max_steps`` steps (equilibration
 included) even if the simulated time has not been reached, and says so.
@@ -132,7 +133,7 @@ from .free_flight import (
 )
 from .jit import njit
 from .settings import ShardSettings
-from .tallies import SCALAR_INDEX, ShardTallies, tally_seed_sequence
+from .tallies import EARLY_FRACTION, SCALAR_INDEX, ShardTallies, tally_seed_sequence
 
 # the modules whose code decides a shard's numbers (see ``source_digest``)
 SOURCES = stages.SIMULATION
@@ -151,10 +152,10 @@ _NOISE_SUM = SCALAR_INDEX["noise_sum"]
 _NOISE_V_SUM = SCALAR_INDEX["noise_v_sum"]
 _NOISE_SCALED_SUM = SCALAR_INDEX["noise_scaled_sum"]
 _NORMAL_SUM = SCALAR_INDEX["normal_sum"]
-_FIRST_HALF_TIME = SCALAR_INDEX["first_half_time"]
-_FIRST_HALF_COLLISIONS = SCALAR_INDEX["first_half_collisions"]
-_FIRST_HALF_INT_X = SCALAR_INDEX["first_half_int_x"]
-_FIRST_HALF_INT_X2 = SCALAR_INDEX["first_half_int_x2"]
+_EARLY_TIME = SCALAR_INDEX["early_time"]
+_EARLY_COLLISIONS = SCALAR_INDEX["early_collisions"]
+_EARLY_INT_X = SCALAR_INDEX["early_int_x"]
+_EARLY_INT_X2 = SCALAR_INDEX["early_int_x2"]
 
 
 def shard_seed_sequence(seed: int, label: str, shard: int) -> np.random.SeedSequence:
@@ -537,12 +538,12 @@ def _run(
     noise_v_sum = 0.0
     noise_scaled_sum = 0.0
     normal_sum = 0.0
-    # the first half of the recording: the running sums when a step first starts past t_half
-    t_half = 0.5 * recorded_time if recording else math.inf
-    first_half_time = 0.0
-    first_half_collisions = 0
-    first_half_int_x = 0.0
-    first_half_int_x2 = 0.0
+    # the early part of the recording: the running sums when a step first starts past t_early
+    t_early = EARLY_FRACTION * recorded_time if recording else math.inf
+    early_time = 0.0
+    early_collisions = 0
+    early_int_x = 0.0
+    early_int_x2 = 0.0
 
     while True:
         if t >= t_stop:
@@ -552,14 +553,14 @@ def _run(
             x_bin = _bin_index(x, x_log_lo, x_per_ln, nx, x_edges)
             t = 0.0
             t_stop = recorded_time
-            t_half = 0.5 * recorded_time
+            t_early = EARLY_FRACTION * recorded_time
             continue
-        if t >= t_half:
-            first_half_time = t
-            first_half_collisions = collisions
-            first_half_int_x = int_x
-            first_half_int_x2 = int_x2
-            t_half = math.inf
+        if t >= t_early:
+            early_time = t
+            early_collisions = collisions
+            early_int_x = int_x
+            early_int_x2 = int_x2
+            t_early = math.inf
         if steps >= max_steps:
             exhausted = 1
             break
@@ -730,10 +731,10 @@ def _run(
     scalars[_NOISE_V_SUM] = noise_v_sum
     scalars[_NOISE_SCALED_SUM] = noise_scaled_sum
     scalars[_NORMAL_SUM] = normal_sum
-    scalars[_FIRST_HALF_TIME] = first_half_time
-    scalars[_FIRST_HALF_COLLISIONS] = first_half_collisions
-    scalars[_FIRST_HALF_INT_X] = first_half_int_x
-    scalars[_FIRST_HALF_INT_X2] = first_half_int_x2
+    scalars[_EARLY_TIME] = early_time
+    scalars[_EARLY_COLLISIONS] = early_collisions
+    scalars[_EARLY_INT_X] = early_int_x
+    scalars[_EARLY_INT_X2] = early_int_x2
 
 
 def simulate_shard(

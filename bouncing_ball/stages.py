@@ -19,7 +19,17 @@ SIMULATION = (
     "simulation",
     "tallies",
 )
-MERGE = ("batches", "bins", "histograms", "io", "restitution", "settings", "shards", "tallies")
+MERGE = (
+    "batches",
+    "bins",
+    "equilibration",
+    "histograms",
+    "io",
+    "restitution",
+    "settings",
+    "shards",
+    "tallies",
+)
 SOLVER = (
     "asymptotics",
     "bins",

@@ -86,8 +86,8 @@
 #define FLOOR_STRATUM_HEIGHT 0.1
 /* the layout of the scalars (bouncing_ball.tallies.SCALARS, its one definition):
    benchmarks/reference_loop.py defines SCALAR_<NAME> as the index of each when it compiles
-   this file (-DSCALAR_TIME=0 ...) */
-#ifndef SCALAR_TIME
+   this file (-DSCALAR_TIME=0 ...), and EARLY_FRACTION as tallies.EARLY_FRACTION */
+#if !defined(SCALAR_TIME) || !defined(EARLY_FRACTION)
 #error "compile with benchmarks.reference_loop.build(), which passes the scalars' layout"
 #endif
 
@@ -690,12 +690,12 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
     double noise_v_sum = 0.0;
     double noise_scaled_sum = 0.0;
     double normal_sum = 0.0;
-    /* the first half of the recording: the running sums when a step first starts past t_half */
-    double t_half = recording ? 0.5 * recorded_time : INFINITY;
-    double first_half_time = 0.0;
-    int64_t first_half_collisions = 0;
-    double first_half_int_x = 0.0;
-    double first_half_int_x2 = 0.0;
+    /* the early part of the recording: the running sums when a step first starts past t_early */
+    double t_early = recording ? EARLY_FRACTION * recorded_time : INFINITY;
+    double early_time = 0.0;
+    int64_t early_collisions = 0;
+    double early_int_x = 0.0;
+    double early_int_x2 = 0.0;
 
     for (;;) {
         if (t >= t_stop) {
@@ -705,15 +705,15 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
             x_bin = bin_index(x, x_log_lo, x_per_ln, nx, x_edges);
             t = 0.0;
             t_stop = recorded_time;
-            t_half = 0.5 * recorded_time;
+            t_early = EARLY_FRACTION * recorded_time;
             continue;
         }
-        if (t >= t_half) {
-            first_half_time = t;
-            first_half_collisions = collisions;
-            first_half_int_x = int_x;
-            first_half_int_x2 = int_x2;
-            t_half = INFINITY;
+        if (t >= t_early) {
+            early_time = t;
+            early_collisions = collisions;
+            early_int_x = int_x;
+            early_int_x2 = int_x2;
+            t_early = INFINITY;
         }
         if (steps >= max_steps) {
             exhausted = 1;
@@ -853,10 +853,10 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
     scalars[SCALAR_NOISE_V_SUM] = noise_v_sum;
     scalars[SCALAR_NOISE_SCALED_SUM] = noise_scaled_sum;
     scalars[SCALAR_NORMAL_SUM] = normal_sum;
-    scalars[SCALAR_FIRST_HALF_TIME] = first_half_time;
-    scalars[SCALAR_FIRST_HALF_COLLISIONS] = (double)first_half_collisions;
-    scalars[SCALAR_FIRST_HALF_INT_X] = first_half_int_x;
-    scalars[SCALAR_FIRST_HALF_INT_X2] = first_half_int_x2;
+    scalars[SCALAR_EARLY_TIME] = early_time;
+    scalars[SCALAR_EARLY_COLLISIONS] = (double)early_collisions;
+    scalars[SCALAR_EARLY_INT_X] = early_int_x;
+    scalars[SCALAR_EARLY_INT_X2] = early_int_x2;
     free(x_bin_lower);
     free(x_bin_upper);
     return 0;

@@ -26,6 +26,7 @@ from bouncing_ball.tallies import (
     CONTROL_VARIATE_SUMS as CONTROL_VARIATES,
 )
 from bouncing_ball.tallies import (
+    EARLY_FRACTION,
     ShardTallies,
     merge_shards,
     tallies_from_frame,
@@ -78,10 +79,10 @@ def shard_tallies(draw):
         flight_time_sum=draw(times),
         flight_time_squared_sum=draw(times),
         **{name: draw(noise) for name in CONTROL_VARIATES},
-        first_half_time=draw(times),
-        first_half_collisions=draw(counts),
-        first_half_int_x=draw(times),
-        first_half_int_x2=draw(times),
+        early_time=draw(times),
+        early_collisions=draw(counts),
+        early_int_x=draw(times),
+        early_int_x2=draw(times),
     )
 
 
@@ -203,7 +204,7 @@ def test_truncated_file_gives_an_error_that_names_it(tmp_path):
 
 def test_the_compiled_loop_fills_each_scalar_by_its_name_in_SCALARS():
     """The scalars' layout has one definition, tallies.SCALARS: each scalar of a short shard
-    (stopped by its step budget in the second half of its recording, so that none is 0)
+    (stopped by its step budget past the middle of its recording, so that none is 0)
     holds what its name says."""
     from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 
@@ -224,22 +225,26 @@ def test_the_compiled_loop_fills_each_scalar_by_its_name_in_SCALARS():
     for name in ("noise_sum", "noise_v_sum", "noise_scaled_sum"):
         assert getattr(shard, name) != 0.0
     assert shard.noise_sum != shard.normal_sum
-    # the first half: the steps that start before 200, so it ends within a step of it
-    assert 200.0 <= shard.first_half_time < 201.0
-    assert 0 < shard.first_half_collisions < shard.collisions
-    assert 0.0 < shard.first_half_int_x < shard.int_x
-    assert 0.0 < shard.first_half_int_x2 < shard.int_x2
+    # the early part: the steps that start before 400 EARLY_FRACTION, so it ends within a
+    # step of that
+    assert EARLY_FRACTION * 400.0 <= shard.early_time < EARLY_FRACTION * 400.0 + 1.0
+    assert 0 < shard.early_collisions < shard.collisions
+    assert 0.0 < shard.early_int_x < shard.int_x
+    assert 0.0 < shard.early_int_x2 < shard.int_x2
 
 
 def test_the_C_reference_reads_the_scalar_layout_of_SCALARS():
-    """reference_loop passes SCALARS' layout to gcc as -D flags; the C source writes every
-    scalar through them and defines no index of its own."""
+    """reference_loop passes SCALARS' layout and EARLY_FRACTION to gcc as -D flags; the C
+    source writes every scalar through them and defines no index of its own."""
     import re
 
     from bouncing_ball.tallies import SCALARS
 
     flags = reference_loop.scalar_layout_flags()
-    assert flags == [f"-DSCALAR_{name.upper()}={k}" for k, name in enumerate(SCALARS)]
+    assert flags == [
+        *(f"-DSCALAR_{name.upper()}={k}" for k, name in enumerate(SCALARS)),
+        f"-DEARLY_FRACTION={EARLY_FRACTION.hex()}",
+    ]
     command = reference_loop.compile_command(reference_loop.SOURCE, reference_loop.SOURCE)
     assert set(flags) <= set(command)
     source = reference_loop.SOURCE.read_text()
