@@ -1,4 +1,4 @@
-"""python -m benchmarks [--json] [--scaling]: see benchmarks/benchmark.py."""
+"""python -m benchmarks [--json] [--markdown FILE] [--scaling]: see benchmarks/benchmark.py."""
 
 from .benchmark import run_single_threaded
 

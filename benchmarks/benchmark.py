@@ -1,4 +1,10 @@
-"""Benchmarks on the machine it runs on: ``python -m benchmarks [--json] [--scaling]`` (repository root).
+"""Benchmarks on the machine it runs on (from the repository root):
+
+    python -m benchmarks [--json] [--markdown FILE] [--scaling]
+
+prints the tables as Markdown (``report``), or writes them to FILE with the machine and
+the time of the run (e.g. ``--markdown results/benchmarks/benchmark.md``); ``--json``
+prints the results themselves.
 
 Measured here (about 1 minute; ``--scaling`` adds about 2.5 more, outside that budget):
   * simulation throughput on one core at r = 0.25, 0.5, 0.75 with the default
@@ -7,9 +13,8 @@ Measured here (about 1 minute; ``--scaling`` adds about 2.5 more, outside that b
     step, and the CPU per simulated time the default c saves;
   * where a step's time goes at r = 1/2 and c = 5, 3 (``breakdown``): ns per step of the
     stepping and of each tally, of the criterion root and of the normals, and collisions
-    per CPU second against issue 18's hand-tuned C loop (its figures, and the loop itself,
-    ``reference/hand_tuned.c``, measured in the same run; targets: 0.9 of it stepping,
-    0.8 with every tally);
+    per CPU second against the hand-tuned C loop (``reference/hand_tuned.c``, measured in
+    the same run; targets: 0.9 of it stepping, 0.8 with every tally);
   * the same loop in plain C (``reference/shard_loop.c``, gcc -O3, numpy's
     own ziggurat on the same PCG64 stream, so the tallies must be identical):
     numba's speed over C's at r = 1/2, with the tallies and stepping only
@@ -41,15 +46,15 @@ import subprocess
 import sys
 import tempfile
 import time
+from datetime import UTC, datetime
 from pathlib import Path
 
-from .breakdown import breakdown, print_breakdown
+from .breakdown import breakdown
+from .report import REFERENCE_TARGET, SOLVER_TARGET_MS, machine_info, markdown_report
 
 SINGLE_THREAD = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 SOLVER_RESTITUTIONS = (0.05, 0.1, 0.25, 1.0 / 3.0, 0.5, 0.75, 0.9, 0.95, 0.99)
-SOLVER_TARGET_SECONDS = 0.050  # per r, at the solver's accuracy target (solver.ACCURACY_TARGET)
-
 
 REPOSITORY = Path(__file__).resolve().parents[1]
 PAPER_CRITERION_C = 5.0
@@ -65,15 +70,8 @@ def _default_shard_settings():
 
 
 SHARD_SETTINGS = _default_shard_settings()
-REFERENCE_TARGET = 0.9  # numba's speed at least 90% of the C reference's
 # simulated time per throughput shard: about 2-4 CPU seconds each
 THROUGHPUT_TIMES = {0.25: 6.0e5, 0.5: 2.0e6, 0.75: 6.0e6}
-TARGETS = {
-    "noop_seconds": 3.0,
-    "grid_dry_run_seconds": 5.0,
-    "cores_speedup": 1.8,
-    "compile_later_seconds": 0.5,
-}
 
 
 def _shard(r, recorded_time, shard=0, seed=1, loop=None, **changes):
@@ -110,7 +108,12 @@ def simulation_benchmark():
                     "ns_per_step": 1e9 * seconds / tallies.steps,
                 }
             )
-    return {"rows": rows}
+    return {
+        "rows": rows,
+        "default_c": SHARD_SETTINGS.criterion_c,
+        "paper_c": PAPER_CRITERION_C,
+        "min_step_divisor": SHARD_SETTINGS.min_step_divisor,
+    }
 
 
 def reference_benchmark(r=0.5, recorded_time=2.0e6, repeats=3):
@@ -206,13 +209,12 @@ def efficiency_benchmark(settings=None, shards=32, recorded_time=1.0e5, r=0.5):
 _PROBE = """
 import json, resource, sys, time
 started = time.perf_counter()
-from bouncing_ball.bins import LogBins
 from bouncing_ball.settings import ShardSettings
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 imported = time.perf_counter()
 before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 def run(t):
-    settings = ShardSettings(t, 100.0, 5.0, 500.0, 10**13, LogBins(1e-4, 1e2, 10), LogBins(1e-3, 1e3, 5))
+    settings = ShardSettings(t, 100.0, 5.0, 500.0, 10**13)  # the default bins
     return simulate_shard(0.5, shard_seed_sequence(1, "0.5", 0), settings)
 run(10.0)
 first = time.perf_counter()
@@ -388,8 +390,8 @@ def solver_benchmark(repeats=7):
         "rows": rows,
         "worst_solve_ms": worst_time,
         "worst_error_vs_exact": worst_error,
-        "target_met": worst_time <= 1e3 * SOLVER_TARGET_SECONDS
-        and worst_error <= solver.ACCURACY_TARGET,
+        "accuracy_target": solver.ACCURACY_TARGET,
+        "target_met": worst_time <= SOLVER_TARGET_MS and worst_error <= solver.ACCURACY_TARGET,
     }
 
 
@@ -437,144 +439,6 @@ def distribution_benchmark():
     return {"rows": rows}
 
 
-def _print_distribution(result):
-    print("The whole distribution and the collision statistics, per r (rule solve, default grids)")
-    print(
-        f"{'r':>6} {'w(F) build s':>13} {'P(x), w tables s':>17} {'P(x,v) table s':>15}"
-        f" {'flights s':>10} {'total s':>8}"
-    )
-    for row in result["rows"]:
-        print(
-            f"{row['r']:6.3g} {row['weight_function_seconds']:13.1f}"
-            f" {row['position_and_weight_tables_seconds']:17.2f}"
-            f" {row['distribution_table_seconds']:15.1f} {row['collision_tables_seconds']:10.2f}"
-            f" {row['total_seconds']:8.1f}"
-        )
-
-
-def _print_solver(result):
-    from bouncing_ball import solver
-
-    print("Solver of eq. (inteq), one core (median of repeats, after warm-up)")
-    print(
-        f"{'r':>8} {'nodes':>6} {'solve ms':>9} {'+401 outputs ms':>16} {'energy resid':>13} {'err vs exact':>13}"
-    )
-    for row in result["rows"]:
-        error = f"{row['error_vs_exact']:.1e}" if "error_vs_exact" in row else "-"
-        print(
-            f"{row['r']:8.4g} {row['nodes']:6d} {row['solve_ms']:9.1f} {row['solve_and_401_outputs_ms']:16.1f}"
-            f" {row['energy_balance_residual']:13.1e} {error:>13}"
-        )
-    verdict = "met" if result["target_met"] else "MISSED"
-    print(
-        f"target: <= {1e3 * SOLVER_TARGET_SECONDS:.0f} ms per r at <= {solver.ACCURACY_TARGET:.0e}: {verdict}"
-        f" (worst {result['worst_solve_ms']:.1f} ms, worst error {result['worst_error_vs_exact']:.1e})"
-    )
-
-
-def _verdict(value, target, larger_is_better=False):
-    if value is None:
-        return "not measured"
-    return "met" if (value >= target if larger_is_better else value <= target) else "MISSED"
-
-
-def _print_all(results):
-    print(
-        f"Simulation, one core, the default c = {SHARD_SETTINGS.criterion_c:g} and the paper's "
-        f"c = {PAPER_CRITERION_C:g}, the 1/{SHARD_SETTINGS.min_step_divisor:g} rule"
-    )
-    print(
-        f"{'r':>6} {'c':>3} {'CPU s':>6} {'collisions/CPU s':>17} {'time/CPU s':>11} {'steps/collision':>16} {'ns/step':>8}"
-    )
-    rows = results["simulation"]["rows"]
-    for row in rows:
-        print(
-            f"{row['r']:6.3g} {row['criterion_c']:3g} {row['cpu_seconds']:6.2f} {row['collisions_per_cpu_second']:17.3g}"
-            f" {row['simulated_time_per_cpu_second']:11.3g} {row['steps_per_collision']:16.1f}"
-            f" {row['ns_per_step']:8.0f}"
-        )
-    default, paper = SHARD_SETTINGS.criterion_c, PAPER_CRITERION_C
-    if default != paper:
-        rate = {
-            (row["r"], row["criterion_c"]): row["simulated_time_per_cpu_second"] for row in rows
-        }
-        saving = ", ".join(
-            f"{100 * (1 - rate[r, paper] / rate[r, default]):.0f}% at r = {r:g}"
-            for r in THROUGHPUT_TIMES
-        )
-        print(f"CPU per simulated time, c = {default:g} against c = {paper:g}: {saving} less")
-    print()
-    print_breakdown(results["breakdown"])
-    ref = results["reference"]
-    print()
-    if "skipped" in ref:
-        print(f"C reference of the same loop: not measured ({ref['skipped']})")
-    else:
-        print(
-            f"numba against the C reference of the same loop (gcc {ref['compiler']}; same stream), r = {ref['r']:g},"
-            f" c = {ref['criterion_c']:g}, best CPU s"
-        )
-        for row in ref["rows"]:
-            print(
-                f"  {row['case']:>14}: numba {row['numba_cpu_seconds']:.2f} s, C {row['c_cpu_seconds']:.2f} s,"
-                f" numba speed / C speed {row['speed_ratio']:.2f}, tallies identical: {row['identical_tallies']}"
-            )
-        print(
-            f"  target: numba >= {REFERENCE_TARGET:.0%} of C: {'met' if ref['target_met'] else 'MISSED'}"
-        )
-    print()
-    for key in ("efficiency", "efficiency_paper_c"):
-        e = results[key]
-        print(
-            f"Statistical efficiency at r = 1/2 ({e['shards']} shards x {e['shard_time']:.0e}, c = "
-            f"{e['criterion_c']:g}, divisor {e['min_step_divisor']:g}): I = {e['collision_rate']:.5f} "
-            f"+- {100 * e['relative_error']:.2f}%, {e['steps_per_collision']:.1f} steps/collision, CPU "
-            f"{e['cpu_seconds']:.1f} s, (rel. error)^2 x CPU s = {e['variance_times_cpu']:.2e} "
-            f"(+- {100 * (2 / (e['shards'] - 1)) ** 0.5:.0f}%; lower is better)"
-        )
-    c = results["compile"]
-    print(
-        f"\nnumba: first shard in an empty cache {c['first_shard_compile_seconds']:.1f} s (compile), a later shard "
-        f"in a new process {c['later_shard_load_seconds']:.2f} s (cache load; target <= "
-        f"{TARGETS['compile_later_seconds']} s: {_verdict(c['later_shard_load_seconds'], TARGETS['compile_later_seconds'])}); "
-        f"imports {c['import_seconds']:.1f} s"
-    )
-    print(
-        f"peak memory of a shard (r = 1/2, {c['memory_shard_time']:.0e} time units): {c['peak_memory_mib']:.0f} MiB "
-        f"({c['memory_before_shard_mib']:.0f} MiB before it)"
-    )
-    print()
-    _print_solver(results["solver"])
-    print()
-    _print_distribution(results["distribution"])
-    w = results["workflow"]
-    print()
-    if "skipped" in w:
-        print(f"Workflow overhead: skipped ({w['skipped']})")
-    else:
-        print(
-            f"Workflow: dry run of 20 r x 16 shards ({w['grid_shard_jobs']} shard jobs): {w['grid_dry_run_seconds']:.1f} s"
-            f" (target < {TARGETS['grid_dry_run_seconds']:.0f} s: {_verdict(w['grid_dry_run_seconds'], TARGETS['grid_dry_run_seconds'])})"
-        )
-        if w["noop_seconds"] is None:
-            print(
-                f"no-op rerun of the default workflow: not measured (its results are not complete; "
-                f"its dry run took {w['default_dry_run_seconds']:.1f} s)"
-            )
-        else:
-            print(
-                f"no-op rerun of the default workflow: {w['noop_seconds']:.1f} s (target < "
-                f"{TARGETS['noop_seconds']:.0f} s: {_verdict(w['noop_seconds'], TARGETS['noop_seconds'])})"
-            )
-    if "scaling" in results:
-        s = results["scaling"]
-        print(
-            f"simulation stage, {s['shards']} shards: --cores 1 {s['cores_1_seconds']:.1f} s, --cores 2 "
-            f"{s['cores_2_seconds']:.1f} s, speed-up {s['speedup']:.2f} (target >= {TARGETS['cores_speedup']}: "
-            f"{_verdict(s['speedup'], TARGETS['cores_speedup'], larger_is_better=True)})"
-        )
-
-
 def main(argv=None):
     parser = argparse.ArgumentParser(
         prog="python -m benchmarks",
@@ -585,31 +449,53 @@ def main(argv=None):
         "--json", action="store_true", help="print machine-readable JSON instead of tables"
     )
     parser.add_argument(
+        "--markdown",
+        metavar="FILE",
+        type=Path,
+        help="write the tables as Markdown to FILE (e.g. results/benchmarks/benchmark.md)",
+    )
+    parser.add_argument(
         "--scaling", action="store_true", help="also time the simulation stage with 1 and 2 cores"
     )
     args = parser.parse_args(argv)
     started = time.perf_counter()
-    solver_result = solver_benchmark()  # first: timed in a process that has run nothing else
     results = {
-        "simulation": simulation_benchmark(),
-        "breakdown": breakdown(SHARD_SETTINGS),
-        "reference": reference_benchmark(),
-        "efficiency": efficiency_benchmark(),
-        "efficiency_paper_c": efficiency_benchmark({"criterion_c": PAPER_CRITERION_C}),
-        "compile": compile_benchmark(),
-        "solver": solver_result,
-        "distribution": distribution_benchmark(),
-        "workflow": workflow_benchmark(),
+        "started_utc": datetime.now(UTC).strftime("%Y-%m-%d %H:%M:%S"),
+        "machine": machine_info(),
+        # first: timed in a process that has run nothing else
+        "solver": solver_benchmark(),
     }
+    results.update(
+        {
+            "simulation": simulation_benchmark(),
+            "breakdown": breakdown(SHARD_SETTINGS),
+            "reference": reference_benchmark(),
+            "efficiency": efficiency_benchmark(),
+            "efficiency_paper_c": efficiency_benchmark({"criterion_c": PAPER_CRITERION_C}),
+            "compile": compile_benchmark(),
+            "distribution": distribution_benchmark(),
+            "workflow": workflow_benchmark(),
+        }
+    )
     if args.scaling:
         results["scaling"] = scaling_benchmark()
     results["seconds"] = time.perf_counter() - started
     if args.json:
         print(json.dumps(results, indent=2))
-    else:
-        _print_all(results)
-        print(f"\n(benchmark took {results['seconds']:.0f} s)")
+    report = markdown_report(results)
+    if args.markdown:
+        write_markdown(report, args.markdown)
+        print(f"wrote {args.markdown}", file=sys.stderr)
+    elif not args.json:
+        print(report)
     return 0
+
+
+def write_markdown(report: str, path) -> None:
+    """Write ``report`` to ``path``, making its folder."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(report)
 
 
 def run_single_threaded(module="benchmarks"):

@@ -1,14 +1,11 @@
-"""Where a step of the shard loop spends its time, and how it compares with issue 18's
-hand-tuned C loop (``hand_tuned_loop``): part of ``python -m benchmarks``.
+"""Where a step of the shard loop spends its time, and how it compares with the hand-tuned
+C loop (``hand_tuned_loop``, measured in the same run): part of ``python -m benchmarks``.
 
 Two kinds of measurement, both CPU time on one core, best of ``repeats``:
   * the shard loop itself (``simulation.simulate_shard``) with its tallies switched on
     one at a time (its ``parts`` argument): "stepping" records what the hand-tuned C loop
     records (collisions, their outgoing speeds, time, steps, int x dt and int x^2 dt),
-    and each tally's cost is the loop's ns per step with it minus without it; and every
-    tally with P(x)'s assignment not walked over the mean path's crossings
-    (``simulation.POSITION_WITHOUT_WALK``, not a shard's loop): what the walk costs, as
-    ``position_walk_study`` measures what it buys;
+    and each tally's cost is the loop's ns per step with it minus without it;
   * the two pieces of a step that cannot be switched off, timed on their own: the step-size
     root of eq. (criterion) (``free_flight.criterion_root``, from the loop's warm start and
     from the cold start, over the states of a real trajectory, which ``_trajectory``
@@ -38,16 +35,9 @@ from bouncing_ball.simulation import (
     JOINT,
     MEAN_PATH_INTEGRALS,
     POSITION,
-    POSITION_WITHOUT_WALK,
     shard_seed_sequence,
     simulate_shard,
 )
-
-# issue 18's figures for its hand-tuned C loop at r = 1/2, measured on this project's 2-core
-# machine: collisions per CPU second, by c
-ISSUE_HAND_TUNED = {5.0: 8.6e5, 3.0: 1.09e6}
-TARGET_EVERY_TALLY = 0.8  # of the hand-tuned loop's collisions per CPU second
-TARGET_STEPPING = 0.9
 
 PARTS = (
     ("stepping (collisions, P(0,v), int x, int x^2)", MEAN_PATH_INTEGRALS),
@@ -55,8 +45,6 @@ PARTS = (
     ("+ P(x, v)", MEAN_PATH_INTEGRALS | JOINT),
     ("+ flight times and return speeds", MEAN_PATH_INTEGRALS | FLIGHTS),
     ("+ control variates (noise sums)", MEAN_PATH_INTEGRALS | CONTROL_VARIATES),
-    # not a shard's loop: P(x) with no walk over the crossings (position_walk_study)
-    ("every tally, P(x) without its walk", EVERY_TALLY | POSITION_WITHOUT_WALK),
     ("every tally", EVERY_TALLY),
 )
 
@@ -157,59 +145,37 @@ def step_pieces(settings, r=0.5, steps=2_000_000, repeats=3):
     }
 
 
-def breakdown(settings, criterion_cs=(5.0, 3.0), r=0.5):
-    """Per c: the loop's parts, the root and the normals, and the comparison with the
-    hand-tuned C loop (the issue's figures, and the loop itself measured here when gcc is
-    at hand)."""
+def hand_tuned_rate(r, criterion_c, recorded_time=2.0e6, repeats=3):
+    """Collisions per CPU second of the hand-tuned C loop (best of ``repeats``), or None with
+    the reason where it cannot be built (no gcc)."""
     from . import hand_tuned_loop
 
+    try:
+        best = min(
+            (hand_tuned_loop.run(r, criterion_c, recorded_time) for _ in range(repeats)),
+            key=lambda result: result["cpu_seconds"],
+        )
+    except (RuntimeError, OSError) as error:  # no compiler
+        return None, str(error).splitlines()[0]
+    return best["collisions_per_cpu_second"], None
+
+
+def breakdown(settings, criterion_cs=(5.0, 3.0), r=0.5):
+    """Per c: the loop's parts, the root and the normals, and the loop's speed against the
+    hand-tuned C loop measured here (skipped, with the reason, where gcc is missing)."""
     results = []
     for c in criterion_cs:
         shard = settings.replace(criterion_c=c)
         rows = loop_parts(shard, r)
         row = {"r": r, "criterion_c": c, "parts": rows, **step_pieces(shard, r)}
-        ours = {"stepping": rows[0], "every tally": rows[-1], "no walk": rows[-2]}
-        references = {"issue": ISSUE_HAND_TUNED[c]}
-        try:
-            measured = min(
-                (hand_tuned_loop.run(r, c, 2.0e6) for _ in range(3)),
-                key=lambda result: result["cpu_seconds"],
-            )
-            references["measured here"] = measured["collisions_per_cpu_second"]
-        except (RuntimeError, OSError) as error:  # no compiler
-            row["hand_tuned_skipped"] = str(error).splitlines()[0]
-        row["against_hand_tuned"] = {
-            source: {case: ours[case]["collisions_per_cpu_second"] / rate for case in ours}
-            for source, rate in references.items()
-        }
-        row["hand_tuned_collisions_per_cpu_second"] = references
+        rate, skipped = hand_tuned_rate(r, c)
+        if rate is None:
+            row["hand_tuned_skipped"] = skipped
+        else:
+            ours = {"stepping": rows[0], "every tally": rows[-1]}
+            row["hand_tuned_collisions_per_cpu_second"] = rate
+            row["against_hand_tuned"] = {
+                case: ours[case]["collisions_per_cpu_second"] / rate for case in ours
+            }
         results.append(row)
     return results
-
-
-def print_breakdown(results):
-    print("Where a step goes, r = 1/2 (ns per step, CPU, one core; 'extra': over stepping)")
-    for row in results:
-        print(f"  c = {row['criterion_c']:g}")
-        for part in row["parts"]:
-            extra = part.get("extra_ns_per_step")
-            print(
-                f"    {part['part']:<48} {part['ns_per_step']:6.1f} ns/step"
-                + (f" (extra {extra:5.1f})" if extra is not None else "")
-                + f"  {part['collisions_per_cpu_second']:.3g} collisions/CPU s"
-            )
-        print(
-            f"    on their own: the criterion root {row['criterion_root_ns']:.1f} ns/step from the loop's "
-            f"warm start ({row['criterion_root_cold_start_ns']:.1f} from the cold start), two normals "
-            f"{row['two_normals_ns']:.1f} ns/step"
-        )
-        for source, rate in row["hand_tuned_collisions_per_cpu_second"].items():
-            ratios = row["against_hand_tuned"][source]
-            print(
-                f"    against the hand-tuned C loop ({source}: {rate:.3g} collisions/CPU s): stepping "
-                f"{ratios['stepping']:.2f} (target {TARGET_STEPPING}), every tally "
-                f"{ratios['every tally']:.2f} (target {TARGET_EVERY_TALLY}); every tally with P(x) "
-                f"not walked {ratios['no walk']:.2f}"
-            )
-        if "hand_tuned_skipped" in row:
-            print(f"    hand-tuned C loop not measured here: {row['hand_tuned_skipped']}")

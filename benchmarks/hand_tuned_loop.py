@@ -1,12 +1,13 @@
-"""The hand-tuned C loop that issue 18 measures our shard loop against: build it, run it.
+"""The hand-tuned C loop, the benchmark's speed anchor: build it, run it.
 
-``reference/hand_tuned.c`` is the issue's comparison point, "a hand-tuned C loop of the
-same physics": the paper's Sec. IV (step D(x, v) + delta from eq. (criterion), the 1/500
-rule for delta after each collision, the exact free-flight update), collisions placed where
-the step bridge's mean path first reaches 0, the in-step integrals of x and x^2 exact in
-expectation given each step's ends, and a histogram of outgoing speeds (P(0, v)).  It is
-development material outside the package, like ``reference_loop``: the workflow never runs
-it.
+``reference/hand_tuned.c`` is "a hand-tuned C loop of the same physics": the paper's
+Sec. IV (step D(x, v) + delta from eq. (criterion), the 1/500 rule for delta after each
+collision, the exact free-flight update), collisions placed where the step bridge's mean
+path first reaches 0, the in-step integrals of x and x^2 exact in expectation given each
+step's ends, and a histogram of outgoing speeds (P(0, v)).  ``python -m benchmarks``
+measures the shard loop's collisions per CPU second against it, in the same run
+(``breakdown``).  It is outside the package, like ``reference_loop``: the workflow never
+runs it.
 
 How it differs from ``simulation._run`` (and from its line-by-line translation
 ``reference/shard_loop.c``):
@@ -16,15 +17,15 @@ How it differs from ``simulation._run`` (and from its line-by-line translation
     seeded by an integer (the project itself only ever draws from numpy's Generator), so its
     numbers are statistically, not bit for bit, those of the project's loop;
   * the step-size root starts from a first-order prediction off the previous step's root
-    (Householder's third-order iteration, about 2 iterations a step, no cube root) instead
-    of the project's cold start, and a step that does not collide skips the bridge's cubic;
+    (Householder's third-order iteration, no cube root), where the project's loop starts
+    cold, and a step that does not collide skips the bridge's cubic;
   * gcc -O3 -march=native with fused multiply-adds allowed (the reference switches them off).
 
 Its physics is checked by ``physics_check``: I, <x> and Delta x against the exact r = 1/2
-values and the solver's at other r (when it was written: |z| <= 2.2 in all 18 comparisons
-at r = 0.25, 0.5, 0.75 and c = 3, 5, 16 seeds each), and the pooled P(0, v) histogram
-against the exact one (chi^2 about 60 on 52 bins at r = 1/2); ``normals`` and
-``criterion_root`` expose the generator and the root for their own checks.
+values and the solver's at other r (z-scores from the scatter of independent seeds), and
+the pooled P(0, v) histogram against the exact one (chi^2 over the bins); ``python -m
+benchmarks.hand_tuned_loop --check`` prints them.  ``normals`` and ``criterion_root``
+expose the generator and the root for their own checks.
 
 ``build`` compiles it into ``__pycache__/hand-tuned-<key>/`` keyed on the hash of the source
 and the compiler command (``reference_loop.build_shared_library``); ``run`` runs one shard and returns
@@ -42,7 +43,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bouncing_ball.bins import LogBins
+from bouncing_ball.settings import DEFAULT_SPEED_BINS
 
 from .reference_loop import COMPILER, build_shared_library
 
@@ -58,8 +59,7 @@ FLAGS = (
     "-fPIC",
     "-shared",
 )
-# the default config's speed bins: outgoing speeds of P(0, v)
-SPEED_BINS = LogBins(1.0e-4, 1.0e2, 10)
+SPEED_BINS = DEFAULT_SPEED_BINS  # outgoing speeds of P(0, v)
 OUTPUTS = (
     "time",
     "collisions",

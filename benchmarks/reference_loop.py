@@ -11,7 +11,8 @@ C loop has no ``parts`` mask).  It is the yardstick of the performance target
 the workflow does not use it.
 
 ``build`` compiles it with gcc (-O3 -march=native, and -ffp-contract=off:
-numba does not fuse multiply-adds, so the C must not either) into a folder
+numba does not fuse multiply-adds, so the C must not either; the scalars' layout of
+``tallies.SCALARS`` as -D flags, ``scalar_layout_flags``) into a folder
 keyed on the hash of the C source and the whole compiler command, compiling
 only when that folder lacks the library and writing it atomically.  This
 module imports numpy and the library's light modules only, never numba.
@@ -31,7 +32,13 @@ from pathlib import Path
 import numpy as np
 
 from bouncing_ball.settings import ShardSettings
-from bouncing_ball.tallies import BINS, ShardTallies, tally_seed_sequence
+from bouncing_ball.tallies import (
+    BINS,
+    EARLY_FRACTION,
+    SCALARS,
+    ShardTallies,
+    tally_seed_sequence,
+)
 
 HERE = Path(__file__).resolve().parent
 SOURCE = HERE / "reference" / "shard_loop.c"
@@ -49,11 +56,22 @@ def npyrandom_library() -> Path:
     return path
 
 
+def scalar_layout_flags() -> list[str]:
+    """``-DSCALAR_<NAME>=<index>`` for each scalar of ``tallies.SCALARS``, and
+    ``-DEARLY_FRACTION``: the C reference reads the layout of its scalar array from these, so
+    it has one definition (``float.hex``: the same double)."""
+    return [
+        *(f"-DSCALAR_{name.upper()}={index}" for index, name in enumerate(SCALARS)),
+        f"-DEARLY_FRACTION={EARLY_FRACTION.hex()}",
+    ]
+
+
 def compile_command(source: Path, output: Path) -> list[str]:
     """The gcc command that builds ``source`` into the shared library ``output``."""
     return [
         COMPILER,
         *FLAGS,
+        *scalar_layout_flags(),
         f"-I{np.get_include()}",
         f"-I{sysconfig.get_paths()['include']}",  # numpy's headers include Python.h
         str(source),

@@ -16,8 +16,10 @@ from .bins import LinearBins, LogBins, linear_bins, log_bins
 # the compiled loop's 64-bit step counter (9.2e18); the config schema repeats it
 MAX_STEPS_LIMIT = 10**15
 
-# the bins of the tallies of issues 16 and 17, when a config or a caller does not name them
-# (the default config names them; config/README.md says why these)
+# the bins of the tallies, when a config or a caller does not name them (the default config
+# names them; config/README.md says why these)
+DEFAULT_SPEED_BINS = LogBins(1.0e-4, 1.0e2, 10)
+DEFAULT_POSITION_BINS = LogBins(1.0e-3, 1.0e3, 5)
 DEFAULT_VELOCITY_BINS = LinearBins(-24.0, 20.0, 0.25)
 DEFAULT_FLIGHT_TIME_BINS = LogBins(1.0e-12, 1.0e3, 5)
 
@@ -31,8 +33,8 @@ class ShardSettings:
     criterion_c: float  # c of eq. (criterion)
     min_step_divisor: float  # sqrt(2 delta) = v_out / min_step_divisor after each collision
     max_steps: int  # step budget, equilibration included
-    speed_bins: LogBins  # outgoing speeds, P(0, v)
-    position_bins: LogBins  # heights, P(x) and <v^2>_x
+    speed_bins: LogBins = DEFAULT_SPEED_BINS  # outgoing speeds, P(0, v)
+    position_bins: LogBins = DEFAULT_POSITION_BINS  # heights, P(x) and <v^2>_x
     min_step_floor: float = 0.0  # lower bound on delta (0: the paper's rule alone)
     velocity_bins: LinearBins = DEFAULT_VELOCITY_BINS  # v of the 2-D P(x, v) (x: position_bins)
     flight_time_bins: LogBins = DEFAULT_FLIGHT_TIME_BINS  # times between collisions

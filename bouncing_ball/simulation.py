@@ -79,6 +79,11 @@ depends on the state):
     step cut short by a collision).  ``histograms.control_variate_rate``
     subtracts their fitted share from the collision count: the same
     expectation, 3.5-7 times less variance of I (docs/performance.md).
+  * the time, collisions, int x dt and int x^2 dt of the steps that start in the
+    early part of the recording (t < EARLY_FRACTION x shard_time, tallies): the
+    shard's own evidence of equilibration, that part against the rest compared by
+    ``equilibration``.  Taken as the running sums when the first step starts past
+    it, so no step is cut there.
 
 A shard's work is bounded: it stops after ``max_steps`` steps (equilibration
 included) even if the simulated time has not been reached, and says so.
@@ -128,27 +133,29 @@ from .free_flight import (
 )
 from .jit import njit
 from .settings import ShardSettings
-from .tallies import ShardTallies, tally_seed_sequence
+from .tallies import EARLY_FRACTION, SCALAR_INDEX, ShardTallies, tally_seed_sequence
 
 # the modules whose code decides a shard's numbers (see ``source_digest``)
 SOURCES = stages.SIMULATION
 
-# indices into the scalar tally array of the compiled loop, in the order of tallies.SCALARS
-(
-    _TIME,
-    _COLLISIONS,
-    _STEPS,
-    _INT_X,
-    _INT_X2,
-    _EXHAUSTED,
-    _FLIGHTS,
-    _FLIGHT_TIME_SUM,
-    _FLIGHT_TIME_SQUARED_SUM,
-    _NOISE_SUM,
-    _NOISE_V_SUM,
-    _NOISE_SCALED_SUM,
-    _NORMAL_SUM,
-) = range(13)
+# indices into the scalar tally array of the compiled loop (its layout: tallies.SCALARS)
+_TIME = SCALAR_INDEX["time"]
+_COLLISIONS = SCALAR_INDEX["collisions"]
+_STEPS = SCALAR_INDEX["steps"]
+_INT_X = SCALAR_INDEX["int_x"]
+_INT_X2 = SCALAR_INDEX["int_x2"]
+_EXHAUSTED = SCALAR_INDEX["budget_exhausted"]
+_FLIGHTS = SCALAR_INDEX["flights"]
+_FLIGHT_TIME_SUM = SCALAR_INDEX["flight_time_sum"]
+_FLIGHT_TIME_SQUARED_SUM = SCALAR_INDEX["flight_time_squared_sum"]
+_NOISE_SUM = SCALAR_INDEX["noise_sum"]
+_NOISE_V_SUM = SCALAR_INDEX["noise_v_sum"]
+_NOISE_SCALED_SUM = SCALAR_INDEX["noise_scaled_sum"]
+_NORMAL_SUM = SCALAR_INDEX["normal_sum"]
+_EARLY_TIME = SCALAR_INDEX["early_time"]
+_EARLY_COLLISIONS = SCALAR_INDEX["early_collisions"]
+_EARLY_INT_X = SCALAR_INDEX["early_int_x"]
+_EARLY_INT_X2 = SCALAR_INDEX["early_int_x2"]
 
 
 def shard_seed_sequence(seed: int, label: str, shard: int) -> np.random.SeedSequence:
@@ -408,12 +415,6 @@ JOINT = 4  # P(x, v) from the bridge sample
 FLIGHTS = 8  # flight times and (outgoing, return) speed pairs
 CONTROL_VARIATES = 16  # the noise sums of histograms.control_variate_rate
 EVERY_TALLY = MEAN_PATH_INTEGRALS | POSITION | JOINT | FLIGHTS | CONTROL_VARIATES
-# For the benchmark, never a shard: with POSITION, a step not cut by a collision assigns all
-# its time (and int v^2 dt) to the bin it starts in, with no walk over the mean path's
-# crossings, and the bridge correction alone moves it.  Exact in expectation still (the
-# correction undoes any assignment), it measures what the walk costs, and what it buys:
-# errors of <v^2>_x 1.3 times smaller at r = 1/2, c = 5 (``benchmarks.position_walk_study``).
-POSITION_WITHOUT_WALK = 32
 
 
 @njit(cache=True)
@@ -537,6 +538,12 @@ def _run(
     noise_v_sum = 0.0
     noise_scaled_sum = 0.0
     normal_sum = 0.0
+    # the early part of the recording: the running sums when a step first starts past t_early
+    t_early = EARLY_FRACTION * recorded_time if recording else math.inf
+    early_time = 0.0
+    early_collisions = 0
+    early_int_x = 0.0
+    early_int_x2 = 0.0
 
     while True:
         if t >= t_stop:
@@ -546,7 +553,14 @@ def _run(
             x_bin = _bin_index(x, x_log_lo, x_per_ln, nx, x_edges)
             t = 0.0
             t_stop = recorded_time
+            t_early = EARLY_FRACTION * recorded_time
             continue
+        if t >= t_early:
+            early_time = t
+            early_collisions = collisions
+            early_int_x = int_x
+            early_int_x2 = int_x2
+            t_early = math.inf
         if steps >= max_steps:
             exhausted = 1
             break
@@ -600,15 +614,7 @@ def _run(
                     s = t_low + u * (tau - t_low)
                     weight = tau - t_low
                     s2 = rng_tally.random() * t_low
-            if parts & POSITION and parts & POSITION_WITHOUT_WALK and not collided:
-                k_s = k_s2 = x_bin
-                sq = speed_squared_coefficients(a1, a2, a3, dt)
-                position_time[x_bin] += tau
-                position_v2_time[x_bin] += quintic_antiderivative_value(
-                    sq[0], sq[1], sq[2], sq[3], sq[4], tau
-                )
-                x_bin = _walked_bin_index(x_tau, x_bin, x_bin_lower, x_bin_upper)
-            elif parts & POSITION:
+            if parts & POSITION:
                 x_bin, k_s, k_s2 = _tally_step(
                     a,
                     dt,
@@ -725,6 +731,10 @@ def _run(
     scalars[_NOISE_V_SUM] = noise_v_sum
     scalars[_NOISE_SCALED_SUM] = noise_scaled_sum
     scalars[_NORMAL_SUM] = normal_sum
+    scalars[_EARLY_TIME] = early_time
+    scalars[_EARLY_COLLISIONS] = early_collisions
+    scalars[_EARLY_INT_X] = early_int_x
+    scalars[_EARLY_INT_X2] = early_int_x2
 
 
 def simulate_shard(

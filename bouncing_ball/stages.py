@@ -19,7 +19,17 @@ SIMULATION = (
     "simulation",
     "tallies",
 )
-MERGE = ("batches", "bins", "histograms", "io", "restitution", "settings", "shards", "tallies")
+MERGE = (
+    "batches",
+    "bins",
+    "equilibration",
+    "histograms",
+    "io",
+    "restitution",
+    "settings",
+    "shards",
+    "tallies",
+)
 SOLVER = (
     "asymptotics",
     "bins",
@@ -64,6 +74,7 @@ STUDIES = (
 # results/tables/validation: the comparison, the exact bin averages, the solver curve's bin averages
 VALIDATION = ("bins", "comparison", "exact", "fits", "io", "restitution")
 
-# what numba compiles: the modules with compiled functions and what those call into (the
-# key of numba's cache folder, bouncing_ball.jit); an edit elsewhere does not recompile
-COMPILED = ("distribution", "free_flight", "jit", "kernel", "simulation")
+# what numba compiles: the modules with compiled functions and what those call into or read
+# constants from (the key of numba's cache folder, bouncing_ball.jit); an edit elsewhere does
+# not recompile
+COMPILED = ("distribution", "free_flight", "jit", "kernel", "simulation", "tallies")

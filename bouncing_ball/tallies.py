@@ -12,12 +12,18 @@ A shard is stored as one long table, a row per tally entry:
                                                         and returning at speed v in the cell
     time, collisions, steps, int_x, int_x2, budget_exhausted,
     flights, flight_time_sum, flight_time_squared_sum,
-    noise_sum, noise_v_sum, noise_scaled_sum, normal_sum
+    noise_sum, noise_v_sum, noise_scaled_sum, normal_sum,
+    early_time, early_collisions, early_int_x, early_int_x2
                             NaN    NaN    NaN    NaN    the scalar
 
 A 2-D tally's rows run over its second variable fastest (row-major, the first
 variable's bins on the outer loop), each variable with its under- and
 overflow bins.  Every entry is additive over shards, so merging is a sum.
+
+``SCALARS`` is the one definition of the scalars' layout: their order in the table, in
+the array a compiled shard loop fills (``SCALAR_INDEX``: the numba loop's indices, and
+the C reference's, which ``benchmarks/reference_loop.py`` passes to the compiler, with
+``EARLY_FRACTION``).
 """
 
 from dataclasses import dataclass, fields, replace
@@ -41,6 +47,10 @@ HISTOGRAMS_2D = {
 }
 # the martingale sums of mean 0 that correct I (``histograms.control_variate_rate``)
 CONTROL_VARIATE_SUMS = ("noise_sum", "noise_v_sum", "noise_scaled_sum", "normal_sum")
+# the same sums over the early part of the recording, the steps that start before
+# EARLY_FRACTION x shard_time: the shard's own evidence of equilibration (``equilibration``)
+EARLY_FRACTION = 0.125
+EARLY_SUMS = ("early_time", "early_collisions", "early_int_x", "early_int_x2")
 SCALARS = (
     "time",
     "collisions",
@@ -52,8 +62,11 @@ SCALARS = (
     "flight_time_sum",
     "flight_time_squared_sum",
     *CONTROL_VARIATE_SUMS,
+    *EARLY_SUMS,
 )
-_INTEGER = ("collisions", "steps", "budget_exhausted", "flights")
+# where each scalar sits in the array a compiled shard loop fills
+SCALAR_INDEX = {name: index for index, name in enumerate(SCALARS)}
+_INTEGER = ("collisions", "steps", "budget_exhausted", "flights", "early_collisions")
 BINS = ("speed_bins", "position_bins", "velocity_bins", "flight_time_bins")
 
 
@@ -95,6 +108,12 @@ class ShardTallies:
     noise_v_sum: float  # sum v_n xi_n
     noise_scaled_sum: float  # sum v_n xi_n / (x_n + v_n^2 / 2 + 4 dt_n)
     normal_sum: float  # sum normal_n
+    # the steps that start in the early part of the recording (t < EARLY_FRACTION shard_time):
+    # their time, collisions, int x dt and int x^2 dt (all 0 if the shard stopped before)
+    early_time: float
+    early_collisions: int
+    early_int_x: float
+    early_int_x2: float
 
     @staticmethod
     def loop_arrays(settings) -> dict:
@@ -116,9 +135,10 @@ class ShardTallies:
     def from_loop(cls, settings, arrays: dict) -> "ShardTallies":
         """The tallies of a compiled shard loop: the arrays of ``loop_arrays`` after the loop
         (the numba loop and its C reference both fill them so)."""
-        values = dict(zip(SCALARS, arrays["scalars"]))
-        for name in _INTEGER:
-            values[name] = int(values[name])
+        values = {
+            name: int(value) if name in _INTEGER else float(value)
+            for name, value in zip(SCALARS, arrays["scalars"])
+        }
         histograms = {name: array for name, array in arrays.items() if name != "scalars"}
         return cls(
             **{name: getattr(settings, name) for name in BINS},

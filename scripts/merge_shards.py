@@ -1,10 +1,12 @@
 """Rule merge_shards: the shards of one r merged into P(0, v), P(x) and <v^2>_x, P(x, v), the
 flight-time density, the return speeds, and the summary (<x>, Delta x, I, the flight-time
 moments) -> results/simulation/r{r}/{p0v,position,distribution,flight_time,return_speed,
-summary}.parquet."""
+summary}.parquet.  Refused where the shards' early parts disagree with the rest beyond doubt
+(``equilibration``), a warning where they disagree less; the check goes into the provenance."""
 
 import logging
 
+from bouncing_ball.equilibration import early_check, early_check_message, early_check_record
 from bouncing_ball.histograms import (
     distribution_histogram,
     flight_time_histogram,
@@ -33,6 +35,23 @@ with job_log(snakemake.log[0]):
         "simulation_code": first["code"],
         **{key: first[key] for key in ("seed", *ShardSettings.names())},
     }
+    # the shards' own evidence of equilibration: the early part of each against the rest
+    equilibration = early_check(shards)
+    provenance["equilibration_check"] = early_check_record(equilibration)
+    verdict = provenance["equilibration_check"]["verdict"]
+    if verdict in ("warn", "refuse"):
+        message = (
+            f"{early_check_message(equilibration, label)}. The shards "
+            f"{'are not' if verdict == 'refuse' else 'may not be'} in equilibrium when they "
+            "start recording: raise simulation.equilibration_time for this r "
+            f'(simulation.per_restitution: {{"{label}": {{equilibration_time: ...}}}}) and '
+            "rerun its shards"
+        )
+        if verdict == "refuse":
+            raise RuntimeError(f"{message}. Their errors cannot be trusted: nothing is written")
+        logging.warning(message)
+    else:
+        logging.info(early_check_message(equilibration, label))
     summary = position_moments_summary(shards, float(exact))
     write_tables(
         {

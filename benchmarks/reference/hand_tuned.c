@@ -1,6 +1,6 @@
 /*
- * hand_tuned.c -- a hand-tuned C99 loop of the paper's Sec. IV simulation: the comparison
- * point of issue 18 ("a hand-tuned C loop of the same physics").
+ * hand_tuned.c -- a hand-tuned C99 loop of the paper's Sec. IV simulation: the speed anchor
+ * of the benchmark ("a hand-tuned C loop of the same physics", python -m benchmarks).
  *
  * Physics (the same as bouncing_ball.simulation._run; g = Lambda = 1):
  *   - start at x = 1, v = 0;
@@ -16,8 +16,8 @@
  * free_flight.mean_path_integrals), and the outgoing speeds on the log bins passed in.
  * Not tallied (unlike the project's loop): P(x), <v^2>_x, P(x, v), flights.
  *
- * Where it is fast, and how it stays honest (ns per step measured on the 2-core EPYC of this
- * project, r = 1/2, c = 5: about 40, of which about 11.5 per root iteration):
+ * Where it is fast, and how it stays honest (its ns per step: python -m
+ * benchmarks.hand_tuned_loop):
  *   - The loop is latency-bound: each step's size needs the root of the state the previous
  *     step produced.  The root: Householder's third-order iteration (quartic convergence) on
  *     f, one division an iteration, stopped after a step <= ROOT_TOLERANCE s (the error left

@@ -84,21 +84,12 @@
 /* simulation.py */
 #define COLLAPSED_STEP 1.0e-80
 #define FLOOR_STRATUM_HEIGHT 0.1
-enum {
-    TIME,
-    COLLISIONS,
-    STEPS,
-    INT_X,
-    INT_X2,
-    EXHAUSTED,
-    FLIGHTS,
-    FLIGHT_TIME_SUM,
-    FLIGHT_TIME_SQUARED_SUM,
-    NOISE_SUM,
-    NOISE_V_SUM,
-    NOISE_SCALED_SUM,
-    NORMAL_SUM
-};
+/* the layout of the scalars (bouncing_ball.tallies.SCALARS, its one definition):
+   benchmarks/reference_loop.py defines SCALAR_<NAME> as the index of each when it compiles
+   this file (-DSCALAR_TIME=0 ...), and EARLY_FRACTION as tallies.EARLY_FRACTION */
+#if !defined(SCALAR_TIME) || !defined(EARLY_FRACTION)
+#error "compile with benchmarks.reference_loop.build(), which passes the scalars' layout"
+#endif
 
 /* Python's min(a, b) and max(a, b) on floats, as numba compiles them */
 static inline double py_min(double a, double b) { return b < a ? b : a; }
@@ -699,6 +690,12 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
     double noise_v_sum = 0.0;
     double noise_scaled_sum = 0.0;
     double normal_sum = 0.0;
+    /* the early part of the recording: the running sums when a step first starts past t_early */
+    double t_early = recording ? EARLY_FRACTION * recorded_time : INFINITY;
+    double early_time = 0.0;
+    int64_t early_collisions = 0;
+    double early_int_x = 0.0;
+    double early_int_x2 = 0.0;
 
     for (;;) {
         if (t >= t_stop) {
@@ -708,7 +705,15 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
             x_bin = bin_index(x, x_log_lo, x_per_ln, nx, x_edges);
             t = 0.0;
             t_stop = recorded_time;
+            t_early = EARLY_FRACTION * recorded_time;
             continue;
+        }
+        if (t >= t_early) {
+            early_time = t;
+            early_collisions = collisions;
+            early_int_x = int_x;
+            early_int_x2 = int_x2;
+            t_early = INFINITY;
         }
         if (steps >= max_steps) {
             exhausted = 1;
@@ -835,19 +840,23 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
         }
     }
 
-    scalars[TIME] = recording ? t : 0.0;
-    scalars[COLLISIONS] = (double)collisions;
-    scalars[STEPS] = (double)recorded_steps;
-    scalars[INT_X] = int_x;
-    scalars[INT_X2] = int_x2;
-    scalars[EXHAUSTED] = (double)exhausted;
-    scalars[FLIGHTS] = (double)flights;
-    scalars[FLIGHT_TIME_SUM] = flight_time_sum;
-    scalars[FLIGHT_TIME_SQUARED_SUM] = flight_time_squared_sum;
-    scalars[NOISE_SUM] = noise_sum;
-    scalars[NOISE_V_SUM] = noise_v_sum;
-    scalars[NOISE_SCALED_SUM] = noise_scaled_sum;
-    scalars[NORMAL_SUM] = normal_sum;
+    scalars[SCALAR_TIME] = recording ? t : 0.0;
+    scalars[SCALAR_COLLISIONS] = (double)collisions;
+    scalars[SCALAR_STEPS] = (double)recorded_steps;
+    scalars[SCALAR_INT_X] = int_x;
+    scalars[SCALAR_INT_X2] = int_x2;
+    scalars[SCALAR_BUDGET_EXHAUSTED] = (double)exhausted;
+    scalars[SCALAR_FLIGHTS] = (double)flights;
+    scalars[SCALAR_FLIGHT_TIME_SUM] = flight_time_sum;
+    scalars[SCALAR_FLIGHT_TIME_SQUARED_SUM] = flight_time_squared_sum;
+    scalars[SCALAR_NOISE_SUM] = noise_sum;
+    scalars[SCALAR_NOISE_V_SUM] = noise_v_sum;
+    scalars[SCALAR_NOISE_SCALED_SUM] = noise_scaled_sum;
+    scalars[SCALAR_NORMAL_SUM] = normal_sum;
+    scalars[SCALAR_EARLY_TIME] = early_time;
+    scalars[SCALAR_EARLY_COLLISIONS] = (double)early_collisions;
+    scalars[SCALAR_EARLY_INT_X] = early_int_x;
+    scalars[SCALAR_EARLY_INT_X2] = early_int_x2;
     free(x_bin_lower);
     free(x_bin_upper);
     return 0;

@@ -225,25 +225,6 @@ def test_a_step_cut_by_a_collision_keeps_its_mean_path():
     assert time_in.sum() == pytest.approx(tau, rel=1e-12)
 
 
-def test_the_tally_without_its_walk_agrees_with_it_shard_by_shard():
-    """``simulation.POSITION_WITHOUT_WALK`` (the benchmark's measure of what the walk costs,
-    ``benchmarks.position_walk_study``) gives each step's time to its start bin and lets the
-    bridge correction alone move it: exact in expectation too.  On the same shards as the
-    walk, the paired difference of the two P(x) has z of order 1 in the 23 bins of
-    1e-3 <= x <= 50: mean z^2 below 2.2 (chi^2 with 23 degrees of freedom exceeds 50.6 with
-    probability 5e-4; a fixed seed), and the time they cover is the shard's."""
-    from benchmarks.position_walk_study import compare, run_shards
-
-    results = run_shards(0.5, 5.0, shards=24, shard_time=1.5e4)
-    for result in results.values():
-        for tallies in result["tallies"]:
-            assert tallies.position_time.sum() == pytest.approx(tallies.time, rel=1e-9)
-    table, _ = compare(results)
-    z = table["P(x) paired z"]
-    assert len(z) == 23 and np.all(np.isfinite(z))
-    assert np.mean(z**2) < 2.2
-
-
 @njit(cache=True)
 def _floor_step_corrections(a, dt, tau, x_tau, v_tau, t_low, edges, lower, upper, draws, seed):
     """The loop's bridge correction of a step from the floor, per draw: with t_low < tau its

@@ -26,6 +26,7 @@ from bouncing_ball.tallies import (
     CONTROL_VARIATE_SUMS as CONTROL_VARIATES,
 )
 from bouncing_ball.tallies import (
+    EARLY_FRACTION,
     ShardTallies,
     merge_shards,
     tallies_from_frame,
@@ -78,6 +79,10 @@ def shard_tallies(draw):
         flight_time_sum=draw(times),
         flight_time_squared_sum=draw(times),
         **{name: draw(noise) for name in CONTROL_VARIATES},
+        early_time=draw(times),
+        early_collisions=draw(counts),
+        early_int_x=draw(times),
+        early_int_x2=draw(times),
     )
 
 
@@ -197,37 +202,55 @@ def test_truncated_file_gives_an_error_that_names_it(tmp_path):
         read_table(path)
 
 
-def test_the_compiled_loop_fills_its_scalars_in_the_order_of_SCALARS():
-    from bouncing_ball import simulation
+def test_the_compiled_loop_fills_each_scalar_by_its_name_in_SCALARS():
+    """The scalars' layout has one definition, tallies.SCALARS: each scalar of a short shard
+    (stopped by its step budget past the middle of its recording, so that none is 0)
+    holds what its name says."""
+    from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
+
+    settings = ShardSettings(400.0, 50.0, 3.0, 500.0, 2000, LogBins(1e-4, 1e2, 10), POSITION_BINS)
+    shard = simulate_shard(0.5, shard_seed_sequence(1, "0.5", 0), settings)
+    assert shard.budget_exhausted == 1 and 200.0 < shard.time < 400.0
+    assert 0 < shard.steps < 2000 and 0 < shard.collisions < shard.steps
+    assert shard.flights == shard.collisions  # every recorded collision has an earlier one
+    # the first flight may start in equilibration
+    assert 0.0 < shard.flight_time_sum < shard.time + settings.equilibration_time
+    assert shard.flight_time_sum**2 < shard.flights * shard.flight_time_squared_sum
+    mean_x = shard.int_x / shard.time
+    assert 0.0 < mean_x**2 < shard.int_x2 / shard.time < 1e3
+    assert shard.position_time.sum() == pytest.approx(shard.time, rel=1e-9)
+    assert shard.speed_counts.sum() == shard.collisions
+    # the noise sums: of mean 0, with standard deviations about sqrt(steps) for the normals
+    assert 0.0 < abs(shard.normal_sum) < 5.0 * shard.steps**0.5
+    for name in ("noise_sum", "noise_v_sum", "noise_scaled_sum"):
+        assert getattr(shard, name) != 0.0
+    assert shard.noise_sum != shard.normal_sum
+    # the early part: the steps that start before 400 EARLY_FRACTION, so it ends within a
+    # step of that
+    assert EARLY_FRACTION * 400.0 <= shard.early_time < EARLY_FRACTION * 400.0 + 1.0
+    assert 0 < shard.early_collisions < shard.collisions
+    assert 0.0 < shard.early_int_x < shard.int_x
+    assert 0.0 < shard.early_int_x2 < shard.int_x2
+
+
+def test_the_C_reference_reads_the_scalar_layout_of_SCALARS():
+    """reference_loop passes SCALARS' layout and EARLY_FRACTION to gcc as -D flags; the C
+    source writes every scalar through them and defines no index of its own."""
+    import re
+
     from bouncing_ball.tallies import SCALARS
 
-    indices = (
-        simulation._TIME,
-        simulation._COLLISIONS,
-        simulation._STEPS,
-        simulation._INT_X,
-        simulation._INT_X2,
-        simulation._EXHAUSTED,
-        simulation._FLIGHTS,
-        simulation._FLIGHT_TIME_SUM,
-        simulation._FLIGHT_TIME_SQUARED_SUM,
-        simulation._NOISE_SUM,
-        simulation._NOISE_V_SUM,
-        simulation._NOISE_SCALED_SUM,
-        simulation._NORMAL_SUM,
-    )
-    assert [SCALARS[k] for k in indices] == [
-        "time",
-        "collisions",
-        "steps",
-        "int_x",
-        "int_x2",
-        "budget_exhausted",
-        "flights",
-        "flight_time_sum",
-        "flight_time_squared_sum",
-        *CONTROL_VARIATES,
+    flags = reference_loop.scalar_layout_flags()
+    assert flags == [
+        *(f"-DSCALAR_{name.upper()}={k}" for k, name in enumerate(SCALARS)),
+        f"-DEARLY_FRACTION={EARLY_FRACTION.hex()}",
     ]
+    command = reference_loop.compile_command(reference_loop.SOURCE, reference_loop.SOURCE)
+    assert set(flags) <= set(command)
+    source = reference_loop.SOURCE.read_text()
+    written = set(re.findall(r"scalars\[SCALAR_([A-Z0-9_]+)\]", source))
+    assert written == {name.upper() for name in SCALARS}
+    assert not re.search(r"#define\s+SCALAR_|enum\s*{", source)
 
 
 def _batch_file(path, shards, named=None):
