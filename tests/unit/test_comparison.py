@@ -10,7 +10,6 @@ from scipy import stats
 
 from bouncing_ball import exact
 from bouncing_ball.bins import LogBins
-from bouncing_ball.histograms import outgoing_speed_histogram, position_histogram
 from bouncing_ball.comparison import (
     PAPER_VALUES,
     VALIDATION_CHECKS,
@@ -28,6 +27,7 @@ from bouncing_ball.comparison import (
     validation_table,
     value_with_error,
 )
+from bouncing_ball.histograms import outgoing_speed_histogram, position_histogram
 
 
 @pytest.mark.parametrize("restitution", exact.EXACT_RESTITUTIONS)
