@@ -1,6 +1,7 @@
-"""The CI-sized runs that issues 16 and 17 are tested on (test_distribution_vs_solver.py,
-test_flights_vs_solver.py): 16 shards per r at r = 0.25, 1/3, 1/2, 0.75, simulated once per pytest
-session and shared by both modules (~25 s on 2 cores), with the selections of bins both use."""
+"""The CI-sized runs that P(x), P(x, v) and the flights are tested on against the solver
+(test_distribution_vs_solver.py, test_flights_vs_solver.py): 16 shards per r at r = 0.25, 1/3,
+1/2, 0.75, simulated once per pytest session and shared by both modules, with the selections of
+bins both use."""
 
 import functools
 from fractions import Fraction

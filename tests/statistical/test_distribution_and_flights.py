@@ -1,4 +1,4 @@
-"""The tallies of issues 16 and 17 against the exact solution at r = 1/2.
+"""P(x, v) and the flights between collisions against the exact solution at r = 1/2.
 
 P(x, v) of eqs. (fpsol), (psi), (weightfunc2), averaged over each cell of (x, v) by
 Gauss-Legendre quadrature, against the simulated time-weighted P(x, v) (drawn on each

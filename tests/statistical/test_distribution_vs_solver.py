@@ -1,4 +1,4 @@
-"""Issue 16: P(x) and P(x, v) at r = 0.25 and 0.75, where the paper has no exact solution, from
+"""P(x) and P(x, v) at r = 0.25 and 0.75, where the paper has no exact solution, from
 the solver's P(0, v) (w(F) of eq. (weightfunc), P(x) of eq. (P(x)1), P(x, v) of eq. (fpsol))
 against the simulation: P(x) on the simulation's x bins, P(x, v) on its cells of x bin x v bin
 (v bins of 0.5 at r = 0.25, 1 at r = 0.75, where the distribution is wider), in every bin or cell

@@ -1,4 +1,4 @@
-"""Issue 17: the flights between collisions at r = 0.25, 1/3, 1/2, 0.75 against the theory of
+"""The flights between collisions at r = 0.25, 1/3, 1/2, 0.75 against the theory of
 flight_time.py (McKean's first-passage law with gravity, averaged over the solver's P(0, u)).
 
 - the return speed v given the outgoing speed u of the same flight, the probability of each v bin

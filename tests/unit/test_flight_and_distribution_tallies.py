@@ -1,4 +1,4 @@
-"""The tallies of issues 16 and 17: P(x, v) drawn on the step's bridge, and the flights.
+"""The tallies of P(x, v), drawn on the step's bridge, and of the flights between collisions.
 
 The bridge's joint law of (x(s), v(s)) given both ends of a step is checked against brute
 force; the flight tallies against a plain-Python replay of the same trajectory; the 2-D
