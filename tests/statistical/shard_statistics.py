@@ -3,17 +3,14 @@
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
-from workflow_support import REPOSITORY
+from conftest import DEFAULT_SETTINGS as DEFAULT_CONFIG_SETTINGS
 
-from bouncing_ball.config import read_config, shard_settings
 from bouncing_ball.histograms import outgoing_speed_density, outgoing_speed_histogram
 from bouncing_ball.restitution import restitution_label
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 
 # the exact-result tests hold the simulation to the settings users run: the default config's
-DEFAULT_SETTINGS = shard_settings(
-    read_config(REPOSITORY / "config" / "config.yaml"), "0.5"
-).replace(equilibration_time=200.0, max_steps=10**12)
+DEFAULT_SETTINGS = DEFAULT_CONFIG_SETTINGS.replace(equilibration_time=200.0, max_steps=10**12)
 CRITERION_C = DEFAULT_SETTINGS.criterion_c
 
 

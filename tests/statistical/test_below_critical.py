@@ -9,25 +9,19 @@ reaches a steady state whose P(0,v), away from the floor's speed scale
 
 import numpy as np
 import pytest
+from conftest import DEFAULT_SETTINGS
 from shard_statistics import outgoing_speed_bins, sign_flip_p_values, simulate_shards
 
 from bouncing_ball import solver
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION, small_speed_exponent
-from bouncing_ball.bins import LogBins, outgoing_speed_bin_average
-from bouncing_ball.settings import ShardSettings
+from bouncing_ball.bins import outgoing_speed_bin_average
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 
 R = 0.05
 FLOOR = 1.0e-12  # noise (2 delta)^(1/2) = 1.4e-6, 70 times below the lowest bin compared
 # the paper's delta rule alone, no floor
-COLLAPSING = ShardSettings(
-    shard_time=1.0e3,
-    equilibration_time=10.0,
-    criterion_c=5.0,
-    min_step_divisor=500.0,
-    max_steps=2_000_000,
-    speed_bins=LogBins(1e-4, 1e2, 10),
-    position_bins=LogBins(1e-3, 1e3, 5),
+COLLAPSING = DEFAULT_SETTINGS.replace(
+    shard_time=1.0e3, equilibration_time=10.0, criterion_c=5.0, max_steps=2_000_000
 )
 SHARDS, SHARD_TIME = 16, 1.0e4  # 16 shards: a sign-flip p-value can reach 1/65536
 
