@@ -10,11 +10,12 @@ reaches a steady state whose P(0,v), away from the floor's speed scale
 import numpy as np
 import pytest
 from conftest import DEFAULT_SETTINGS
-from shard_statistics import outgoing_speed_bins, sign_flip_p_values, simulate_shards
+from shard_statistics import outgoing_speed_bins, simulate_shards
 
 from bouncing_ball import solver
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION, small_speed_exponent
 from bouncing_ball.bins import outgoing_speed_bin_average
+from bouncing_ball.comparison import sign_flip_test
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 
 R = 0.05
@@ -53,11 +54,11 @@ def test_regularised_outgoing_speeds_follow_the_solver_not_v_to_the_minus_2(regu
     assert lower[0] == pytest.approx(1e-4) and len(lower) >= 30
     solution = solver.solve_outgoing_speed_density(R)
     predicted = outgoing_speed_bin_average(solution.outgoing_speed_density, lower, upper)
-    chi2_per_dof, p_chi2, p_worst = sign_flip_p_values(per_shard - predicted)
+    chi2_per_dof, p_chi2, p_worst = sign_flip_test(per_shard - predicted)
     assert p_chi2 > 1e-3 and p_worst > 1e-3, (
         f"chi^2/dof = {chi2_per_dof:.2f}, p = {p_chi2:.4f}, {p_worst:.4f}"
     )
-    _, p_wrong, _ = sign_flip_p_values(per_shard - 1.02 * predicted)
+    _, p_wrong, _ = sign_flip_test(per_shard - 1.02 * predicted)
     assert p_wrong < 1e-3  # the comparison has power: a 2% error is rejected
     assert small_speed_exponent(R) > 2.3
     # the v^-2 mode (a constant flux of collisions through speed scales), scaled to the data, misses

@@ -11,10 +11,11 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
-from shard_statistics import sign_flip_p_values, simulate_shards
+from shard_statistics import simulate_shards
 
 from bouncing_ball import exact
 from bouncing_ball.bins import LinearBins
+from bouncing_ball.comparison import sign_flip_test
 from bouncing_ball.histograms import position_moments_summary
 
 R = Fraction(1, 2)
@@ -67,7 +68,7 @@ def test_distribution_matches_the_exact_solution_cell_by_cell(shards):
     error = per_shard.std(axis=0, ddof=1) / np.sqrt(SHARDS)
     assert np.median(error / expected) < 0.05, "run too short for a sharp test"
     deviations = (per_shard - expected).reshape(SHARDS, -1)
-    chi2_per_dof, p_chi2, p_worst = sign_flip_p_values(deviations)
+    chi2_per_dof, p_chi2, p_worst = sign_flip_test(deviations)
     assert p_chi2 > 1e-3 and p_worst > 1e-3, (
         f"chi^2/dof = {chi2_per_dof:.3f} (p = {p_chi2:.4f}), worst cell p = {p_worst:.4f}; "
         f"z = {np.round((per_shard.mean(axis=0) - expected) / error, 1)}"

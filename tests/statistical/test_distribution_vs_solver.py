@@ -12,10 +12,10 @@ negligible against the simulation's (~1e-3); seeds are fixed (solver_runs.py).
 import numpy as np
 import pytest
 from distribution_support import build
-from shard_statistics import sign_flip_p_values
 from solver_runs import MINIMUM_TIME_FRACTION, SHARDS, assert_agrees, shards, times
 
 from bouncing_ball import distribution
+from bouncing_ball.comparison import sign_flip_test
 
 RESTITUTIONS = [0.25, 0.75]
 # v bins of the simulation joined per cell, per r
@@ -76,7 +76,7 @@ def test_position_density_agrees(position):
 
 def test_position_density_detects_a_one_percent_error(position):
     _, per_shard, expected = position
-    _, p_chi2, _ = sign_flip_p_values(per_shard - 1.01 * expected)
+    _, p_chi2, _ = sign_flip_test(per_shard - 1.01 * expected)
     assert p_chi2 < 1e-3
 
 
@@ -90,5 +90,5 @@ def test_distribution_agrees_cell_by_cell(cells):
 
 def test_distribution_detects_a_one_percent_error(cells):
     _, per_shard, expected = cells
-    _, p_chi2, _ = sign_flip_p_values(per_shard - 1.01 * expected)
+    _, p_chi2, _ = sign_flip_test(per_shard - 1.01 * expected)
     assert p_chi2 < 1e-3

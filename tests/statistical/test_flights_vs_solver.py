@@ -23,10 +23,10 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
-from shard_statistics import sign_flip_p_values
 from solver_runs import MINIMUM_COUNT, SHARDS, assert_agrees, shards
 
 from bouncing_ball import flight_time, solver
+from bouncing_ball.comparison import sign_flip_test
 from bouncing_ball.histograms import position_moments_summary
 
 RESTITUTIONS = [0.25, Fraction(1, 3), Fraction(1, 2), 0.75]
@@ -100,7 +100,7 @@ def test_flight_time_density_agrees(flight_times):
 
 def test_flight_time_density_detects_a_one_percent_error(flight_times):
     per_shard, expected = flight_times
-    _, p_chi2, _ = sign_flip_p_values(per_shard - 1.01 * expected)
+    _, p_chi2, _ = sign_flip_test(per_shard - 1.01 * expected)
     assert p_chi2 < 1e-3
 
 
@@ -110,7 +110,7 @@ def test_return_speed_law_detects_a_one_percent_error_pooled_over_r():
     for r in RESTITUTIONS:
         per_shard, expected = _return_speeds(r)
         deviations.append(per_shard - 1.01 * expected)
-    _, p_chi2, _ = sign_flip_p_values(np.hstack(deviations))
+    _, p_chi2, _ = sign_flip_test(np.hstack(deviations))
     assert p_chi2 < 1e-3
 
 
