@@ -67,6 +67,7 @@ def cells(request):
 
 
 def test_position_density_agrees(position):
+    """Smallest error rejected: P(x) scaled by 1.01 (the power test below)."""
     r, per_shard, expected = position
     error = per_shard.std(axis=0, ddof=1) / np.sqrt(SHARDS)
     assert len(expected) >= 15, "too few populated bins for a meaningful chi^2"
@@ -75,12 +76,14 @@ def test_position_density_agrees(position):
 
 
 def test_position_density_detects_a_one_percent_error(position):
+    """The solver's P(x) scaled by 1.01 is rejected by the same shards, p < 1e-3."""
     _, per_shard, expected = position
     _, p_chi2, _ = sign_flip_test(per_shard - 1.01 * expected)
     assert p_chi2 < 1e-3
 
 
 def test_distribution_agrees_cell_by_cell(cells):
+    """Smallest error rejected: P(x, v) scaled by 1.01 (the power test below)."""
     r, per_shard, expected = cells
     error = per_shard.std(axis=0, ddof=1) / np.sqrt(SHARDS)
     assert len(expected) >= 100, "too few populated cells"
@@ -89,6 +92,7 @@ def test_distribution_agrees_cell_by_cell(cells):
 
 
 def test_distribution_detects_a_one_percent_error(cells):
+    """The solver's P(x, v) scaled by 1.01 is rejected by the same shards, p < 1e-3."""
     _, per_shard, expected = cells
     _, p_chi2, _ = sign_flip_test(per_shard - 1.01 * expected)
     assert p_chi2 < 1e-3
