@@ -12,6 +12,7 @@ import pandas as pd
 
 from . import exact, stages
 from .fits import LARGE_SPEED, SMALL_SPEED, bin_averages_of_curve, usable_curve
+from .histograms import outgoing_speed_density
 
 SOURCES = stages.COMPARISON
 
@@ -116,7 +117,8 @@ def outgoing_speed_residuals(simulated: pd.DataFrame, solver_curve: pd.DataFrame
 
     ``simulated`` is a merged p0v table (bins ``v_lo``, ``v_hi``), ``solver_curve``
     the solver's ``v, p0v`` grid; the solver enters as its average over each
-    bin (eq. (collrate)), like the data.  Bins without an error (no
+    bin (eq. (collrate)), like the data (column ``reference``; ``bin`` is the
+    bin's position in ``simulated``).  Bins without an error (no
     collisions, the under- and overflow bins) and bins beyond the solver's
     grid (or beyond where its P(0, v) underflows) are left out.
     """
@@ -136,6 +138,8 @@ def outgoing_speed_residuals(simulated: pd.DataFrame, solver_curve: pd.DataFrame
             "v_hi": bins.v_hi.to_numpy(),
             "residual": (bins.p0v.to_numpy() - reference) / bins.p0v_err.to_numpy(),
             "count": bins["count"].to_numpy(),
+            "reference": reference,
+            "bin": np.flatnonzero(inside.to_numpy()),
         }
     )
 
@@ -143,7 +147,8 @@ def outgoing_speed_residuals(simulated: pd.DataFrame, solver_curve: pd.DataFrame
 def exact_outgoing_speed_residuals(simulated: pd.DataFrame, restitution) -> pd.DataFrame:
     """(simulation - exact) / sigma per finite bin with an error of a merged p0v table at
     r = 1/2 or 1/3, the exact bin averages of eq. (P(0,v)) in closed form
-    (``exact.outgoing_speed_bin_average``); columns v, residual."""
+    (``exact.outgoing_speed_bin_average``); columns v, residual, reference (the exact bin
+    average) and bin (the bin's position in ``simulated``)."""
     usable = (
         (simulated.v_lo > 0.0)
         & np.isfinite(simulated.v_hi)
@@ -158,6 +163,8 @@ def exact_outgoing_speed_residuals(simulated: pd.DataFrame, restitution) -> pd.D
         {
             "v": bins.v.to_numpy(),
             "residual": (bins.p0v.to_numpy() - truth) / bins.p0v_err.to_numpy(),
+            "reference": truth,
+            "bin": np.flatnonzero(usable.to_numpy()),
         }
     )
 
@@ -171,7 +178,7 @@ VALIDATION_COLUMNS = (
     "bins",
     "value",
     "bin_centre",
-    "expected",
+    "p_sign_flip",
     "detail",
 )
 
@@ -197,22 +204,112 @@ POSITION_RANGE = (1.0e-3, 50.0)
 FIT_SIDES = (SMALL_SPEED, LARGE_SPEED)
 
 
-def expected_chi2_per_bin(shards):
-    """E[z^2] for z = (mean - truth) / jackknife error over ``shards`` equal shards: z is
-    Student t with shards - 1 degrees of freedom, of variance (shards - 1) / (shards - 3);
-    NaN (infinite or undefined) for 3 shards or fewer."""
-    return (shards - 1.0) / (shards - 3.0) if shards > 3 else np.nan
+# the sign-flip test of the chi^2/n rows: this many random flips, from a fixed seed, so that
+# the table is the same on every machine
+SIGN_FLIPS = 10_000
+SIGN_FLIP_SEED = 20061121
+_FLIPS_PER_BLOCK = 1000  # flips evaluated at once (memory: block x bins)
 
 
-def _z_rows(quantity, reference, where, z, shards, symbol):
-    """The chi^2/n and worst-bin rows of one set of residuals ``z`` at bin centres ``where``."""
+def sign_flip_test(deviations, flips=SIGN_FLIPS, seed=SIGN_FLIP_SEED):
+    """chi^2 per bin of shard-level deviations from a prediction, and the p-values of chi^2
+    and of the largest z^2 against their sign-flip null distributions.
+
+    Parameters
+    ----------
+    deviations : array (shards, bins)
+        Each shard's deviation from the prediction: its estimate minus the prediction (shards
+        of equal time) or its share of the merged estimate's deviation (``ratio_deviations``).
+    flips : int
+        How many random sign patterns are drawn.
+    seed : int
+        Seed of ``numpy.random.default_rng`` for the signs: the same deviations give the same
+        p-values on every machine.
+
+    Returns
+    -------
+    chi2_per_bin, p_chi2, p_worst : float
+        z of a bin is the deviations' mean over its standard error from the scatter between
+        the shards (the jackknife's, for a mean over shards); chi2_per_bin is the mean of z^2
+        over the bins.  Under the null the shards are independent and each shard's deviation
+        vector is symmetric about 0, so flipping the signs of whole shards leaves the joint
+        distribution unchanged: the flipped statistics are the null distribution, and it
+        carries the correlations between bins (shared shards, the normalisation, cascades of
+        collisions filling neighbouring bins).  p = (1 + number of flipped statistics >= the
+        observed) / (1 + flips).  Flipping every sign leaves z^2 alone, so with n shards there
+        are 2^(n - 1) distinct statistics and p is never much below 2^(1 - n).
+    """
+    deviations = np.asarray(deviations, dtype=float)
+    n = deviations.shape[0]
+    squares = (deviations**2).sum(axis=0)
+
+    def statistics(signs):
+        mean = signs @ deviations / n
+        with np.errstate(divide="ignore", invalid="ignore"):
+            z_squared = (n - 1) * n * mean**2 / (squares - n * mean**2)
+        return z_squared.mean(axis=-1), z_squared.max(axis=-1)
+
+    chi2, worst = statistics(np.ones(n))
+    rng = np.random.default_rng(seed)
+    chi2_above = worst_above = 0
+    for block in range(0, flips, _FLIPS_PER_BLOCK):
+        signs = rng.choice([-1.0, 1.0], size=(min(_FLIPS_PER_BLOCK, flips - block), n))
+        chi2_null, worst_null = statistics(signs)
+        chi2_above += int(np.sum(chi2_null >= chi2))
+        worst_above += int(np.sum(worst_null >= worst))
+    return float(chi2), (1 + chi2_above) / (1 + flips), (1 + worst_above) / (1 + flips)
+
+
+def ratio_deviations(numerators, denominators, reference):
+    """Each shard's share of the deviation of a ratio estimate from ``reference`` (bins):
+    (numerators_k - reference x denominators_k) / sum_k denominators_k for the estimate
+    sum_k numerators_k / sum_k denominators_k (shards x bins arrays).  The shares add up to
+    the estimate minus the reference; to first order they are what the delete-one jackknife
+    sees of each shard, so ``sign_flip_test`` of them gives the merged table's z to first
+    order."""
+    numerators = np.asarray(numerators, dtype=float)
+    denominators = np.asarray(denominators, dtype=float)
+    return (numerators - np.asarray(reference, dtype=float) * denominators) / denominators.sum(
+        axis=0
+    )
+
+
+def shard_ratios(shards) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Each shard's numerator and denominator (shards x bins, bins as in the merged tables)
+    of the estimates the validation checks, keyed as they are: ``p0v``, its collisions over
+    the time times int_bin v dv (eq. (collrate), ``histograms.outgoing_speed_density``);
+    ``px``, the time spent in the x bin over the time times the bin's width; ``v2_given_x``,
+    the integral of v^2 dt in the bin over the time spent there (eq. (moment2))."""
+    speeds, heights = shards[0].speed_bins, shards[0].position_bins
+    times = np.array([s.time for s in shards], dtype=float)[:, None]
+    in_bin = np.stack([s.position_time for s in shards])
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        per_speed = 1.0 / outgoing_speed_density(1.0, 1.0, speeds.lower, speeds.upper)
+        return {
+            "p0v": (np.stack([s.speed_counts for s in shards]), times * per_speed),
+            "px": (in_bin, times * (heights.upper - heights.lower)),
+            "v2_given_x": (np.stack([s.position_v2_time for s in shards]), in_bin),
+        }
+
+
+def _z_rows(quantity, reference, where, z, shards, symbol, deviations=None):
+    """The chi^2/n and worst-bin rows of one set of residuals ``z`` at bin centres ``where``;
+    the chi^2/n row's p_sign_flip from ``sign_flip_test`` of ``deviations`` (shards x the
+    bins of ``z``; None: no p)."""
     n = len(z)
     if n == 0:
         worst, at, chi2 = np.nan, np.nan, np.nan
     else:
         k = int(np.argmax(np.abs(z)))
         worst, at, chi2 = float(z[k]), float(where[k]), float(np.mean(np.square(z)))
-    note = f"{shards} shards" + ("" if shards > 3 else ": chi^2/n has no finite expectation")
+    if deviations is None or n == 0:
+        p_value = np.nan
+        note = f"{shards} shards; no sign-flip p without the shards' tallies"
+    else:
+        _, p_value, _ = sign_flip_test(deviations)
+        note = f"p_sign_flip from {SIGN_FLIPS} sign flips of the {shards} shards' deviations"
+        if 2.0 ** (1 - shards) > 1.0 / (1 + SIGN_FLIPS):
+            note += f" (with {shards} shards p is never below about {2.0 ** (1 - shards):.2g})"
     return [
         {
             "check": f"{quantity}_chi2_per_bin",
@@ -220,8 +317,9 @@ def _z_rows(quantity, reference, where, z, shards, symbol):
             "bins": n,
             "value": chi2,
             "bin_centre": np.nan,
-            "expected": expected_chi2_per_bin(shards),
-            "detail": f"mean of z^2, z = (simulation - {reference}) / error; {note}",
+            "p_sign_flip": p_value,
+            "detail": f"mean of z^2, z = (simulation - {reference}) / error; the bins are "
+            f"correlated, so it need not be near 1; {note}",
         },
         {
             "check": f"{quantity}_worst_bin",
@@ -229,13 +327,26 @@ def _z_rows(quantity, reference, where, z, shards, symbol):
             "bins": n,
             "value": worst,
             "bin_centre": at,
-            "expected": np.nan,
+            "p_sign_flip": np.nan,
             "detail": f"z of the bin with the largest abs(z), at {symbol} = {_number(at, 3)}",
         },
     ]
 
 
-def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None):
+def _shard_deviations(per_shard, quantity, bins, reference, count):
+    """``ratio_deviations`` of ``per_shard[quantity]`` (``shard_ratios``) in the merged
+    table's bins at positions ``bins``; None without ``per_shard``."""
+    if per_shard is None:
+        return None
+    numerators, denominators = per_shard[quantity]
+    if numerators.shape[0] != count:
+        raise ValueError(
+            f"{quantity}: tallies of {numerators.shape[0]} shards for a table of {count} shards"
+        )
+    return ratio_deviations(numerators[:, bins], denominators[:, bins], reference)
+
+
+def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None, per_shard=None):
     """The simulated P(0, v) (a merged p0v table) against eq. (P(0,v)) at r = 1/2 and 1/3
     (bin averages in closed form, ``exact.outgoing_speed_bin_average``), else against the
     solver's P(0, v) of eq. (inteq) (``solver_curve``: v, p0v), averaged over each bin like
@@ -244,7 +355,9 @@ def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None):
     Rows (without r): chi^2/n and the worst z of z = (simulation - reference) / p0v_err over
     the bins with an error (not the under- and overflow bins, nor bins beyond the solver's
     grid), and the largest relative error p0v_err / p0v over the bins with
-    0.01 <= v <= 5 (an empty bin there counts as an infinite relative error).
+    0.01 <= v <= 5 (an empty bin there counts as an infinite relative error).  ``shards`` is
+    the number of shards; ``per_shard`` (``shard_ratios`` of them) gives chi^2/n its
+    p_sign_flip (``sign_flip_test``).
     """
     if Fraction(restitution) in exact.EXACT_RESTITUTIONS:
         reference = "exact"
@@ -255,7 +368,10 @@ def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None):
         reference = "solver"
         residuals = outgoing_speed_residuals(simulated, solver_curve)
     where, z = residuals.v.to_numpy(), residuals.residual.to_numpy()
-    rows = _z_rows("p0v", reference, where, z, shards, "v")
+    deviations = _shard_deviations(
+        per_shard, "p0v", residuals.bin.to_numpy(), residuals.reference.to_numpy(), shards
+    )
+    rows = _z_rows("p0v", reference, where, z, shards, "v", deviations)
     low, high = QUALITY_SPEEDS
     quality = simulated[(simulated.v >= low) & (simulated.v <= high)]
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -276,7 +392,7 @@ def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None):
             "bins": len(relative),
             "value": largest,
             "bin_centre": at,
-            "expected": np.nan,
+            "p_sign_flip": np.nan,
             "detail": f"max of p0v_err / p0v over the bins with {low:g} <= v <= {high:g}, "
             f"at v = {_number(at, 3)}",
         }
@@ -284,14 +400,15 @@ def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None):
     return rows
 
 
-def position_checks(position, restitution, shards):
+def position_checks(position, restitution, shards, per_shard=None):
     """The simulated P(x) and <v^2>_x (a merged position table) against the exact bin
     averages of eq. (P(x)2) and eq. (moment2) (``exact.position_bin_average``,
     ``exact.speed_squared_given_position_bin_average``) at r = 1/2 and 1/3; no rows
     for another r (no exact P(x) there).
 
     Rows (without r): chi^2/n and the worst z over the bins inside 1e-3 <= x <= 50 that
-    have an error, for P(x) and for <v^2>_x.
+    have an error, for P(x) and for <v^2>_x; chi^2/n with its p_sign_flip where
+    ``per_shard`` (``shard_ratios``) is given, as in ``outgoing_speed_checks``.
     """
     if Fraction(restitution) not in exact.EXACT_RESTITUTIONS:
         return []
@@ -307,12 +424,16 @@ def position_checks(position, restitution, shards):
         ("v2_given_x", exact.speed_squared_given_position_bin_average),
     ):
         error = position[f"{quantity}_err"]
-        bins = position[inside & np.isfinite(error) & (error > 0.0)]
+        compared = inside & np.isfinite(error) & (error > 0.0)
+        bins = position[compared]
         truth = np.asarray(
             bin_average(bins.x_lo.to_numpy(), bins.x_hi.to_numpy(), restitution), dtype=float
         )
         z = (bins[quantity].to_numpy() - truth) / bins[f"{quantity}_err"].to_numpy()
-        for row in _z_rows(quantity, "exact", bins.x.to_numpy(), z, shards, "x"):
+        deviations = _shard_deviations(
+            per_shard, quantity, np.flatnonzero(compared.to_numpy()), truth, shards
+        )
+        for row in _z_rows(quantity, "exact", bins.x.to_numpy(), z, shards, "x", deviations):
             row["detail"] += f"; bins in {low:g} <= x <= {high:g}"
             rows.append(row)
     return rows
@@ -356,7 +477,7 @@ def fit_checks(fits):
                 "bins": bins,
                 "value": joint,
                 "bin_centre": np.nan,
-                "expected": np.nan,
+                "p_sign_flip": np.nan,
                 "detail": f"{where}; {fitted}",
             },
             {
@@ -365,22 +486,24 @@ def fit_checks(fits):
                 "bins": bins,
                 "value": float(first.chi2_per_dof),
                 "bin_centre": np.nan,
-                "expected": 1.0,
-                "detail": f"{where}; {dof} degrees of freedom; bins are correlated",
+                "p_sign_flip": np.nan,
+                "detail": f"{where}; {dof} degrees of freedom; indicative: the bins are "
+                "correlated (the joint p-value is the test)",
             },
         ]
     return rows
 
 
 def validation_rows(
-    label, restitution, p0v, position, fits, shards, solver_curve=None
+    label, restitution, p0v, position, fits, shards, solver_curve=None, per_shard=None
 ) -> list[dict]:
     """Every check of one r: ``outgoing_speed_checks``, ``position_checks`` and
     ``fit_checks`` of the merged p0v and position tables and the fits table, each row
-    with the r label and r.  ``shards`` is the number of shards the errors come from."""
+    with the r label and r.  ``shards`` is the number of shards the errors come from,
+    ``per_shard`` their ``shard_ratios`` (for the p_sign_flip of the chi^2/n rows)."""
     rows = [
-        *outgoing_speed_checks(p0v, restitution, shards, solver_curve),
-        *position_checks(position, restitution, shards),
+        *outgoing_speed_checks(p0v, restitution, shards, solver_curve, per_shard),
+        *position_checks(position, restitution, shards, per_shard),
         *fit_checks(fits),
     ]
     return [{"r_label": label, "r": float(restitution), **row} for row in rows]
@@ -414,7 +537,7 @@ def validation_markdown(table: pd.DataFrame) -> str:
             "bins": table.bins.astype(str),
             "value": [_shown_value(c, v) for c, v in zip(table.check, table.value)],
             "at v or x": table.bin_centre.map(lambda value: _number(value, 3)),
-            "expected": table.expected.map(lambda value: _number(value, 3)),
+            "p_sign_flip": table.p_sign_flip.map(lambda value: _number(value, 2)),
             "detail": table.detail,
         }
     )

@@ -71,8 +71,21 @@ STUDIES = (
     "studies",
     "tallies",
 )
-# results/tables/validation: the comparison, the exact bin averages, the solver curve's bin averages
-VALIDATION = ("bins", "comparison", "exact", "fits", "io", "restitution")
+# results/tables/validation: the comparison, the exact bin averages, the solver curve's bin
+# averages, and the shards read back for the sign-flip p-values
+VALIDATION = (
+    "batches",
+    "bins",
+    "comparison",
+    "exact",
+    "fits",
+    "histograms",
+    "io",
+    "restitution",
+    "settings",
+    "shards",
+    "tallies",
+)
 
 # what numba compiles: the modules with compiled functions and what those call into or read
 # constants from (the key of numba's cache folder, bouncing_ball.jit); an edit elsewhere does

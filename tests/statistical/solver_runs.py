@@ -1,14 +1,16 @@
-"""The CI-sized runs that issues 16 and 17 are tested on (test_distribution_vs_solver.py,
-test_flights_vs_solver.py): 16 shards per r at r = 0.25, 1/3, 1/2, 0.75, simulated once per pytest
-session and shared by both modules (~25 s on 2 cores), with the selections of bins both use."""
+"""The CI-sized runs that P(x), P(x, v) and the flights are tested on against the solver
+(test_distribution_vs_solver.py, test_flights_vs_solver.py): 16 shards per r at r = 0.25, 1/3,
+1/2, 0.75, simulated once per pytest session and shared by both modules, with the selections of
+bins both use."""
 
 import functools
 from fractions import Fraction
 
 import numpy as np
-from shard_statistics import sign_flip_p_values, simulate_shards
+from shard_statistics import simulate_shards
 
 from bouncing_ball.bins import LinearBins
+from bouncing_ball.comparison import sign_flip_test
 
 SHARDS = 16
 SEED = 20061123
@@ -39,8 +41,8 @@ def times(run):
 
 def assert_agrees(per_shard, expected):
     """Shard-level values (shards x bins) agree with ``expected``: chi^2 and the worst bin
-    against the sign-flip null (``shard_statistics.sign_flip_p_values``), p > 1e-3 each."""
-    chi2_per_dof, p_chi2, p_worst = sign_flip_p_values(per_shard - expected)
+    against the sign-flip null (``comparison.sign_flip_test``), p > 1e-3 each."""
+    chi2_per_dof, p_chi2, p_worst = sign_flip_test(per_shard - expected)
     error = per_shard.std(axis=0, ddof=1) / np.sqrt(SHARDS)
     z = (per_shard.mean(axis=0) - expected) / error
     assert p_chi2 > 1e-3 and p_worst > 1e-3, (

@@ -9,25 +9,20 @@ reaches a steady state whose P(0,v), away from the floor's speed scale
 
 import numpy as np
 import pytest
-from shard_statistics import outgoing_speed_bins, sign_flip_p_values, simulate_shards
+from conftest import DEFAULT_SETTINGS
+from shard_statistics import outgoing_speed_bins, simulate_shards
 
 from bouncing_ball import solver
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION, small_speed_exponent
-from bouncing_ball.bins import LogBins, outgoing_speed_bin_average
-from bouncing_ball.settings import ShardSettings
+from bouncing_ball.bins import outgoing_speed_bin_average
+from bouncing_ball.comparison import sign_flip_test
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 
 R = 0.05
 FLOOR = 1.0e-12  # noise (2 delta)^(1/2) = 1.4e-6, 70 times below the lowest bin compared
 # the paper's delta rule alone, no floor
-COLLAPSING = ShardSettings(
-    shard_time=1.0e3,
-    equilibration_time=10.0,
-    criterion_c=5.0,
-    min_step_divisor=500.0,
-    max_steps=2_000_000,
-    speed_bins=LogBins(1e-4, 1e2, 10),
-    position_bins=LogBins(1e-3, 1e3, 5),
+COLLAPSING = DEFAULT_SETTINGS.replace(
+    shard_time=1.0e3, equilibration_time=10.0, criterion_c=5.0, max_steps=2_000_000
 )
 SHARDS, SHARD_TIME = 16, 1.0e4  # 16 shards: a sign-flip p-value can reach 1/65536
 
@@ -52,18 +47,19 @@ def test_a_floor_on_delta_gives_a_steady_state(regularised):
 
 def test_regularised_outgoing_speeds_follow_the_solver_not_v_to_the_minus_2(regularised):
     """Above the floor's speed scale the simulated P(0,v) is the solver's (beta = 2.31):
-    sign-flip chi^2 and worst bin at the 1e-3 level; the best-scaled v^-2 law is rejected."""
+    sign-flip chi^2 and worst bin at the 1e-3 level; the best-scaled v^-2 law is rejected.
+    Smallest error rejected: the solver's P(0,v) scaled by 1.02 (checked here)."""
     lower, upper, per_shard = outgoing_speed_bins(regularised)
     keep = upper <= 0.5  # the large-v tail beyond v ~ 0.5 holds few collisions at r = 0.05
     lower, upper, per_shard = lower[keep], upper[keep], per_shard[:, keep]
     assert lower[0] == pytest.approx(1e-4) and len(lower) >= 30
     solution = solver.solve_outgoing_speed_density(R)
     predicted = outgoing_speed_bin_average(solution.outgoing_speed_density, lower, upper)
-    chi2_per_dof, p_chi2, p_worst = sign_flip_p_values(per_shard - predicted)
+    chi2_per_dof, p_chi2, p_worst = sign_flip_test(per_shard - predicted)
     assert p_chi2 > 1e-3 and p_worst > 1e-3, (
         f"chi^2/dof = {chi2_per_dof:.2f}, p = {p_chi2:.4f}, {p_worst:.4f}"
     )
-    _, p_wrong, _ = sign_flip_p_values(per_shard - 1.02 * predicted)
+    _, p_wrong, _ = sign_flip_test(per_shard - 1.02 * predicted)
     assert p_wrong < 1e-3  # the comparison has power: a 2% error is rejected
     assert small_speed_exponent(R) > 2.3
     # the v^-2 mode (a constant flux of collisions through speed scales), scaled to the data, misses

@@ -1,4 +1,4 @@
-"""Issue 16: P(x) and P(x, v) at r = 0.25 and 0.75, where the paper has no exact solution, from
+"""P(x) and P(x, v) at r = 0.25 and 0.75, where the paper has no exact solution, from
 the solver's P(0, v) (w(F) of eq. (weightfunc), P(x) of eq. (P(x)1), P(x, v) of eq. (fpsol))
 against the simulation: P(x) on the simulation's x bins, P(x, v) on its cells of x bin x v bin
 (v bins of 0.5 at r = 0.25, 1 at r = 0.75, where the distribution is wider), in every bin or cell
@@ -12,10 +12,10 @@ negligible against the simulation's (~1e-3); seeds are fixed (solver_runs.py).
 import numpy as np
 import pytest
 from distribution_support import build
-from shard_statistics import sign_flip_p_values
 from solver_runs import MINIMUM_TIME_FRACTION, SHARDS, assert_agrees, shards, times
 
 from bouncing_ball import distribution
+from bouncing_ball.comparison import sign_flip_test
 
 RESTITUTIONS = [0.25, 0.75]
 # v bins of the simulation joined per cell, per r
@@ -67,6 +67,7 @@ def cells(request):
 
 
 def test_position_density_agrees(position):
+    """Smallest error rejected: P(x) scaled by 1.01 (the power test below)."""
     r, per_shard, expected = position
     error = per_shard.std(axis=0, ddof=1) / np.sqrt(SHARDS)
     assert len(expected) >= 15, "too few populated bins for a meaningful chi^2"
@@ -75,12 +76,14 @@ def test_position_density_agrees(position):
 
 
 def test_position_density_detects_a_one_percent_error(position):
+    """The solver's P(x) scaled by 1.01 is rejected by the same shards, p < 1e-3."""
     _, per_shard, expected = position
-    _, p_chi2, _ = sign_flip_p_values(per_shard - 1.01 * expected)
+    _, p_chi2, _ = sign_flip_test(per_shard - 1.01 * expected)
     assert p_chi2 < 1e-3
 
 
 def test_distribution_agrees_cell_by_cell(cells):
+    """Smallest error rejected: P(x, v) scaled by 1.01 (the power test below)."""
     r, per_shard, expected = cells
     error = per_shard.std(axis=0, ddof=1) / np.sqrt(SHARDS)
     assert len(expected) >= 100, "too few populated cells"
@@ -89,6 +92,7 @@ def test_distribution_agrees_cell_by_cell(cells):
 
 
 def test_distribution_detects_a_one_percent_error(cells):
+    """The solver's P(x, v) scaled by 1.01 is rejected by the same shards, p < 1e-3."""
     _, per_shard, expected = cells
-    _, p_chi2, _ = sign_flip_p_values(per_shard - 1.01 * expected)
+    _, p_chi2, _ = sign_flip_test(per_shard - 1.01 * expected)
     assert p_chi2 < 1e-3

@@ -1,21 +1,17 @@
 """A shard's work is bounded by its step budget; its tallies add up."""
 
 import pytest
+from conftest import DEFAULT_SETTINGS
 
-from bouncing_ball.bins import LogBins
-from bouncing_ball.settings import ShardSettings
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 
 
 def _run(recorded_time, equilibration_time, max_steps, r=0.5):
-    settings = ShardSettings(
+    settings = DEFAULT_SETTINGS.replace(
         shard_time=recorded_time,
         equilibration_time=equilibration_time,
         criterion_c=5.0,
-        min_step_divisor=500.0,
         max_steps=max_steps,
-        speed_bins=LogBins(1e-4, 1e2, 10),
-        position_bins=LogBins(1e-3, 1e3, 5),
     )
     return simulate_shard(r, shard_seed_sequence(2, str(r), 0), settings)
 

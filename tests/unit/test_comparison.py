@@ -1,12 +1,15 @@
 """The comparison of simulation, solver and exact results: z-scores, residuals, the paper's numbers."""
 
 from fractions import Fraction
+from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
 import pytest
+from scipy import stats
 
 from bouncing_ball import exact
+from bouncing_ball.bins import LogBins
 from bouncing_ball.comparison import (
     PAPER_VALUES,
     VALIDATION_CHECKS,
@@ -16,11 +19,15 @@ from bouncing_ball.comparison import (
     moments_table,
     outgoing_speed_checks,
     outgoing_speed_residuals,
+    ratio_deviations,
+    shard_ratios,
+    sign_flip_test,
     validation_markdown,
     validation_rows,
     validation_table,
     value_with_error,
 )
+from bouncing_ball.histograms import outgoing_speed_histogram, position_histogram
 
 
 @pytest.mark.parametrize("restitution", exact.EXACT_RESTITUTIONS)
@@ -251,7 +258,7 @@ def test_validation_of_noisy_exact_bins_gives_chi2_near_one(restitution):
     assert (rows.r_label == "label").all() and (rows.r == float(restitution)).all()
     speeds = rows.loc["p0v_chi2_per_bin"]
     assert speeds.reference == "exact" and speeds.bins == len(p0v) - 3
-    assert speeds.expected == pytest.approx(15.0 / 13.0)
+    assert np.isnan(speeds.p_sign_flip)  # no shards' tallies given: no p
     assert abs(speeds.value - 1.0) < 4.0 * np.sqrt(2.0 / speeds.bins)
     assert abs(rows.loc["p0v_worst_bin", "value"]) < 5.0
     assert rows.loc["p0v_largest_relative_error", "value"] == pytest.approx(0.01, rel=0.05)
@@ -313,7 +320,7 @@ def test_validation_at_an_r_without_exact_solution_uses_the_solver_and_skips_p_x
     )
     assert not any(check.startswith(("px", "v2")) for check in rows.index)
     speeds_row = rows.loc["p0v_chi2_per_bin"]
-    assert speeds_row.reference == "solver" and speeds_row.expected == pytest.approx(3.0)
+    assert speeds_row.reference == "solver"
     assert speeds_row.value > 1.5  # a 1-sigma shift doubles chi^2/n
     with pytest.raises(ValueError, match="no exact"):
         outgoing_speed_checks(p0v, Fraction(3, 5), 4)
@@ -338,7 +345,7 @@ def test_validation_fit_rows_and_markdown():
             "0.5", Fraction(1, 2), p0v, _position_bins(Fraction(1, 2), 0.01, rng), _fits_table(), 3
         )
     )
-    assert np.isnan(table.set_index("check").loc["p0v_chi2_per_bin", "expected"])
+    assert table.p_sign_flip.isna().all()
     markdown = validation_markdown(table)
     assert markdown.count("\n") == len(table) + 2
     assert "P(0,v): largest relative error, 0.01 <= v <= 5" in markdown and "| 1%" in markdown
@@ -356,3 +363,156 @@ def test_validation_fit_rows_say_why_a_joint_p_value_is_missing():
     assert rows.loc["small_speed_fit_joint_p_value", "detail"].startswith("no usable window")
     assert rows.loc["small_speed_fit_chi2_per_dof", "bins"] == 0
     assert np.isnan(rows.loc["small_speed_fit_chi2_per_dof", "value"])
+
+
+def _correlated_deviations(rng, shards=16, bins=30, correlation=0.8):
+    """Shards x bins of N(0, 1) deviations with correlation ``correlation`` between any two bins
+    (a component shared by every bin of a shard, like the shard's normalisation)."""
+    shared = rng.standard_normal((shards, 1))
+    own = rng.standard_normal((shards, bins))
+    return np.sqrt(correlation) * shared + np.sqrt(1.0 - correlation) * own
+
+
+def test_sign_flip_p_value_is_uniform_under_the_null_on_correlated_bins():
+    """400 replicates of 16 shards x 30 bins with a correlation of 0.8 between bins: the
+    p-values of chi^2/n fill 10 equal bins of [0, 1] within 4 binomial standard deviations
+    each, and pass a KS test of uniformity, while the p-value that treats n chi^2/n as
+    chi^2 with n degrees of freedom (independent bins) rejects far more than its level."""
+    rng = np.random.default_rng(21)
+    replicates = 400
+    flipped, independent = [], []
+    for _ in range(replicates):
+        deviations = _correlated_deviations(rng)
+        chi2, p_chi2, p_worst = sign_flip_test(deviations, flips=2000)
+        assert 0.0 < p_chi2 <= 1.0 and 0.0 < p_worst <= 1.0
+        flipped.append(p_chi2)
+        independent.append(stats.chi2.sf(30 * chi2, 30))
+    counts, _ = np.histogram(flipped, bins=10, range=(0.0, 1.0))
+    share = 0.1
+    spread = np.sqrt(replicates * share * (1.0 - share))
+    assert np.all(np.abs(counts - replicates * share) < 4.0 * spread), counts
+    assert stats.kstest(flipped, "uniform").pvalue > 1e-3
+    # the naive p-value: below 0.05 in far more than 5% of the replicates
+    assert np.mean(np.array(independent) < 0.05) > 0.05 + 4.0 * np.sqrt(0.05 * 0.95 / replicates)
+
+
+def test_sign_flip_p_value_is_small_for_a_bias():
+    """The same correlated data with a bias of 6 standard errors in every bin: p of chi^2
+    below 1e-3 (without the bias, above)."""
+    rng = np.random.default_rng(22)
+    shards, bins = 16, 30
+    deviations = _correlated_deviations(rng, shards, bins)
+    _, p_null, _ = sign_flip_test(deviations)
+    assert p_null > 1e-3
+    standard_error = 1.0 / np.sqrt(shards)  # of a bin's mean over the shards
+    _, p_biased, _ = sign_flip_test(deviations + 6.0 * standard_error)
+    assert p_biased < 1e-3
+
+
+def test_sign_flip_test_is_reproducible_and_counts_the_observed_statistic():
+    rng = np.random.default_rng(23)
+    deviations = _correlated_deviations(rng, 8, 12)
+    assert sign_flip_test(deviations) == sign_flip_test(deviations)
+    # every flipped statistic is below an observed one of a large shift: p = 1 / (1 + flips)
+    _, p_chi2, p_worst = sign_flip_test(deviations + 100.0, flips=500)
+    assert p_chi2 == p_worst == pytest.approx(1.0 / 501.0)
+
+
+def test_ratio_deviations_add_up_to_the_merged_estimate_minus_the_reference():
+    rng = np.random.default_rng(24)
+    numerators, denominators = rng.uniform(1.0, 2.0, (6, 4)), rng.uniform(1.0, 3.0, (6, 4))
+    reference = np.array([0.5, 0.6, 0.7, 0.8])
+    shares = ratio_deviations(numerators, denominators, reference)
+    np.testing.assert_allclose(
+        shares.sum(axis=0), numerators.sum(axis=0) / denominators.sum(axis=0) - reference
+    )
+
+
+def _synthetic_shards(restitution, shards, rng, relative_noise=0.04, bias=0.0):
+    """Shards (the attributes the merge reads) at the exact P(0, v), P(x) and <v^2>_x of r,
+    each bin of each shard off by Gaussian noise of relative size ``relative_noise``; P(0, v)
+    scaled by 1 + ``bias``."""
+    speed_bins, position_bins = LogBins(1e-3, 10.0, 5), LogBins(1e-3, 1e2, 5)
+    v_lo, v_hi = speed_bins.lower[1:-1], speed_bins.upper[1:-1]
+    x_lo, x_hi = position_bins.lower[1:-1], position_bins.upper[1:-1]
+    p0v = (1.0 + bias) * exact.outgoing_speed_bin_average(v_lo, v_hi, restitution)
+    px = exact.position_bin_average(x_lo, x_hi, restitution)
+    v2 = exact.speed_squared_given_position_bin_average(x_lo, x_hi, restitution)
+    time = 1.0e3
+
+    def noisy(values):
+        return values * (1.0 + relative_noise * rng.standard_normal(len(values)))
+
+    def padded(values):  # the under- and overflow bins, as the tallies hold them
+        return np.r_[1.0, values, 1.0]
+
+    made = []
+    for _ in range(shards):
+        in_bin = noisy(time * px * (x_hi - x_lo))
+        made.append(
+            SimpleNamespace(
+                speed_bins=speed_bins,
+                position_bins=position_bins,
+                time=time,
+                speed_counts=padded(noisy(time * p0v * 0.5 * (v_hi**2 - v_lo**2))),
+                position_time=padded(in_bin),
+                position_v2_time=padded(noisy(in_bin * v2)),
+            )
+        )
+    return made
+
+
+@pytest.mark.parametrize("restitution", exact.EXACT_RESTITUTIONS)
+def test_validation_chi2_rows_get_a_sign_flip_p_value_from_the_shards(restitution):
+    """Shards at the exact solution: every chi^2/n row has a p_sign_flip in (0, 1], not
+    below 1e-3, and the sign flips' chi^2/n of the shards' shares is the table's to first
+    order; the other rows have none.  P(0, v) 5% high (5 standard errors a bin): its p drops
+    below 1e-3."""
+    rng = np.random.default_rng(25)
+    shards = _synthetic_shards(restitution, 16, rng)
+    rows = _by_check(
+        validation_rows(
+            "label",
+            restitution,
+            outgoing_speed_histogram(shards),
+            position_histogram(shards),
+            _fits_table(),
+            len(shards),
+            per_shard=shard_ratios(shards),
+        )
+    )
+    chi2_rows = [check for check in rows.index if check.endswith("chi2_per_bin")]
+    assert chi2_rows == ["p0v_chi2_per_bin", "px_chi2_per_bin", "v2_given_x_chi2_per_bin"]
+    for check in chi2_rows:
+        assert 1e-3 < rows.loc[check, "p_sign_flip"] <= 1.0, check
+        assert "sign flips of the 16 shards" in rows.loc[check, "detail"]
+    assert rows.drop(index=chi2_rows).p_sign_flip.isna().all()
+    table = outgoing_speed_histogram(shards)
+    usable = np.flatnonzero(np.isfinite(table.p0v_err) & (table.v_lo > 0) & np.isfinite(table.v_hi))
+    numerators, denominators = shard_ratios(shards)["p0v"]
+    reference = exact.outgoing_speed_bin_average(
+        table.v_lo.to_numpy()[usable], table.v_hi.to_numpy()[usable], restitution
+    )
+    chi2, _, _ = sign_flip_test(
+        ratio_deviations(numerators[:, usable], denominators[:, usable], reference)
+    )
+    assert chi2 == pytest.approx(rows.loc["p0v_chi2_per_bin", "value"], rel=0.1)
+    biased = _synthetic_shards(restitution, 16, np.random.default_rng(25), bias=0.05)
+    p0v_rows = _by_check(
+        outgoing_speed_checks(
+            outgoing_speed_histogram(biased),
+            restitution,
+            len(biased),
+            per_shard=shard_ratios(biased),
+        )
+    )
+    assert p0v_rows.loc["p0v_chi2_per_bin", "p_sign_flip"] < 1e-3
+
+
+def test_validation_refuses_tallies_of_another_number_of_shards():
+    rng = np.random.default_rng(26)
+    shards = _synthetic_shards(Fraction(1, 2), 4, rng)
+    with pytest.raises(ValueError, match="tallies of 4 shards for a table of 5 shards"):
+        outgoing_speed_checks(
+            outgoing_speed_histogram(shards), Fraction(1, 2), 5, per_shard=shard_ratios(shards)
+        )

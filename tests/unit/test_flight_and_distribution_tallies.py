@@ -1,4 +1,4 @@
-"""The tallies of issues 16 and 17: P(x, v) drawn on the step's bridge, and the flights.
+"""The tallies of P(x, v), drawn on the step's bridge, and of the flights between collisions.
 
 The bridge's joint law of (x(s), v(s)) given both ends of a step is checked against brute
 force; the flight tallies against a plain-Python replay of the same trajectory; the 2-D
@@ -11,6 +11,7 @@ from dataclasses import fields
 
 import numpy as np
 import pytest
+from conftest import DEFAULT_SETTINGS
 from numba import njit
 
 from bouncing_ball import simulation, tallies
@@ -25,17 +26,12 @@ from bouncing_ball.free_flight import (
     hermite_cubic,
     largest_safe_step,
 )
-from bouncing_ball.settings import ShardSettings
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 
-SETTINGS = ShardSettings(
+SETTINGS = DEFAULT_SETTINGS.replace(
     shard_time=300.0,
     equilibration_time=0.0,
     criterion_c=3.0,
-    min_step_divisor=500.0,
-    max_steps=10**9,
-    speed_bins=LogBins(1e-4, 1e2, 10),
-    position_bins=LogBins(1e-3, 1e3, 5),
     velocity_bins=LinearBins(-6.0, 8.0, 0.25),
     flight_time_bins=LogBins(1e-8, 1e3, 5),
 )

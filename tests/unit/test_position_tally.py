@@ -16,10 +16,10 @@ import math
 
 import numpy as np
 import pytest
+from conftest import DEFAULT_SETTINGS
 from numba import njit
 from scipy import integrate, optimize, special
 
-from bouncing_ball.bins import LogBins
 from bouncing_ball.free_flight import (
     bridge_sample,
     bridge_speed_squared_given_position,
@@ -38,7 +38,7 @@ from bouncing_ball.simulation import (
     floor_stratum_end,
 )
 
-BINS = LogBins(1e-3, 1e3, 5)
+BINS = DEFAULT_SETTINGS.position_bins
 EDGES = BINS.edges
 LOWER = np.concatenate(([-np.inf], EDGES))
 UPPER = np.concatenate((EDGES, [np.inf]))

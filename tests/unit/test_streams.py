@@ -2,25 +2,16 @@
 shards are grouped into jobs."""
 
 import numpy as np
+from conftest import DEFAULT_SETTINGS
 
 from bouncing_ball.batches import batch_to_frame, simulate_batch
-from bouncing_ball.bins import LogBins
 from bouncing_ball.histograms import position_moments_summary
 from bouncing_ball.io import write_table
-from bouncing_ball.settings import ShardSettings
 from bouncing_ball.shards import read_shards
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 from bouncing_ball.tallies import tallies_to_frame
 
-SETTINGS = ShardSettings(
-    shard_time=500.0,
-    equilibration_time=10.0,
-    criterion_c=5.0,
-    min_step_divisor=500.0,
-    max_steps=10**9,
-    speed_bins=LogBins(1e-4, 1e2, 10),
-    position_bins=LogBins(1e-3, 1e3, 5),
-)
+SETTINGS = DEFAULT_SETTINGS.replace(shard_time=500.0, equilibration_time=10.0, criterion_c=5.0)
 
 
 def _run(label, shard, seed=11):

@@ -168,7 +168,9 @@ def test_run_writes_the_validation_table(finished_run):
             assert row.reference == "exact" and row.bins > 5, (label, check)
             assert np.isfinite(row.value) and row.value > 0.0, (label, check)
             assert np.isfinite(rows.loc[f"{check}_worst_bin", "bin_centre"]), (label, check)
-        assert np.isnan(rows.loc["p0v_chi2_per_bin", "expected"])  # 3 and 2 shards
+        chi2_rows = [check for check in rows.index if check.endswith("chi2_per_bin")]
+        assert rows.loc[chi2_rows, "p_sign_flip"].between(0.0, 1.0, inclusive="right").all()
+        assert rows.drop(index=chi2_rows).p_sign_flip.isna().all()
         assert rows.loc["p0v_largest_relative_error", "value"] > 0.0
     markdown = (finished_run / "results/tables/validation.md").read_text()
     assert markdown.count("\n") == len(table) + 2 and "P(0,v): chi^2/n" in markdown

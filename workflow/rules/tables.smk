@@ -1,5 +1,6 @@
 # The tables: the time averages of eq. (xandDeltax) at every simulated r, against the
 # paper, the exact solutions and the solver (moments); the run's validation checks.
+from types import SimpleNamespace
 
 
 rule moments_table:
@@ -33,9 +34,15 @@ rule moments_table:
 
 
 # The run's own validation: the simulated P(0,v), P(x) and <v^2>_x against the exact
-# solutions (r = 1/2, 1/3) or the solver, and the free-exponent fits against the theory.
+# solutions (r = 1/2, 1/3) or the solver, and the free-exponent fits against the theory;
+# the shards' batch files give each chi^2/n its sign-flip p-value.
 rule validation_table:
     input:
+        shards=[
+            path
+            for label in RESTITUTION
+            for path in batch_files(SimpleNamespace(r=label))
+        ],
         p0v=expand("results/simulation/r{r}/p0v.parquet", r=RESTITUTION),
         position=expand("results/simulation/r{r}/position.parquet", r=RESTITUTION),
         solver=expand("results/solver/r{r}/p0v.parquet", r=RESTITUTION),
