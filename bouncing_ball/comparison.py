@@ -587,8 +587,9 @@ def position_asymptotics_markdown(table: pd.DataFrame) -> str:
         }
     )
     note = (
-        "\nSmall x: local slopes at x ~ 1e-7, with corrections of relative order x^(1/3) "
-        "(so differences of order 1e-2 are expected); at r = 1/2 (beta = 1) P(x) ~ -ln x, whose "
+        "\nSmall x: local slopes at x ~ 1e-7, with corrections of relative order "
+        "x^((beta - 1)/3) for 1 < beta < 2 and x^(1/3) otherwise (so the differences shrink "
+        "slowly as x -> 0: x^(1/6) = 0.07 at x = 1e-7 and r = 1/3); at r = 1/2 (beta = 1) P(x) ~ -ln x, whose "
         "local slope goes to 0 only like 1/ln x. Large x: a fit of ln P(x) over the window where "
         "w(F) is computed (docs/distribution.md).\n"
     )
