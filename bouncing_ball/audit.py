@@ -55,18 +55,30 @@ def figure_provenance(png) -> dict | None:
         return None
 
 
-def figure_differences(png, inputs) -> list[str] | None:
-    """Why an existing figure is not the one its rule would draw from ``inputs`` now;
-    None if there is no such file."""
+def figure_differences(png, inputs, params: dict) -> list[str] | None:
+    """Why an existing figure is not the one its rule would draw now from ``inputs`` with
+    ``params`` (its settings: those its caption names among them); None if there is no
+    such file."""
     if not Path(png).exists():
         return None
     provenance = figure_provenance(png)
     if provenance is None:
         return ["no provenance in its metadata"]
+    found = []
     drawn, asked = list(provenance.get("inputs", [])), [str(path) for path in inputs]
-    if drawn == asked:
-        return []
-    return [f"drawn from {', '.join(drawn)}; the config asks for {', '.join(asked)}"]
+    if drawn != asked:
+        found.append(f"drawn from {', '.join(drawn)}; the config asks for {', '.join(asked)}")
+    return found + differences(provenance.get("params", {}), params)
+
+
+def older_than_inputs(path, inputs) -> list[str]:
+    """The inputs of an existing output that are newer than it (it was not made from them)."""
+    made = Path(path).stat().st_mtime_ns
+    return [
+        f"its input {source} is newer"
+        for source in map(str, inputs)
+        if Path(source).exists() and Path(source).stat().st_mtime_ns > made
+    ]
 
 
 def stale_message(stale: dict, why: str, remedy: str) -> str:

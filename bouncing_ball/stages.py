@@ -19,7 +19,17 @@ SIMULATION = (
     "simulation",
     "tallies",
 )
-MERGE = ("batches", "bins", "histograms", "io", "restitution", "settings", "shards", "tallies")
+MERGE = (
+    "audit",
+    "batches",
+    "bins",
+    "histograms",
+    "io",
+    "restitution",
+    "settings",
+    "shards",
+    "tallies",
+)
 SOLVER = (
     "asymptotics",
     "bins",
@@ -34,6 +44,7 @@ EXACT = ("bins", "exact")
 THEORY = ("asymptotics", "bins")
 FITS = (
     "asymptotics",
+    "audit",
     "batches",
     "bins",
     "fits",
@@ -48,6 +59,7 @@ PLOTTING = ("io", "plotting", "restitution")
 COMPARISON = ("comparison", "fits", "io", "restitution")
 # the studies' reports (workflow/rules/studies.smk); their shards are SIMULATION's
 STUDIES = (
+    "audit",
     "batches",
     "bins",
     "comparison",
