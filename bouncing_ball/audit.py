@@ -19,13 +19,24 @@ from .io import UnreadableFileError, read_provenance
 
 def differences(provenance: dict, expected: dict) -> list[str]:
     """``key = recorded (config: asked)`` for every key of ``expected`` the provenance
-    records otherwise (JSON round trip: numbers and nested mappings compare exactly)."""
+    records otherwise (JSON round trip: numbers and nested mappings compare exactly); in a
+    nested mapping, only the keys that differ (``settings.positions = ...``)."""
     expected = json.loads(json.dumps(expected, default=str))
-    return [
-        f"{key} = {provenance.get(key)!r} (config: {value!r})"
-        for key, value in expected.items()
-        if provenance.get(key) != value
-    ]
+    found = []
+    for key, value in expected.items():
+        recorded = provenance.get(key)
+        if recorded == value:
+            continue
+        if isinstance(recorded, dict) and isinstance(value, dict):
+            found += [f"{key}.{difference}" for difference in differences(recorded, value)]
+            found += [
+                f"{key}.{extra} = {recorded[extra]!r} (config: none)"
+                for extra in recorded
+                if extra not in value
+            ]
+        else:
+            found.append(f"{key} = {recorded!r} (config: {value!r})")
+    return found
 
 
 def table_differences(path, expected: dict) -> list[str] | None:

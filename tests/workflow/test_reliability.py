@@ -324,24 +324,35 @@ def test_a_report_of_other_solver_exact_and_figure_settings_is_refused(finished_
     assert "results/figures/fig11.png: outgoing_speeds = [0.3, 1.0] (config: [2.0, 5.0])" in (
         message
     )
-    for table in ("exact/r0.5/distribution", "solver/r0.333333/p0v", "solver/r0.5/position"):
-        assert f"results/{table}.parquet: settings = " in message, table
+    for table in ("exact/r0.5/distribution", "exact/r0.333333/summary"):
+        assert f"results/{table}.parquet: settings.positions = [0, 0.1] (config: [0, 0.5])" in (
+            message
+        ), table
+    for table in ("solver/r0.333333/p0v", "solver/r0.5/position"):
+        assert f"results/{table}.parquet: settings.quadrature_step = 0.25 (config: 0.3)" in (
+            message
+        ), table
+    assert "results/solver/time_averages.parquet: quadrature_step = 0.25 (config: 0.3)" in message
     # without Snakemake's record of the parameters, a run names them too (it would keep them)
     shutil.rmtree(directory / ".snakemake")
     result = snakemake(directory, "--dry-run")
     message = result.stdout + result.stderr
     assert result.returncode != 0
     assert "results made for another config, which Snakemake has no record of" in message
-    assert "results/solver/r0.5/summary.parquet: settings = " in message
+    assert "results/solver/r0.5/summary.parquet: settings.quadrature_step = 0.25" in message
     assert "results/figures/fig11.png: outgoing_speeds = " in message
 
 
 def test_a_report_after_a_run_is_made(finished_run, tmp_path):
+    """`--report-after-run` runs what is missing first (here the theory's table, and the
+    figures drawn from it), then writes the report."""
     directory = tmp_path / "copy"
     shutil.copytree(finished_run, directory)
+    (directory / "results/theory/exponents.parquet").unlink()
     report = tmp_path / "report.html"
     result = snakemake(directory, "--report", str(report), "--report-after-run")
     assert result.returncode == 0, result.stderr[-3000:]
+    assert (directory / "results/theory/exponents.parquet").exists()
     assert "fig11.png" in report.read_text()
 
 
