@@ -318,24 +318,33 @@ def check_memory(config: dict) -> None:
     for key in per_restitution(config):
         cases[key] = simulation_settings(config, restitution_label(parse_restitution(key)))
     for label, settings in cases.items():
-        cells = tally_cells(settings)
-        total = sum(cells.values())
         shards, per_job = int(settings["shards"]), int(settings["shards_per_job"])
         per_job = min(per_job, shards)
-        merge = total * (shards * BYTES_PER_CELL_IN_MEMORY + per_job * BYTES_PER_CELL_IN_A_TABLE)
-        if merge > MEMORY_BUDGET:
-            largest = max(cells, key=cells.get)
-            whose = (
-                f"simulation.per_restitution.{label} ({shards} shards, {per_job} a job)"
-                if label
-                else f"simulation.shards = {shards}, shards_per_job = {per_job}"
-            )
-            raise ValueError(
-                f"{TALLY_KEYS[largest]}: the tallies of a shard have {total} cells "
-                f"({largest}: {cells[largest]}); with {whose} merging them would need "
-                f"about {_gib(merge)}, more than a job's {_gib(MEMORY_BUDGET)}: use wider "
-                "bins or a narrower range"
-            )
+        check_merge_memory(
+            settings,
+            shards,
+            per_job,
+            f"simulation.per_restitution.{label} ({shards} shards, {per_job} a job)"
+            if label
+            else f"simulation.shards = {shards}, shards_per_job = {per_job}",
+        )
+
+
+def check_merge_memory(simulation: dict, shards: int, per_job: int, whose: str) -> None:
+    """Refuse shard bins (``simulation``, config-shaped) with which merging ``shards`` shards
+    stored ``per_job`` to a file would need more than ``MEMORY_BUDGET`` bytes; ``whose``
+    names the settings in the message."""
+    cells = tally_cells(simulation)
+    total = sum(cells.values())
+    merge = total * (shards * BYTES_PER_CELL_IN_MEMORY + per_job * BYTES_PER_CELL_IN_A_TABLE)
+    if merge > MEMORY_BUDGET:
+        largest = max(cells, key=cells.get)
+        raise ValueError(
+            f"{TALLY_KEYS[largest]}: the tallies of a shard have {total} cells "
+            f"({largest}: {cells[largest]}); with {whose} merging them would need "
+            f"about {_gib(merge)}, more than a job's {_gib(MEMORY_BUDGET)}: use wider "
+            "bins or a narrower range"
+        )
 
 
 def per_restitution(config: dict) -> dict:
@@ -555,4 +564,13 @@ def study_runs(studies: dict, config: dict) -> dict[str, dict[str, StudyRun]]:
             criterion_c=run["criterion_c"],
         )
         runs[where][name] = StudyRun(where, name, value, run["seed"], run["shards"], settings)
+    for study, named in runs.items():
+        for name, run in named.items():
+            # a study shard is a file of its own; its report reads every shard of its study
+            check_merge_memory(
+                run.settings.as_mapping(),
+                sum(other.shards for other in named.values()),
+                1,
+                f"the shards of {study} (run {name})",
+            )
     return runs

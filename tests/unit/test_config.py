@@ -17,6 +17,7 @@ from bouncing_ball.config import (
     shard_count,
     shard_settings,
     simulation_settings,
+    study_runs,
 )
 from bouncing_ball.restitution import parse_restitution, restitution_grid, restitution_label
 from bouncing_ball.settings import MAX_STEPS_LIMIT
@@ -307,3 +308,11 @@ def test_the_memory_budget_leaves_room_for_the_default_and_the_quick_configs():
     config["simulation"]["shards"] = 64
     check_config(config, _schema())
     assert MEMORY_BUDGET == 2 * 2**30
+
+
+def test_a_study_whose_bins_need_more_memory_than_a_job_may_use_is_refused():
+    studies = read_yaml(REPOSITORY / "config" / "studies.yaml")
+    study_runs(copy.deepcopy(studies), _default_config())
+    studies["r075"]["simulation"] = {"velocity_bins": {"lo": -24, "hi": 20, "width": 1.0e-3}}
+    with pytest.raises(ValueError, match=r"velocity_bins .*the shards of r075 \(run c3\)"):
+        study_runs(studies, _default_config())
