@@ -19,13 +19,24 @@ from .io import UnreadableFileError, read_provenance
 
 def differences(provenance: dict, expected: dict) -> list[str]:
     """``key = recorded (config: asked)`` for every key of ``expected`` the provenance
-    records otherwise (JSON round trip: numbers and nested mappings compare exactly)."""
+    records otherwise (JSON round trip: numbers and nested mappings compare exactly); in a
+    nested mapping, only the keys that differ (``settings.positions = ...``)."""
     expected = json.loads(json.dumps(expected, default=str))
-    return [
-        f"{key} = {provenance.get(key)!r} (config: {value!r})"
-        for key, value in expected.items()
-        if provenance.get(key) != value
-    ]
+    found = []
+    for key, value in expected.items():
+        recorded = provenance.get(key)
+        if recorded == value:
+            continue
+        if isinstance(recorded, dict) and isinstance(value, dict):
+            found += [f"{key}.{difference}" for difference in differences(recorded, value)]
+            found += [
+                f"{key}.{extra} = {recorded[extra]!r} (config: none)"
+                for extra in recorded
+                if extra not in value
+            ]
+        else:
+            found.append(f"{key} = {recorded!r} (config: {value!r})")
+    return found
 
 
 def table_differences(path, expected: dict) -> list[str] | None:
@@ -55,18 +66,30 @@ def figure_provenance(png) -> dict | None:
         return None
 
 
-def figure_differences(png, inputs) -> list[str] | None:
-    """Why an existing figure is not the one its rule would draw from ``inputs`` now;
-    None if there is no such file."""
+def figure_differences(png, inputs, params: dict) -> list[str] | None:
+    """Why an existing figure is not the one its rule would draw now from ``inputs`` with
+    ``params`` (its settings: those its caption names among them); None if there is no
+    such file."""
     if not Path(png).exists():
         return None
     provenance = figure_provenance(png)
     if provenance is None:
         return ["no provenance in its metadata"]
+    found = []
     drawn, asked = list(provenance.get("inputs", [])), [str(path) for path in inputs]
-    if drawn == asked:
-        return []
-    return [f"drawn from {', '.join(drawn)}; the config asks for {', '.join(asked)}"]
+    if drawn != asked:
+        found.append(f"drawn from {', '.join(drawn)}; the config asks for {', '.join(asked)}")
+    return found + differences(provenance.get("params", {}), params)
+
+
+def older_than_inputs(path, inputs) -> list[str]:
+    """The inputs of an existing output that are newer than it (it was not made from them)."""
+    made = Path(path).stat().st_mtime_ns
+    return [
+        f"its input {source} is newer"
+        for source in map(str, inputs)
+        if Path(source).exists() and Path(source).stat().st_mtime_ns > made
+    ]
 
 
 def stale_message(stale: dict, why: str, remedy: str) -> str:

@@ -1,19 +1,25 @@
 """Checks of the workflow config that a JSON schema cannot express.
 
 The schema (workflow/schemas/config.schema.yaml) fixes keys, types and
-simple ranges; here: r values parsed exactly and unique, bin ranges
-ordered, and the keys of the per-r overrides valid r values.  An override
+simple ranges, and ``check_types`` refuses a number that is not finite (JSON
+Schema lets NaN through every bound); here: r values parsed exactly and unique, bin
+ranges ordered, the keys of the per-r overrides valid r values, the heights
+and speeds the figures compare within the simulation's bins, and the memory
+a job would need within ``MEMORY_BUDGET``.  An override
 may name an r that is not in ``restitution``: it then applies when that r
 is asked for as a target.  Likewise for the studies' file, config/studies.yaml
 (``study_runs``; schema workflow/schemas/studies.schema.yaml).
 """
 
+import math
 from dataclasses import dataclass
 from fractions import Fraction
+from pathlib import Path
 
 import jsonschema
 import yaml
 
+from .bins import linear_bins, log_bins
 from .restitution import (
     EXACT_RESTITUTIONS,
     SOLVER_RESTITUTION_RANGE,
@@ -24,7 +30,15 @@ from .restitution import (
     restitution_label,
     shared_label_message,
 )
-from .settings import ShardSettings
+from .settings import DEFAULT_FLIGHT_TIME_BINS, DEFAULT_VELOCITY_BINS, ShardSettings
+from .tallies import HISTOGRAMS, HISTOGRAMS_2D
+
+# the config's schema, in the repository that holds this package
+SCHEMA = Path(__file__).resolve().parents[1] / "workflow" / "schemas" / "config.schema.yaml"
+
+# the memory one job may ask for, in bytes: ``check_config`` refuses settings whose largest
+# arrays would need more (estimated from the settings, before any job runs)
+MEMORY_BUDGET = 2 * 2**30
 
 
 class _UniqueKeyLoader(yaml.SafeLoader):
@@ -54,7 +68,7 @@ def read_yaml(path):
 def read_config(path) -> dict:
     """A config file, checked as the workflow checks it (for scripts run by hand)."""
     config = read_yaml(path)
-    check_config(config)
+    check_config(config, read_yaml(SCHEMA) if SCHEMA.exists() else None)
     return config
 
 
@@ -77,10 +91,30 @@ def _is_integer(checker, instance) -> bool:
     return isinstance(instance, int) and not isinstance(instance, bool)
 
 
+def _non_finite_numbers(instance, path=()):
+    """Yield (path, value) of every float in ``instance`` (nested mappings and lists) that is
+    not finite."""
+    if isinstance(instance, float) and not math.isfinite(instance):
+        yield path, instance
+    elif isinstance(instance, dict):
+        for key, value in instance.items():
+            yield from _non_finite_numbers(value, (*path, key))
+    elif isinstance(instance, list):
+        for index, value in enumerate(instance):
+            yield from _non_finite_numbers(value, (*path, index))
+
+
 def check_types(instance, schema: dict, source: str) -> None:
-    """``instance`` against ``schema`` with integers that are integers: JSON Schema (and
-    Snakemake's ``validate``) counts 1.0 or 1.0e+20 as one, and a seed of 1.0 or a step
-    budget of 1.0e+20 would then fail in every job.  ValueError naming the key."""
+    """``instance`` against ``schema`` with numbers that are finite and integers that are
+    integers.  YAML's ``.nan`` passes every ``minimum`` and ``maximum`` of JSON Schema (each
+    comparison with NaN is false) and ``.inf`` every ``minimum``; and JSON Schema (and
+    Snakemake's ``validate``) counts 1.0 or 1.0e+20 as an integer, so that a seed of 1.0 or
+    a step budget of 1.0e+20 would fail in every job.  ValueError naming the key."""
+    for path, value in _non_finite_numbers(instance):
+        where = ".".join(str(part) for part in path)
+        raise ValueError(
+            f"{source}: {where}: {value} is not a finite number (.nan and .inf are not values)"
+        )
     base = jsonschema.validators.validator_for(schema)
     strict = jsonschema.validators.extend(
         base, type_checker=base.TYPE_CHECKER.redefine("integer", _is_integer)
@@ -152,6 +186,7 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
             raise ValueError(
                 f"fits.{side}: min = {window['min']} must be smaller than max = {window['max']}"
             )
+    check_figure_positions(config)
     seen = {}
     for key in per_restitution(config):
         where = f"simulation.per_restitution.{key}"
@@ -168,7 +203,148 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
                 f"as a target it would be asked for by its label {label}, which is another r "
                 f"({label}); add r = {key} to restitution, or key the override by {label}"
             )
+    check_memory(config)
     return grid
+
+
+def check_figure_positions(config: dict) -> None:
+    """The heights of the P(x, v) curves (``solver.positions``, ``exact.positions``) and the
+    outgoing speeds of Fig. 11 (``figures.return_speeds``): no repeats, and those the figures
+    compare with the simulation inside its bins.  Fig. 8 draws, with the curve at x > 0, the
+    cells of the x bin that holds x, and Fig. 11 one panel per speed bin that holds a speed: an
+    underflow or overflow bin there would be set against a value at one end of it.
+    ValueError naming the key otherwise."""
+    position_bins = config["simulation"]["position_bins"]
+    for section in ("solver", "exact"):
+        positions = config[section]["positions"]
+        for index, x in enumerate(positions):
+            where = f"{section}.positions[{index}]"
+            if x in positions[:index]:
+                raise ValueError(
+                    f"{where}: x = {x} repeats {section}.positions[{positions.index(x)}]"
+                )
+            if (
+                section == "solver"
+                and x > 0
+                and not (position_bins["lo"] <= x < position_bins["hi"])
+            ):
+                raise ValueError(
+                    f"{where}: x = {x} is outside simulation.position_bins "
+                    f"[{position_bins['lo']}, {position_bins['hi']}): Fig. 8 would draw the "
+                    "simulation's underflow or overflow bin against the curve at x; use 0 or "
+                    "an x inside the bins"
+                )
+    speed_bins = log_bins(config["simulation"]["speed_bins"])
+    shown = {}
+    for index, speed in enumerate(config["figures"]["return_speeds"]):
+        where = f"figures.return_speeds[{index}]"
+        if not speed_bins.lo <= speed < speed_bins.hi:
+            raise ValueError(
+                f"{where}: u = {speed} is outside simulation.speed_bins "
+                f"[{speed_bins.lo}, {speed_bins.hi}): Fig. 11 draws one panel per speed bin"
+            )
+        bin_index = int(math.floor(math.log10(speed / speed_bins.lo) * speed_bins.per_decade))
+        if bin_index in shown:
+            raise ValueError(
+                f"{where}: u = {speed} is in the speed bin of figures.return_speeds"
+                f"[{shown[bin_index]}]: each panel of Fig. 11 is one speed bin"
+            )
+        shown[bin_index] = index
+
+
+# the peak memory of a solve job per point of its output grids, in bytes (tracemalloc at
+# r = 0.05, 1/2 and 0.75, with a margin): the flight-time density integrates McKean's law
+# over every node of the solution at each T
+SOLVER_BYTES_PER_POINT = {
+    "solver.flight_times": 1.2e6,
+    "solver.position_grid": 2.5e4,
+    "solver.output_speeds": 5.0e3,
+}
+# the bytes a cell of a shard's tallies takes: 8 in a shard's arrays (the merge holds every
+# shard's, and its jackknife two more copies), 64 as a row of a batch table
+# (batches.batch_to_frame: shard, tally, four edges, value)
+BYTES_PER_CELL_IN_MEMORY, BYTES_PER_CELL_IN_A_TABLE = 3 * 8, 64
+
+
+def tally_cells(simulation: dict) -> dict[str, int]:
+    """{tally: cells} of one shard's tallies (each bin range with under- and overflow), from
+    the bins of a config-shaped ``simulation`` mapping (the optional ones at their defaults)."""
+    bins = {
+        "speed_bins": log_bins(simulation["speed_bins"]),
+        "position_bins": log_bins(simulation["position_bins"]),
+        "velocity_bins": linear_bins(simulation["velocity_bins"])
+        if simulation.get("velocity_bins")
+        else DEFAULT_VELOCITY_BINS,
+        "flight_time_bins": log_bins(simulation["flight_time_bins"])
+        if simulation.get("flight_time_bins")
+        else DEFAULT_FLIGHT_TIME_BINS,
+    }
+    cells = {name: bins[spec].n + 2 for name, (spec, _, _) in HISTOGRAMS.items()}
+    for name, ((first, second), _, _) in HISTOGRAMS_2D.items():
+        cells[name] = (bins[first].n + 2) * (bins[second].n + 2)
+    return cells
+
+
+# the settings behind each tally's cells, as the config names them
+TALLY_KEYS = {
+    "outgoing_speed": "simulation.speed_bins",
+    "position_time": "simulation.position_bins",
+    "position_v2_time": "simulation.position_bins",
+    "flight_time": "simulation.flight_time_bins",
+    "position_velocity_time": "simulation.velocity_bins and simulation.position_bins",
+    "return_speed": "simulation.speed_bins (squared: every pair of speed bins)",
+}
+
+
+def _gib(size: float) -> str:
+    return f"{size / 2**30:.3g} GiB"
+
+
+def check_memory(config: dict) -> None:
+    """Refuse settings with which a job would need more than ``MEMORY_BUDGET`` bytes: the
+    solve job's output grids, and the merge of the shards of an r (every shard's tallies,
+    one batch table at a time) and the job that simulates a batch (its table); the per-r
+    overrides of ``shards`` and ``shards_per_job`` included.  ValueError naming the key."""
+    for key, per_point in SOLVER_BYTES_PER_POINT.items():
+        section, name = key.split(".")
+        points = config[section][name]["points"]
+        if points * per_point > MEMORY_BUDGET:
+            raise ValueError(
+                f"{key}: {points} points would need about {_gib(points * per_point)} in the "
+                f"solve job, more than a job's {_gib(MEMORY_BUDGET)}; use at most "
+                f"{int(MEMORY_BUDGET // per_point)} points"
+            )
+    cases = {None: simulation_settings(config, "")}  # no r has the label "": the defaults
+    for key in per_restitution(config):
+        cases[key] = simulation_settings(config, restitution_label(parse_restitution(key)))
+    for label, settings in cases.items():
+        shards, per_job = int(settings["shards"]), int(settings["shards_per_job"])
+        per_job = min(per_job, shards)
+        check_merge_memory(
+            settings,
+            shards,
+            per_job,
+            f"simulation.per_restitution.{label} ({shards} shards, {per_job} a job)"
+            if label
+            else f"simulation.shards = {shards}, shards_per_job = {per_job}",
+        )
+
+
+def check_merge_memory(simulation: dict, shards: int, per_job: int, whose: str) -> None:
+    """Refuse shard bins (``simulation``, config-shaped) with which merging ``shards`` shards
+    stored ``per_job`` to a file would need more than ``MEMORY_BUDGET`` bytes; ``whose``
+    names the settings in the message."""
+    cells = tally_cells(simulation)
+    total = sum(cells.values())
+    merge = total * (shards * BYTES_PER_CELL_IN_MEMORY + per_job * BYTES_PER_CELL_IN_A_TABLE)
+    if merge > MEMORY_BUDGET:
+        largest = max(cells, key=cells.get)
+        raise ValueError(
+            f"{TALLY_KEYS[largest]}: the tallies of a shard have {total} cells "
+            f"({largest}: {cells[largest]}); with {whose} merging them would need "
+            f"about {_gib(merge)}, more than a job's {_gib(MEMORY_BUDGET)}: use wider "
+            "bins or a narrower range"
+        )
 
 
 def per_restitution(config: dict) -> dict:
@@ -388,4 +564,13 @@ def study_runs(studies: dict, config: dict) -> dict[str, dict[str, StudyRun]]:
             criterion_c=run["criterion_c"],
         )
         runs[where][name] = StudyRun(where, name, value, run["seed"], run["shards"], settings)
+    for study, named in runs.items():
+        for name, run in named.items():
+            # a study shard is a file of its own; its report reads every shard of its study
+            check_merge_memory(
+                run.settings.as_mapping(),
+                sum(other.shards for other in named.values()),
+                1,
+                f"the shards of {study} (run {name})",
+            )
     return runs

@@ -198,9 +198,12 @@ def read_provenance(path) -> dict:
     return _provenance(path, schema)
 
 
-def read_table(path, kind: TableKind | None = None) -> tuple[pd.DataFrame, dict]:
+def read_table(
+    path, kind: TableKind | None = None, label: str | None = None
+) -> tuple[pd.DataFrame, dict]:
     """The frame and provenance of a table written by ``write_table``; with ``kind``,
-    refused (naming the file) unless that kind's rule wrote it with its columns."""
+    refused (naming the file) unless that kind's rule wrote it with its columns; with
+    ``label``, unless it was made for the r of that label (``restitution_label``)."""
     path = Path(path)
     try:
         table = pq.read_table(path)
@@ -216,6 +219,10 @@ def read_table(path, kind: TableKind | None = None) -> tuple[pd.DataFrame, dict]
                 f"not {kind.rule}"
             )
         require_columns(frame, path, kind.columns)
+    if label is not None and provenance.get("r_label") != label:
+        raise UnreadableFileError(
+            f"{path}: made for r = {provenance.get('r_label')}, not r = {label}"
+        )
     return frame, provenance
 
 

@@ -2,8 +2,9 @@
 step needs (the files: ``batches``)."""
 
 from .asymptotics import CRITICAL_RESTITUTION
+from .audit import differences, stale_message
 from .batches import batch_from_frame
-from .io import UnreadableFileError, read_table
+from .io import UnreadableFileError, read_provenance, read_table
 from .restitution import parse_restitution
 from .settings import ShardSettings
 
@@ -35,21 +36,42 @@ def _recorded_no_time(path, shard, provenance) -> UnreadableFileError:
     )
 
 
-def read_shards(paths, label):
+def check_batch_provenance(paths, expected: dict) -> None:
+    """Refuse batch files whose provenance records another value of a key of ``expected``
+    (seed, code, shard settings: what the config asks for now), naming every such file and
+    how to make them again (they may be copies of another run, which Snakemake has no
+    reason to re-run)."""
+    stale = {}
+    for path in paths:
+        found = differences(read_provenance(path), expected)
+        if found:
+            stale[str(path)] = found
+    if stale:
+        files = " ".join(stale)
+        raise UnreadableFileError(
+            stale_message(
+                stale,
+                "batch files made with other settings than the config's:",
+                "Make them again (your targets, if any, first):  snakemake --cores 2 "
+                f"--forcerun {files}",
+            )
+        )
+
+
+def read_shards(paths, label, expected: dict | None = None):
     """The tallies of every shard in the batch files ``paths``, in file order, and one
     provenance per shard (its file's, with ``shard`` and, where the file records it, the
-    shard's own ``cpu_seconds``).  Checked: every file belongs to r = ``label`` and holds
-    the shards it names, all share settings, no shard appears twice, every shard recorded
-    some time; and there are two shards at least, since every error bar is the scatter
-    between shards (a jackknife)."""
+    shard's own ``cpu_seconds``).  Checked: every file belongs to r = ``label``, records
+    the values of ``expected`` (``check_batch_provenance``) and holds the shards it names,
+    all share settings, no shard appears twice, every shard recorded some time; and there
+    are two shards at least, since every error bar is the scatter between shards (a
+    jackknife)."""
     paths = list(paths)
+    if expected is not None:
+        check_batch_provenance(paths, expected)
     shards, provenances, first_file = [], [], {}
     for path in paths:
-        frame, provenance = read_table(path)
-        if provenance.get("r_label") != label:
-            raise UnreadableFileError(
-                f"{path}: simulated for r = {provenance.get('r_label')}, not r = {label}"
-            )
+        frame, provenance = read_table(path, label=label)
         named = _provenance_shards(path, provenance)
         if provenances and any(
             provenance.get(key) != provenances[0].get(key)

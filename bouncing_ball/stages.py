@@ -20,6 +20,7 @@ SIMULATION = (
     "tallies",
 )
 MERGE = (
+    "audit",
     "batches",
     "bins",
     "equilibration",
@@ -44,6 +45,7 @@ EXACT = ("bins", "exact")
 THEORY = ("asymptotics", "bins")
 FITS = (
     "asymptotics",
+    "audit",
     "batches",
     "bins",
     "fits",
@@ -58,6 +60,7 @@ PLOTTING = ("io", "plotting", "restitution")
 COMPARISON = ("comparison", "fits", "io", "restitution")
 # the studies' reports (workflow/rules/studies.smk); their shards are SIMULATION's
 STUDIES = (
+    "audit",
     "batches",
     "bins",
     "comparison",

@@ -16,7 +16,7 @@ with job_log(snakemake.log[0]):
     settings = snakemake.params.settings
     value = parse_restitution(snakemake.params.restitution)
     label, r = restitution_label(value), float(value)
-    shards, provenances = read_shards(list(snakemake.input.shards), label)
+    shards, provenances = read_shards(list(snakemake.input.shards), label, snakemake.params.batch)
     table = outgoing_speed_histogram(shards)
     times = np.array([s.time for s in shards])
     curve, solver_provenance = read_table(snakemake.input.solver, SOLVER_P0V)

@@ -24,7 +24,7 @@ from bouncing_ball.shards import read_shards
 with job_log(snakemake.log[0]):
     exact = parse_restitution(snakemake.params.restitution)
     label = restitution_label(exact)
-    shards, provenances = read_shards(list(snakemake.input), label)
+    shards, provenances = read_shards(list(snakemake.input), label, snakemake.params.batch)
     first = provenances[0]
     provenance = {
         "rule": "merge_shards",

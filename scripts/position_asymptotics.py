@@ -8,9 +8,9 @@ from bouncing_ball.jobs import job_log
 
 with job_log(snakemake.log[0]):
     summaries = []
-    for path in snakemake.input:
-        summary, provenance = read_table(path, SOLVER_SUMMARY)
-        summaries.append((provenance["r_label"], summary.iloc[0]))
+    for path, label in zip(snakemake.input, snakemake.params.labels, strict=True):
+        summary, _ = read_table(path, SOLVER_SUMMARY, label=label)
+        summaries.append((label, summary.iloc[0]))
     table = position_asymptotics_table(summaries)
     write_csv_and_markdown(
         table,

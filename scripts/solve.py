@@ -53,6 +53,8 @@ with job_log(snakemake.log[0]):
         "r_label": label,
         "quadrature_step": settings["quadrature_step"],
         "weight_panel_nodes": settings["weight_panel_nodes"],
+        "settings": settings,
+        "speed_bins": snakemake.params.speed_bins,
         "code": snakemake.params.code,
         "normalisation": "momentum balance M_2 = r / (1 + r)",
     }

@@ -32,5 +32,9 @@ with job_log(snakemake.log[0]):
         plotting.flight_time_figure(panels),
         *snakemake.output,
         snakemake.params.dpi,
-        {"figure": snakemake.rule, "inputs": list(snakemake.input)},
+        {
+            "figure": snakemake.rule,
+            "inputs": list(snakemake.input),
+            "params": dict(snakemake.params.items()),
+        },
     )

@@ -28,5 +28,9 @@ with job_log(snakemake.log[0]):
         plotting.return_speed_figure(panels, snakemake.params.outgoing_speeds),
         *snakemake.output,
         snakemake.params.dpi,
-        {"figure": snakemake.rule, "inputs": list(snakemake.input)},
+        {
+            "figure": snakemake.rule,
+            "inputs": list(snakemake.input),
+            "params": dict(snakemake.params.items()),
+        },
     )

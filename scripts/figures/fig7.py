@@ -29,5 +29,9 @@ with job_log(snakemake.log[0]):
         figure,
         *snakemake.output,
         snakemake.params.dpi,
-        {"figure": snakemake.rule, "inputs": list(snakemake.input)},
+        {
+            "figure": snakemake.rule,
+            "inputs": list(snakemake.input),
+            "params": dict(snakemake.params.items()),
+        },
     )

@@ -23,5 +23,9 @@ with job_log(snakemake.log[0]):
         plotting.joint_distribution_figure(panels),
         *snakemake.output,
         snakemake.params.dpi,
-        {"figure": snakemake.rule, "inputs": list(snakemake.input)},
+        {
+            "figure": snakemake.rule,
+            "inputs": list(snakemake.input),
+            "params": dict(snakemake.params.items()),
+        },
     )

@@ -22,5 +22,9 @@ with job_log(snakemake.log[0]):
         plotting.position_density_figure(panels),
         *snakemake.output,
         snakemake.params.dpi,
-        {"figure": snakemake.rule, "inputs": list(snakemake.input)},
+        {
+            "figure": snakemake.rule,
+            "inputs": list(snakemake.input),
+            "params": dict(snakemake.params.items()),
+        },
     )

@@ -8,6 +8,7 @@ import yaml
 from workflow_support import REPOSITORY
 
 from bouncing_ball.config import (
+    MEMORY_BUDGET,
     batch_ranges,
     check_config,
     overlay_per_restitution,
@@ -16,6 +17,7 @@ from bouncing_ball.config import (
     shard_count,
     shard_settings,
     simulation_settings,
+    study_runs,
 )
 from bouncing_ball.restitution import parse_restitution, restitution_grid, restitution_label
 from bouncing_ball.settings import MAX_STEPS_LIMIT
@@ -88,9 +90,6 @@ def test_bad_bins_and_overrides_named():
     bad["simulation"]["per_restitution"] = {"1.5": {"shards": 2}}
     with pytest.raises(ValueError, match="per_restitution.1.5"):
         check_config(bad)
-
-
-# ---- issue 15: what a real user's config got through before ----
 
 
 @pytest.mark.parametrize("value", [0.9999995, 0.9999999, "9999999/10000000"])
@@ -210,3 +209,110 @@ def test_shards_are_batched_into_jobs_and_more_shards_keep_the_full_batches():
     config["simulation"]["per_restitution"]["0.75"]["shards_per_job"] = 1  # e.g. a cluster
     assert shard_batches(config, "0.75") == [(k, k) for k in range(64)]
     assert len(shard_batches(config, "0.25")) == 4
+
+
+def _small_config():
+    with open(REPOSITORY / ".test" / "config" / "config.yaml") as handle:
+        return yaml.safe_load(handle)
+
+
+def _set(config, key, value):
+    *parents, last = key.split(".")
+    node = config
+    for parent in parents:
+        node = node[parent]
+    node[last] = value
+    return config
+
+
+NAN, INF = float("nan"), float("inf")
+
+
+@pytest.mark.parametrize(
+    "key, value, where",
+    [
+        ("fits.max_bias", NAN, "fits.max_bias"),
+        ("solver.forces.max", INF, "solver.forces.max"),
+        ("solver.positions", [INF], "solver.positions.0"),
+        ("solver.positions", [NAN], "solver.positions.0"),
+        ("exact.positions", [0, NAN], "exact.positions.1"),
+        ("simulation.speed_bins.hi", INF, "simulation.speed_bins.hi"),
+        ("simulation.velocity_bins.hi", INF, "simulation.velocity_bins.hi"),
+        ("simulation.velocity_bins.lo", -INF, "simulation.velocity_bins.lo"),
+        ("figures.return_speeds", [NAN], "figures.return_speeds.0"),
+        ("simulation.shard_time", INF, "simulation.shard_time"),
+        ("simulation.criterion_c", INF, "simulation.criterion_c"),
+        ("simulation.equilibration_time", NAN, "simulation.equilibration_time"),
+        (
+            "simulation.per_restitution",
+            {"0.5": {"shard_time": INF}},
+            "simulation.per_restitution.0.5",
+        ),
+        ("restitution", [0.5, NAN], "restitution.1"),
+        ("fits.small_speed_window", {"min": 1.0e-3, "max": INF}, "fits.small_speed_window.max"),
+    ],
+)
+def test_a_number_that_is_not_finite_is_refused_naming_the_key(key, value, where):
+    config = _set(_small_config(), key, value)
+    with pytest.raises(ValueError, match=rf"config: {where}.*is not a finite number"):
+        check_config(config, _schema())
+
+
+@pytest.mark.parametrize(
+    "key, value, message",
+    [
+        ("figures.return_speeds", [1.0e6], r"figures.return_speeds\[0\]: u = 1000000.0 is outside"),
+        ("figures.return_speeds", [0.3, 0.31], r"figures.return_speeds\[1\]: .*speed bin of"),
+        ("solver.positions", [0, 1.0e-4], r"solver.positions\[1\]: x = 0.0001 is outside"),
+        ("solver.positions", [0, 2.0e3], r"solver.positions\[1\]: x = 2000.0 is outside"),
+        ("solver.positions", [0, 0.1, 0.1], r"solver.positions\[2\]: x = 0.1 repeats .*\[1\]"),
+        ("exact.positions", [0, 0.1, 0], r"exact.positions\[2\]: x = 0 repeats .*\[0\]"),
+    ],
+)
+def test_what_a_figure_compares_with_the_simulation_lies_inside_its_bins(key, value, message):
+    config = _set(_small_config(), key, value)
+    with pytest.raises(ValueError, match=message):
+        check_config(config, _schema())
+
+
+@pytest.mark.parametrize(
+    "key, value, message",
+    [
+        ("solver.position_grid.points", 10_000_000, "solver.position_grid.points: .*maximum"),
+        ("solver.position_grid.points", 90_000, "solver.position_grid: 90000 points would need"),
+        ("solver.flight_times.points", 10_000, "solver.flight_times: 10000 points would need"),
+        ("solver.restitution_grid.points", 100_000_000, "solver.restitution_grid.points: "),
+        ("theory.restitution_grid.points", 100_000_000, "theory.restitution_grid.points: "),
+        ("exact.position_grid.points", 10_000_000, "exact.position_grid.points: "),
+        ("simulation.velocity_bins.width", 1.0e-7, "simulation.velocity_bins and simulation.pos"),
+        ("simulation.velocity_bins.width", 1.0e-4, "simulation.velocity_bins and simulation.pos"),
+        ("simulation.speed_bins.per_decade", 5000, r"simulation.speed_bins \(squared"),
+        ("simulation.shards", 10**9, "simulation.shards: .*maximum"),
+        (
+            "simulation.per_restitution",
+            {"0.5": {"shards": 200_000, "shards_per_job": 1000}},
+            r"per_restitution.0.5 \(200000 shards",
+        ),
+    ],
+)
+def test_settings_that_need_more_memory_than_a_job_may_use_are_refused(key, value, message):
+    config = _set(_small_config(), key, value)
+    with pytest.raises(ValueError, match=message):
+        check_config(config, _schema())
+
+
+def test_the_memory_budget_leaves_room_for_the_default_and_the_quick_configs():
+    check_config(_default_config(), _schema())
+    check_config(_small_config(), _schema())
+    config = _set(_small_config(), "simulation.velocity_bins.width", 0.01)  # 25 times finer
+    config["simulation"]["shards"] = 64
+    check_config(config, _schema())
+    assert MEMORY_BUDGET == 2 * 2**30
+
+
+def test_a_study_whose_bins_need_more_memory_than_a_job_may_use_is_refused():
+    studies = read_yaml(REPOSITORY / "config" / "studies.yaml")
+    study_runs(copy.deepcopy(studies), _default_config())
+    studies["r075"]["simulation"] = {"velocity_bins": {"lo": -24, "hi": 20, "width": 1.0e-3}}
+    with pytest.raises(ValueError, match=r"velocity_bins .*the shards of r075 \(run c3\)"):
+        study_runs(studies, _default_config())

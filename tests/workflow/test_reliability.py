@@ -1,6 +1,8 @@
 """Interrupted runs, corrupt files and reruns: the workflow recovers and the numbers do not change."""
 
+import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -10,9 +12,10 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pyarrow.parquet as pq
 import pytest
 import yaml
-from workflow_support import SMALL, copy_repository, snakemake
+from workflow_support import SMALL, copy_repository, planned_jobs, snakemake
 
 from bouncing_ball.io import read_table
 
@@ -206,14 +209,16 @@ def test_extreme_r_runs_end_to_end_within_its_budget(tmp_path):
 
 
 def test_every_reader_refuses_a_table_of_the_wrong_kind_or_r(finished_run, tmp_path):
-    """A table of the wrong kind gave a raw AttributeError; the r = 1/3 solver curve under
-    the r = 1/2 simulation would be a wrong comparison: each reader names the file."""
+    """A table of the wrong kind, or the r = 1/3 solver's tables under the r = 1/2 label (a
+    copy, a symlink): each reader names the file instead of drawing a wrong comparison."""
     directory = tmp_path / "copy"
     shutil.copytree(finished_run, directory)
     results = directory / "results"
     shutil.copy(results / "solver/r0.5/p0v.parquet", results / "theory/exponents.parquet")
     shutil.copy(results / "solver/r0.333333/p0v.parquet", results / "solver/r0.5/p0v.parquet")
     shutil.copy(results / "solver/r0.5/summary.parquet", results / "exact/r0.5/summary.parquet")
+    (results / "solver/r0.5/summary.parquet").unlink()
+    (results / "solver/r0.5/summary.parquet").symlink_to("../r0.333333/summary.parquet")
     before = {path: path.read_bytes() for path in results.rglob("*.p*")}
     result = snakemake(directory, "--keep-going")
     assert result.returncode != 0
@@ -226,6 +231,9 @@ def test_every_reader_refuses_a_table_of_the_wrong_kind_or_r(finished_run, tmp_p
         "fits/r0.5": "results/solver/r0.5/p0v.parquet: solved for r = 0.333333, not r = 0.5",
         "figures/fig6": "results/exact/r0.5/summary.parquet: not a exact summary table",
         "tables/moments": "results/exact/r0.5/summary.parquet: not a exact summary table",
+        "tables/position_asymptotics": (
+            "results/solver/r0.5/summary.parquet: made for r = 0.333333, not r = 0.5"
+        ),
     }
     for log, message in expected.items():
         text = (directory / "logs" / f"{log}.log").read_text()
@@ -250,8 +258,8 @@ def _longer_shards(config):
 
 
 def test_tables_of_another_config_without_snakemakes_record_are_named(finished_run, tmp_path):
-    """With .snakemake/ gone a changed shard_time gave "Nothing to be done" and kept the
-    old tables: each table's provenance is compared with the config, before any job."""
+    """With .snakemake/ gone Snakemake has no record of the parameters that made a table:
+    each table's provenance is compared with the config, before any job."""
     directory = _copy_with_config(finished_run, tmp_path, _longer_shards)
     planned = subprocess.run(
         [sys.executable, "-m", "snakemake", "--cores", "2", "--dry-run"],
@@ -281,8 +289,8 @@ def test_tables_of_another_config_without_snakemakes_record_are_named(finished_r
 
 
 def test_a_report_of_results_made_with_another_config_is_refused(finished_run, tmp_path):
-    """`snakemake --report` without the run's overlay captioned the overlay's figures
-    with the base config's r."""
+    """`snakemake --report` without the run's overlay: the figures drawn from other tables
+    and the tables made with other settings are named."""
 
     def other_panels(config):
         config["figures"]["fig4"] = ["1/3"]
@@ -297,3 +305,98 @@ def test_a_report_of_results_made_with_another_config_is_refused(finished_run, t
     result = snakemake(directory, "--report", str(tmp_path / "report.html"))
     assert result.returncode != 0
     assert "results/simulation/r0.5/summary.parquet: shard_time = 2000.0" in result.stderr
+
+
+def test_a_report_of_other_solver_exact_and_figure_settings_is_refused(finished_run, tmp_path):
+    """The captions name exact.positions and figures.return_speeds, and the solver's settings
+    shape its tables: each is compared with the provenance of the files the report shows."""
+
+    def other_settings(config):
+        config["exact"]["positions"] = [0, 0.5]
+        config["figures"]["return_speeds"] = [2.0, 5.0]
+        config["solver"]["quadrature_step"] = 0.3
+
+    directory = _copy_with_config(finished_run, tmp_path, other_settings)
+    result = snakemake(directory, "--report", str(tmp_path / "report.html"))
+    message = result.stdout + result.stderr
+    assert result.returncode != 0 and not (tmp_path / "report.html").exists()
+    assert "the report would caption results that are not this config's" in message
+    assert "results/figures/fig11.png: outgoing_speeds = [0.3, 1.0] (config: [2.0, 5.0])" in (
+        message
+    )
+    for table in ("exact/r0.5/distribution", "exact/r0.333333/summary"):
+        assert f"results/{table}.parquet: settings.positions = [0, 0.1] (config: [0, 0.5])" in (
+            message
+        ), table
+    for table in ("solver/r0.333333/p0v", "solver/r0.5/position"):
+        assert f"results/{table}.parquet: settings.quadrature_step = 0.25 (config: 0.3)" in (
+            message
+        ), table
+    assert "results/solver/time_averages.parquet: quadrature_step = 0.25 (config: 0.3)" in message
+    # without Snakemake's record of the parameters, a run names them too (it would keep them)
+    shutil.rmtree(directory / ".snakemake")
+    result = snakemake(directory, "--dry-run")
+    message = result.stdout + result.stderr
+    assert result.returncode != 0
+    assert "results made for another config, which Snakemake has no record of" in message
+    assert "results/solver/r0.5/summary.parquet: settings.quadrature_step = 0.25" in message
+    assert "results/figures/fig11.png: outgoing_speeds = " in message
+
+
+def test_a_report_after_a_run_is_made(finished_run, tmp_path):
+    """`--report-after-run` runs what is missing first (here the theory's table, and the
+    figures drawn from it), then writes the report."""
+    directory = tmp_path / "copy"
+    shutil.copytree(finished_run, directory)
+    (directory / "results/theory/exponents.parquet").unlink()
+    report = tmp_path / "report.html"
+    result = snakemake(directory, "--report", str(report), "--report-after-run")
+    assert result.returncode == 0, result.stderr[-3000:]
+    assert (directory / "results/theory/exponents.parquet").exists()
+    assert "fig11.png" in report.read_text()
+
+
+def _with_provenance(path, **changes):
+    """Rewrite the provenance of a table in place (a copy from another run, as far as the
+    workflow can tell)."""
+    table = pq.read_table(path)
+    metadata = dict(table.schema.metadata)
+    provenance = json.loads(metadata[b"bouncing_ball"]) | changes
+    metadata[b"bouncing_ball"] = json.dumps(provenance).encode()
+    pq.write_table(table.replace_schema_metadata(metadata), path)
+
+
+def test_a_batch_of_another_seed_is_refused_by_the_merge_and_its_advice_works(
+    finished_run, tmp_path
+):
+    directory = tmp_path / "copy"
+    shutil.copytree(finished_run, directory)
+    batch = "results/simulation/r0.5/shards0-1.parquet"
+    _with_provenance(directory / batch, seed=6)
+    target = "results/simulation/r0.5/summary.parquet"
+    result = snakemake(directory, target)
+    assert result.returncode != 0
+    log = (directory / "logs/simulation/r0.5/merge.log").read_text()
+    assert f"{batch}: seed = 6 (config: 5)" in log
+    advice = re.search(r"snakemake --cores 2 --forcerun (.*)", log).group(1).split()
+    assert advice == [batch]
+    result = snakemake(directory, target, "--forcerun", *advice)
+    assert result.returncode == 0, result.stderr[-3000:]
+    for table in ("shards0-1", "summary", "p0v"):
+        got, _ = read_table(directory / f"results/simulation/r0.5/{table}.parquet")
+        expected, _ = read_table(finished_run / f"results/simulation/r0.5/{table}.parquet")
+        pd.testing.assert_frame_equal(got, expected, check_exact=True)
+
+
+def test_a_deleted_batch_file_is_made_again(finished_run, tmp_path):
+    directory = tmp_path / "copy"
+    shutil.copytree(finished_run, directory)
+    batch = "results/simulation/r0.5/shards2-2.parquet"
+    (directory / batch).unlink()
+    assert planned_jobs(directory)["simulate_shards"] == 1
+    result = snakemake(directory, "simulation")
+    assert result.returncode == 0, result.stderr[-3000:]
+    for table in ("shards2-2", "summary"):
+        got, _ = read_table(directory / f"results/simulation/r0.5/{table}.parquet")
+        expected, _ = read_table(finished_run / f"results/simulation/r0.5/{table}.parquet")
+        pd.testing.assert_frame_equal(got, expected, check_exact=True)

@@ -194,6 +194,7 @@ def test_the_report_has_every_figure_and_table_with_its_caption(finished_run, tm
         "Residuals (simulation - solver) / sigma",
         "The time averages of eq. (xandDeltax)",
         "The run held against the exact solutions",
+        "Figs. 6-11 go past it",
     ):
         assert phrase in text, phrase
 
@@ -528,14 +529,21 @@ def test_a_non_canonical_label_is_refused(finished_run):
 @pytest.mark.parametrize(
     "target, message",
     [
-        # the solver's range: it used to write an answer 85% off, or crash (r1e-07)
+        # outside the solver's range
         (
             "results/solver/r0.001/summary.parquet",
             "target results/solver/r0.001: r = '0.001' is outside the solver's range",
         ),
         ("results/fits/r1e-07.parquet", "r = '1e-07' is outside the solver's range"),
-        # a label that rounds to 1 used to be told "use r1", then refused as outside (0, 1)
+        # a label that rounds to 1 (it would read back as r = 1)
         ("results/simulation/r0.9999999/p0v.parquet", "r = '0.9999999' rounds to 1"),
+        # a batch of shards that is not one of the config's (its list of shards: no memory)
+        (
+            "results/simulation/r0.5/shards0-99999999999.parquet",
+            "shards0-99999999999.parquet: not a batch of the config's shards of r = 0.5 "
+            "(simulation.shards and shards_per_job): shards0-1, shards2-2",
+        ),
+        ("results/simulation/r0.5/shards00-1.parquet", "not a batch of the config's shards"),
     ],
 )
 def test_a_target_the_workflow_cannot_answer_is_refused_before_any_job(
@@ -619,7 +627,7 @@ BAD = [
     (_with(["figures", "fig5"], [0.25]), "figures.fig5[0]: r = 0.25 has no exact solution"),
     (_with(["figures", "png_dpi"], 10), "png_dpi"),
     (_with(["figures", "fig6"], [0.5]), "'fig6' was unexpected"),
-    # issue 15: integers that are floats, a step budget beyond the loop's counter
+    # integers that are floats, a step budget beyond the loop's counter
     (_with(["seed"], 1.0), "config: seed: 1.0 is not of type 'integer'"),
     (_with(["simulation", "max_steps"], 1.0e20), "greater than the maximum of 1000000000000000"),
     (
@@ -651,6 +659,35 @@ BAD = [
         _with(["simulation", "per_restitution"], {"0.6000001": {"shards": 3}}),
         "simulation.per_restitution.0.6000001: r = 0.6000001 is not an r of the config",
     ),
+]
+
+
+NAN, INF = float("nan"), float("inf")
+# numbers that are not finite, sizes beyond a job's memory, what a figure would draw wrongly
+BAD += [
+    (_with(["fits", "max_bias"], NAN), "config: fits.max_bias: nan is not a finite number"),
+    (_with(["solver", "forces", "max"], INF), "config: solver.forces.max: inf is not a finite"),
+    (_with(["solver", "positions"], [INF]), "config: solver.positions.0: inf is not a finite"),
+    (_with(["exact", "positions"], [NAN]), "config: exact.positions.0: nan is not a finite"),
+    (_with(["simulation", "shard_time"], INF), "config: simulation.shard_time: inf is not a"),
+    (_with(["simulation", "criterion_c"], INF), "config: simulation.criterion_c: inf is not a"),
+    (_with(["figures", "return_speeds"], [NAN]), "config: figures.return_speeds.0: nan is not"),
+    (_with(["figures", "return_speeds"], [1.0e6]), "figures.return_speeds[0]: u = 1000000.0 is"),
+    (
+        _with(["solver", "position_grid", "points"], 10_000_000),
+        "instance['solver']['position_grid']['points']",
+    ),
+    (_with(["solver", "flight_times", "points"], 20_000), "solver.flight_times: 20000 points"),
+    (
+        _with(["simulation", "velocity_bins", "width"], 1.0e-4),
+        "simulation.velocity_bins and simulation.position_bins: the tallies of a shard have",
+    ),
+    (
+        _with(["solver", "restitution_grid", "points"], 100_000_000),
+        "instance['solver']['restitution_grid']['points']",
+    ),
+    (_with(["solver", "positions"], [0, 1.0e-4]), "solver.positions[1]: x = 0.0001 is outside"),
+    (_with(["solver", "positions"], [0, 0.1, 0]), "solver.positions[2]: x = 0 repeats"),
 ]
 
 
@@ -687,6 +724,8 @@ END_TO_END = [BAD[i] for i in (0, 5, 8, 19)] + [
             "solver.restitution_grid",
             "config: seed",
             "simulation.per_restitution.0.5000001",
+            "config: fits.max_bias: nan",
+            "simulation.velocity_bins and",
         )
     )
 ]

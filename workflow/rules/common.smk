@@ -1,5 +1,6 @@
 # Helpers for every stage: r labels and exact values, per-r settings, shard batches, targets.
 from fractions import Fraction
+from types import SimpleNamespace
 
 from bouncing_ball import source_digest, stages
 from bouncing_ball.config import (
@@ -95,14 +96,33 @@ def batch_files(wildcards):
 
 
 def batch_shards(wildcards):
-    """The shards of a batch file, shards{first}-{last}: first to last, both included."""
+    """The shards of a batch file, shards{first}-{last}: first to last, both included;
+    refused unless it is a batch of the config (``shard_batches``)."""
     first, last = int(wildcards.first), int(wildcards.last)
+    path = f"results/simulation/r{wildcards.r}/shards{wildcards.first}-{wildcards.last}.parquet"
     if last < first:
         raise ValueError(
-            f"results/simulation/r{wildcards.r}/shards{wildcards.first}-{wildcards.last}.parquet: "
-            f"the last shard ({last}) comes before the first ({first})"
+            f"{path}: the last shard ({last}) comes before the first ({first})"
+        )
+    batches = shard_batches(config, wildcards.r)
+    if (first, last) not in batches or wildcards.first != str(first):
+        raise ValueError(
+            f"{path}: not a batch of the config's shards of r = {wildcards.r} "
+            f"(simulation.shards and shards_per_job): "
+            + ", ".join(f"shards{a}-{b}" for a, b in batches[:8])
+            + (", ..." if len(batches) > 8 else "")
         )
     return list(range(first, last + 1))
+
+
+def batch_provenance(label):
+    """What the provenance of every batch file of r = ``label`` records (with its first_shard
+    and last_shard): the seed, the simulation code and the shard settings."""
+    return {
+        "seed": config["seed"],
+        "code": SHARD_CODE,
+        **shard_settings(config, label).as_mapping(),
+    }
 
 
 def batch_time(label, shards):
@@ -139,11 +159,18 @@ SIMULATION_TABLES = (
 
 
 def simulation_targets():
+    """The merged tables and the batch files of every r the config simulates (``restitution``
+    and the figures' r): a deleted batch file is made again even where the tables made from
+    it are up to date."""
     return expand(
         "results/simulation/r{r}/{table}.parquet",
-        r=RESTITUTION,
+        r=KNOWN_RESTITUTION,
         table=SIMULATION_TABLES,
-    )
+    ) + [
+        path
+        for label in KNOWN_RESTITUTION
+        for path in batch_files(SimpleNamespace(r=label))
+    ]
 
 
 def exact_value(wildcards):

@@ -49,6 +49,8 @@ rule merge_shards:
         cpus_per_task=1,
     params:
         restitution=restitution_value,
+        # what every batch file's provenance must record: refused by name otherwise
+        batch=lambda wildcards: batch_provenance(wildcards.r),
         code=code(stages.MERGE, "merge_shards.py"),
     script:
         "../../scripts/merge_shards.py"

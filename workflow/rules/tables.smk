@@ -90,6 +90,7 @@ rule position_asymptotics:
         mem_mb=500,
         cpus_per_task=1,
     params:
+        labels=list(RESTITUTION),  # of the inputs, in their order
         code=code(stages.COMPARISON, "position_asymptotics.py"),
     script:
         "../../scripts/position_asymptotics.py"

@@ -41,6 +41,8 @@ rule fit:
     params:
         restitution=restitution_value,
         settings=config["fits"],
+        # what every batch file's provenance must record (common.smk)
+        batch=lambda wildcards: batch_provenance(wildcards.r),
         code=code(stages.FITS, "fit.py"),
     script:
         "../../scripts/fit.py"
