@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from bouncing_ball.io import read_table
+from bouncing_ball.workflow.io import read_table
 
 # what the small test config (.test/config/config.yaml: r = 1/2 with 3 shards, 1/3 with 2,
 # at most 2 per job: batches 0-1 and 2-2 of r = 1/2, 0-1 of r = 1/3) submits

@@ -63,7 +63,7 @@ PAPER_CRITERION_C = 5.0
 def _default_shard_settings():
     """The default config's shard settings (c, the delta rule, the bins), with a short
     equilibration and no step budget to speak of."""
-    from bouncing_ball.config import read_config, shard_settings
+    from bouncing_ball.workflow.config import read_config, shard_settings
 
     config = read_config(REPOSITORY / "config" / "config.yaml")
     return shard_settings(config, "0.5").replace(equilibration_time=100.0, max_steps=10**13)
@@ -404,7 +404,7 @@ def distribution_benchmark():
     return-speed tables (bouncing_ball.flight_time)."""
     from bouncing_ball import distribution, flight_time, solver
     from bouncing_ball.bins import linear_grid, log_bins, log_grid
-    from bouncing_ball.config import read_config
+    from bouncing_ball.workflow.config import read_config
 
     config = read_config(REPOSITORY / "config" / "config.yaml")
     grids = config["solver"]

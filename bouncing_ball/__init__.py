@@ -53,20 +53,25 @@ def __dir__():
 
 
 def source_digest(modules=None, files=()) -> str:
-    """A short hash of the source of the named modules of this package (all if None),
-    and of ``files`` (a rule's script).
+    """A short hash of the source of the named modules of this package (all if None), dotted
+    below it (``"solver"``, ``"workflow.io"``), and of ``files`` (a rule's script).
 
     The workflow passes it to its rules as a parameter, so that editing the
     code behind a stage re-runs that stage and nothing else, and touching a
     file without changing it re-runs nothing.
     """
     names = (
-        sorted(path.stem for path in PACKAGE.glob("*.py")) if modules is None else sorted(modules)
+        sorted(
+            ".".join(path.relative_to(PACKAGE).with_suffix("").parts)
+            for path in PACKAGE.rglob("*.py")
+        )
+        if modules is None
+        else sorted(modules)
     )
     digest = hashlib.sha256()
     for name in names:
         digest.update(name.encode())
-        digest.update((PACKAGE / f"{name}.py").read_bytes())
+        digest.update(PACKAGE.joinpath(*name.split(".")).with_suffix(".py").read_bytes())
     for path in files:
         digest.update(Path(path).name.encode())
         digest.update(Path(path).read_bytes())

@@ -7,10 +7,6 @@ for v -> infinity, eqs. (asym3)-(asym6).
 import numpy as np
 import pandas as pd
 
-from . import stages
-
-SOURCES = stages.THEORY  # what decides the theory table
-
 # eq. (rc): beta(r_c) = 2
 CRITICAL_RESTITUTION = float(np.exp(-np.pi / np.sqrt(3.0)))
 

@@ -10,11 +10,9 @@ from fractions import Fraction
 import numpy as np
 import pandas as pd
 
-from . import exact, stages
+from . import exact
 from .fits import LARGE_SPEED, SMALL_SPEED, bin_averages_of_curve, usable_curve
 from .histograms import outgoing_speed_density
-
-SOURCES = stages.COMPARISON
 
 # the time averages of eq. (xandDeltax)
 QUANTITIES = ("mean_x", "delta_x", "collision_rate")

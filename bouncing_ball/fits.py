@@ -40,13 +40,9 @@ import pandas as pd
 from scipy import optimize, special  # not scipy.stats: half a second to import, in every job
 from scipy.interpolate import CubicSpline
 
-from . import stages
 from .asymptotics import large_speed_decay_rate, large_speed_exponent, small_speed_exponent
 from .bins import outgoing_speed_bin_average
 from .histograms import outgoing_speed_density
-
-# the modules whose code decides a fit table (see ``source_digest``)
-SOURCES = stages.FITS
 
 SMALL_SPEED = "small_speed"
 LARGE_SPEED = "large_speed"

@@ -10,11 +10,7 @@ variance of a rate with the shards' martingale control variates.
 import numpy as np
 import pandas as pd
 
-from . import stages
 from .tallies import CONTROL_VARIATE_SUMS, ShardTallies, merge_shards
-
-# the modules whose code decides the merged tables (see ``source_digest``)
-SOURCES = stages.MERGE
 
 
 def jackknife(estimator, *per_shard):

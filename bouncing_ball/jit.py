@@ -3,7 +3,7 @@
 ``cache=True`` checks only the file that holds a compiled function, not the
 files it calls into: after an edit of free_flight.py a cached simulation loop
 would silently keep the old code.  So the cache folder is keyed on the source
-of every module numba compiles (``stages.COMPILED``: an edit of plotting.py
+of every module numba compiles (``COMPILED``: an edit of plotting.py
 does not recompile), inside numba's own cache folder or, where the user set
 NUMBA_CACHE_DIR, inside that one.  Only the compiled
 modules import this, so importing the package (as the workflow does to plan a
@@ -34,7 +34,7 @@ from pathlib import Path
 import numba
 from numba.core.caching import FunctionCache
 
-from . import PACKAGE, source_digest, stages
+from . import PACKAGE, source_digest
 
 KEEP_CACHES = 3
 PRUNE_AFTER_SECONDS = 3600.0
@@ -121,9 +121,14 @@ def njit(*args, **options):
     return compile_lazily
 
 
+# what numba compiles: the modules with compiled functions and what those call into or read
+# constants from (the key of numba's cache folder, bouncing_ball.jit); an edit elsewhere does
+# not recompile
+COMPILED = ("distribution", "free_flight", "jit", "kernel", "simulation", "tallies")
+
 _preferred = Path(numba.config.CACHE_DIR) if numba.config.CACHE_DIR else PACKAGE / "__pycache__"
 _base = writable_cache_base(_preferred, user_cache_folder())
-CACHE = _base / f"numba-{source_digest(stages.COMPILED)}"
+CACHE = _base / f"numba-{source_digest(COMPILED)}"
 numba.config.CACHE_DIR = str(CACHE)
 with contextlib.suppress(OSError):  # not there yet, or not ours to touch (a read-only cache)
     os.utime(CACHE)  # in use: the newest to keep

@@ -89,9 +89,9 @@ def _whole_number(value, name, least):
 
 def _run_shard(restitution, seed, label, shard, settings):
     """One shard on its own stream (a module-level function: picklable for spawned workers)."""
-    from .batches import simulate_batch
+    from .simulation import shard_seed_sequence, simulate_shard  # numba: only where it runs
 
-    return next(simulate_batch(restitution, seed, label, [shard], settings))
+    return shard, simulate_shard(restitution, shard_seed_sequence(seed, label, shard), settings)
 
 
 class _Progress:
@@ -354,7 +354,7 @@ class SimulationResult:
     def batch_frame(self):
         """The shards as one table in the workflow's batch format (``batches.batch_to_frame``;
         ``results/simulation/r{r}/shards{first}-{last}.parquet``)."""
-        from .batches import batch_to_frame
+        from .workflow.batches import batch_to_frame
 
         return batch_to_frame(dict(enumerate(self.tallies)))
 

@@ -110,7 +110,6 @@ import math
 
 import numpy as np
 
-from . import stages
 from .free_flight import (
     bridge_sample,
     bridge_speed_squared_given_position,
@@ -134,9 +133,6 @@ from .free_flight import (
 from .jit import njit
 from .settings import ShardSettings
 from .tallies import EARLY_FRACTION, SCALAR_INDEX, ShardTallies, tally_seed_sequence
-
-# the modules whose code decides a shard's numbers (see ``source_digest``)
-SOURCES = stages.SIMULATION
 
 # indices into the scalar tally array of the compiled loop (its layout: tallies.SCALARS)
 _TIME = SCALAR_INDEX["time"]

@@ -55,13 +55,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import linalg, special
 
-from . import stages
 from .asymptotics import large_speed_decay_rate, small_speed_exponent
 from .kernel import kernel_small_u_limit, return_speed_kernel_matrix
 from .restitution import SOLVER_RESTITUTION_RANGE
-
-# the modules whose code decides the solver's numbers
-SOURCES = stages.SOLVER
 
 DEFAULT_STEP = 0.25  # trapezoidal step in s; ~1e-11 relative error at r = 1/2, 1/3
 SQRT_WEIGHT = 1.0  # b in s = ln u + b u^(1/2)

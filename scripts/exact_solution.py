@@ -7,9 +7,9 @@ import pandas as pd
 
 from bouncing_ball import exact
 from bouncing_ball.bins import linear_grid, log_grid
-from bouncing_ball.io import write_tables
-from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
+from bouncing_ball.workflow.io import write_tables
+from bouncing_ball.workflow.jobs import job_log
 
 with job_log(snakemake.log[0]):
     settings, outputs = snakemake.params.settings, snakemake.output

@@ -7,10 +7,10 @@ import numpy as np
 
 from bouncing_ball import fits
 from bouncing_ball.histograms import outgoing_speed_histogram
-from bouncing_ball.io import SOLVER_P0V, UnreadableFileError, read_table, write_table
-from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
-from bouncing_ball.shards import read_shards
+from bouncing_ball.workflow.io import SOLVER_P0V, UnreadableFileError, read_table, write_table
+from bouncing_ball.workflow.jobs import job_log
+from bouncing_ball.workflow.shards import read_shards
 
 with job_log(snakemake.log[0]):
     settings = snakemake.params.settings

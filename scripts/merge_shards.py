@@ -15,11 +15,11 @@ from bouncing_ball.histograms import (
     position_moments_summary,
     return_speed_table,
 )
-from bouncing_ball.io import write_tables
-from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 from bouncing_ball.settings import ShardSettings
-from bouncing_ball.shards import read_shards
+from bouncing_ball.workflow.io import write_tables
+from bouncing_ball.workflow.jobs import job_log
+from bouncing_ball.workflow.shards import read_shards
 
 with job_log(snakemake.log[0]):
     exact = parse_restitution(snakemake.params.restitution)

@@ -6,7 +6,8 @@ there is none) -> results/tables/moments.csv (one row per r and quantity) and mo
 import logging
 
 from bouncing_ball.comparison import moment_rows, moments_markdown, moments_table
-from bouncing_ball.io import (
+from bouncing_ball.restitution import parse_restitution
+from bouncing_ball.workflow.io import (
     EXACT_SUMMARY,
     SIMULATED_SUMMARY,
     SOLVER_SUMMARY,
@@ -14,8 +15,7 @@ from bouncing_ball.io import (
     read_tables_of_one_restitution,
     write_csv_and_markdown,
 )
-from bouncing_ball.jobs import job_log
-from bouncing_ball.restitution import parse_restitution
+from bouncing_ball.workflow.jobs import job_log
 
 with job_log(snakemake.log[0]):
     exact = {}

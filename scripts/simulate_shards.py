@@ -5,11 +5,11 @@ results/studies/{study}/{run}/shard{k}.parquet, a batch of one shard)."""
 import logging
 import time
 
-from bouncing_ball.batches import batch_to_frame, simulate_batch
-from bouncing_ball.io import write_table
-from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 from bouncing_ball.settings import ShardSettings
+from bouncing_ball.workflow.batches import batch_to_frame, simulate_batch
+from bouncing_ball.workflow.io import write_table
+from bouncing_ball.workflow.jobs import job_log
 
 with job_log(snakemake.log[0]):
     exact = parse_restitution(snakemake.params.restitution)

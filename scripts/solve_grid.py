@@ -8,8 +8,8 @@ import pandas as pd
 
 from bouncing_ball import solver
 from bouncing_ball.bins import linear_grid
-from bouncing_ball.io import write_table
-from bouncing_ball.jobs import job_log
+from bouncing_ball.workflow.io import write_table
+from bouncing_ball.workflow.jobs import job_log
 
 COLUMNS = [
     "r",

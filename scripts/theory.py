@@ -5,8 +5,8 @@ import logging
 
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION, exponents_table
 from bouncing_ball.bins import linear_grid
-from bouncing_ball.io import write_table
-from bouncing_ball.jobs import job_log
+from bouncing_ball.workflow.io import write_table
+from bouncing_ball.workflow.jobs import job_log
 
 with job_log(snakemake.log[0]):
     grid = snakemake.params.grid

@@ -13,7 +13,8 @@ from bouncing_ball.comparison import (
     validation_rows,
     validation_table,
 )
-from bouncing_ball.io import (
+from bouncing_ball.restitution import parse_restitution
+from bouncing_ball.workflow.io import (
     FITS,
     SIMULATED_P0V,
     SIMULATED_POSITION,
@@ -21,9 +22,8 @@ from bouncing_ball.io import (
     read_tables_of_one_restitution,
     write_csv_and_markdown,
 )
-from bouncing_ball.jobs import job_log
-from bouncing_ball.restitution import parse_restitution
-from bouncing_ball.shards import read_shards
+from bouncing_ball.workflow.jobs import job_log
+from bouncing_ball.workflow.shards import read_shards
 
 with job_log(snakemake.log[0]):
     rows = []

@@ -7,7 +7,7 @@ them (``DEFAULT_SETTINGS.replace(shard_time=...)``) and keeps the rest.
 
 from workflow_support import REPOSITORY
 
-from bouncing_ball.config import read_config, shard_settings
+from bouncing_ball.workflow.config import read_config, shard_settings
 
 # config/config.yaml's settings at r = 1/2: its speed and position bins (P(0, v); P(x) and
 # <v^2>_x), velocity and flight-time bins, criterion constant c and step rule

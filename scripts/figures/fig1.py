@@ -1,9 +1,9 @@
 """Rule fig1: the exponents beta(r), eq. (asym2), and m(r), eqs. (asym3)-(asym6)."""
 
-from bouncing_ball import plotting
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION
-from bouncing_ball.io import EXPONENTS, read_table
-from bouncing_ball.jobs import job_log
+from bouncing_ball.workflow import plotting
+from bouncing_ball.workflow.io import EXPONENTS, read_table
+from bouncing_ball.workflow.jobs import job_log
 
 with job_log(snakemake.log[0]):
     exponents, _ = read_table(snakemake.input.exponents, EXPONENTS)

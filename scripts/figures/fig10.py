@@ -2,15 +2,15 @@
 law and the solver, with the simulation's flights and the short- and long-time forms, one
 panel per r of figures.fig10."""
 
-from bouncing_ball import plotting
-from bouncing_ball.io import (
+from bouncing_ball.restitution import parse_restitution
+from bouncing_ball.workflow import plotting
+from bouncing_ball.workflow.io import (
     SIMULATED_FLIGHT_TIME,
     SOLVER_FLIGHT_TIME,
     SOLVER_SUMMARY,
     read_tables_of_one_restitution,
 )
-from bouncing_ball.jobs import job_log
-from bouncing_ball.restitution import parse_restitution
+from bouncing_ball.workflow.jobs import job_log
 
 with job_log(snakemake.log[0]):
     panels = []

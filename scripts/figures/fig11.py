@@ -2,14 +2,14 @@
 outgoing-speed bins, against the simulated (outgoing, return) pairs at the r of figures.fig11,
 one panel per speed of figures.return_speeds."""
 
-from bouncing_ball import plotting
-from bouncing_ball.io import (
+from bouncing_ball.restitution import parse_restitution
+from bouncing_ball.workflow import plotting
+from bouncing_ball.workflow.io import (
     SIMULATED_RETURN_SPEED,
     SOLVER_RETURN_SPEED,
     read_tables_of_one_restitution,
 )
-from bouncing_ball.jobs import job_log
-from bouncing_ball.restitution import parse_restitution
+from bouncing_ball.workflow.jobs import job_log
 
 with job_log(snakemake.log[0]):
     panels = []

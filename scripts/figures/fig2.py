@@ -1,8 +1,8 @@
 """Rule fig2: the decay rate q(r), eqs. (asym4) and (asym6)."""
 
-from bouncing_ball import plotting
-from bouncing_ball.io import EXPONENTS, read_table
-from bouncing_ball.jobs import job_log
+from bouncing_ball.workflow import plotting
+from bouncing_ball.workflow.io import EXPONENTS, read_table
+from bouncing_ball.workflow.jobs import job_log
 
 with job_log(snakemake.log[0]):
     exponents, _ = read_table(snakemake.input.exponents, EXPONENTS)

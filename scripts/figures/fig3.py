@@ -1,10 +1,10 @@
 """Rule fig3: the exact P(x, v) against v at the heights of exact.positions, one panel per
 r (1/2, 1/3), eqs. (fpsol), (psi), (weightfunc2), (constants)."""
 
-from bouncing_ball import plotting
-from bouncing_ball.io import EXACT_DISTRIBUTION, read_table
-from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import parse_restitution
+from bouncing_ball.workflow import plotting
+from bouncing_ball.workflow.io import EXACT_DISTRIBUTION, read_table
+from bouncing_ball.workflow.jobs import job_log
 
 with job_log(snakemake.log[0]):
     panels = []

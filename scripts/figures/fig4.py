@@ -1,10 +1,15 @@
 """Rule fig4: simulated P(0, v) with the asymptotic forms (prefactors fitted to the
 simulation) and the solver's curve, one panel per r of figures.fig4."""
 
-from bouncing_ball import plotting
-from bouncing_ball.io import FITS, SIMULATED_P0V, SOLVER_P0V, read_tables_of_one_restitution
-from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import parse_restitution
+from bouncing_ball.workflow import plotting
+from bouncing_ball.workflow.io import (
+    FITS,
+    SIMULATED_P0V,
+    SOLVER_P0V,
+    read_tables_of_one_restitution,
+)
+from bouncing_ball.workflow.jobs import job_log
 
 with job_log(snakemake.log[0]):
     panels = []

@@ -1,10 +1,10 @@
 """Rule fig5: simulated P(0, v) against the exact solution, eqs. (P(0,v)) and (constants),
 with no adjustable parameter, one panel per r of figures.fig5 (1/2, 1/3)."""
 
-from bouncing_ball import plotting
-from bouncing_ball.io import EXACT_P0V, SIMULATED_P0V, read_tables_of_one_restitution
-from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import parse_restitution
+from bouncing_ball.workflow import plotting
+from bouncing_ball.workflow.io import EXACT_P0V, SIMULATED_P0V, read_tables_of_one_restitution
+from bouncing_ball.workflow.jobs import job_log
 
 with job_log(snakemake.log[0]):
     panels = []

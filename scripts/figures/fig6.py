@@ -4,10 +4,10 @@ values at r = 1/2, 1/3."""
 
 import pandas as pd
 
-from bouncing_ball import plotting
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION
-from bouncing_ball.io import EXACT_SUMMARY, SIMULATED_SUMMARY, TIME_AVERAGES, read_table
-from bouncing_ball.jobs import job_log
+from bouncing_ball.workflow import plotting
+from bouncing_ball.workflow.io import EXACT_SUMMARY, SIMULATED_SUMMARY, TIME_AVERAGES, read_table
+from bouncing_ball.workflow.jobs import job_log
 
 
 def rows(paths, kind):

@@ -3,11 +3,11 @@ one row per simulated r; the solver enters as its average over each bin."""
 
 import logging
 
-from bouncing_ball import plotting
 from bouncing_ball.comparison import outgoing_speed_residuals
-from bouncing_ball.io import SIMULATED_P0V, SOLVER_P0V, read_tables_of_one_restitution
-from bouncing_ball.jobs import job_log
 from bouncing_ball.restitution import parse_restitution
+from bouncing_ball.workflow import plotting
+from bouncing_ball.workflow.io import SIMULATED_P0V, SOLVER_P0V, read_tables_of_one_restitution
+from bouncing_ball.workflow.jobs import job_log
 
 with job_log(snakemake.log[0]):
     panels = []

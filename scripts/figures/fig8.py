@@ -2,14 +2,14 @@
 solver.positions from the solver, with the simulation's cells and the exact curve at r = 1/2,
 1/3, one panel per r of figures.fig8."""
 
-from bouncing_ball import plotting
-from bouncing_ball.io import (
+from bouncing_ball.workflow import plotting
+from bouncing_ball.workflow.io import (
     EXACT_DISTRIBUTION,
     SIMULATED_DISTRIBUTION,
     SOLVER_DISTRIBUTION,
     comparison_panels,
 )
-from bouncing_ball.jobs import job_log
+from bouncing_ball.workflow.jobs import job_log
 
 with job_log(snakemake.log[0]):
     inputs = snakemake.input

@@ -1,14 +1,14 @@
 """Rule fig9 (past the paper): P(x) for every r of restitution: the solver through w(F), the
 simulation and the exact eq. (P(x)2) at r = 1/2, 1/3."""
 
-from bouncing_ball import plotting
-from bouncing_ball.io import (
+from bouncing_ball.workflow import plotting
+from bouncing_ball.workflow.io import (
     EXACT_POSITION,
     SIMULATED_POSITION,
     SOLVER_POSITION,
     comparison_panels,
 )
-from bouncing_ball.jobs import job_log
+from bouncing_ball.workflow.jobs import job_log
 
 with job_log(snakemake.log[0]):
     inputs = snakemake.input

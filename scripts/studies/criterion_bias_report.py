@@ -3,9 +3,9 @@ r = 1/2 and 1/3 results, with its cost -> results/studies/criterion_bias.{csv,md
 
 import logging
 
-from bouncing_ball.io import write_csv_and_markdown
-from bouncing_ball.jobs import job_log
-from bouncing_ball.studies import (
+from bouncing_ball.workflow.io import write_csv_and_markdown
+from bouncing_ball.workflow.jobs import job_log
+from bouncing_ball.workflow.studies import (
     criterion_bias_markdown,
     criterion_bias_row,
     criterion_bias_table,

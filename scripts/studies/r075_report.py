@@ -5,14 +5,14 @@ import logging
 
 import pandas as pd
 
-from bouncing_ball.io import (
+from bouncing_ball.workflow.io import (
     SOLVER_SUMMARY,
     UnreadableFileError,
     read_table,
     write_csv_and_markdown,
 )
-from bouncing_ball.jobs import job_log
-from bouncing_ball.studies import r075_markdown, r075_rows, read_runs
+from bouncing_ball.workflow.jobs import job_log
+from bouncing_ball.workflow.studies import r075_markdown, r075_rows, read_runs
 
 with job_log(snakemake.log[0]):
     runs = snakemake.params.runs

@@ -7,7 +7,9 @@ import pytest
 import yaml
 from workflow_support import REPOSITORY
 
-from bouncing_ball.config import (
+from bouncing_ball.restitution import parse_restitution, restitution_grid, restitution_label
+from bouncing_ball.settings import MAX_STEPS_LIMIT
+from bouncing_ball.workflow.config import (
     MEMORY_BUDGET,
     batch_ranges,
     check_config,
@@ -19,8 +21,6 @@ from bouncing_ball.config import (
     simulation_settings,
     study_runs,
 )
-from bouncing_ball.restitution import parse_restitution, restitution_grid, restitution_label
-from bouncing_ball.settings import MAX_STEPS_LIMIT
 
 
 def test_labels_follow_the_design():

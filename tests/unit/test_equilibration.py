@@ -10,7 +10,6 @@ import yaml
 from workflow_support import REPOSITORY
 
 from bouncing_ball.bins import LinearBins, LogBins
-from bouncing_ball.config import check_config, read_yaml, shard_settings
 from bouncing_ball.equilibration import (
     QUANTITIES,
     early_check,
@@ -19,6 +18,7 @@ from bouncing_ball.equilibration import (
     window_estimates,
 )
 from bouncing_ball.tallies import EARLY_FRACTION, ShardTallies
+from bouncing_ball.workflow.config import check_config, read_yaml, shard_settings
 
 BINS = SimpleNamespace(
     speed_bins=LogBins(1e-2, 1e1, 2),

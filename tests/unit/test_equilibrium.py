@@ -13,9 +13,9 @@ from scipy import integrate
 from workflow_support import TEST_CONFIG
 
 import bouncing_ball as bb
-from bouncing_ball.batches import batch_to_frame, simulate_batch
-from bouncing_ball.config import read_config, shard_settings
 from bouncing_ball.restitution import SOLVER_RESTITUTION_RANGE
+from bouncing_ball.workflow.batches import batch_to_frame, simulate_batch
+from bouncing_ball.workflow.config import read_config, shard_settings
 
 EXACT = ["1/2", "1/3"]
 TOLERANCE = 1e-8

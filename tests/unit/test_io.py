@@ -6,7 +6,7 @@ import stat
 import pandas as pd
 import pytest
 
-from bouncing_ball.io import (
+from bouncing_ball.workflow.io import (
     EXPONENTS,
     UnreadableFileError,
     atomic_paths,

@@ -5,7 +5,7 @@ import subprocess
 import sys
 import time
 
-from bouncing_ball import PACKAGE, jit, source_digest, stages
+from bouncing_ball import PACKAGE, jit, source_digest
 
 
 def _folder(base, name, age_seconds):
@@ -19,8 +19,8 @@ def _folder(base, name, age_seconds):
 
 def test_the_cache_folder_is_named_after_the_compiled_source_only():
     """An edit of plotting.py (not compiled) keeps the cache; one of free_flight.py does not."""
-    assert jit.CACHE.name == f"numba-{source_digest(stages.COMPILED)}"
-    assert "plotting" not in stages.COMPILED and "free_flight" in stages.COMPILED
+    assert jit.CACHE.name == f"numba-{source_digest(jit.COMPILED)}"
+    assert "plotting" not in jit.COMPILED and "free_flight" in jit.COMPILED
 
 
 def test_old_cache_folders_are_pruned_keeping_the_newest_and_the_recent(tmp_path):
@@ -47,14 +47,14 @@ def test_pruning_keeps_a_recently_used_folder_beyond_the_count(tmp_path):
 
 
 def test_every_module_with_compiled_code_keys_the_cache():
-    """A module that numba compiles (an @njit function) must be in stages.COMPILED, else an
+    """A module that numba compiles (an @njit function) must be in jit.COMPILED, else an
     edit of it would be served stale code from the cache."""
     compiled = {
         path.stem
         for path in PACKAGE.glob("*.py")
         if "@njit" in path.read_text() or "njit(" in path.read_text()
     }
-    assert compiled - {"jit"} and compiled <= set(stages.COMPILED)
+    assert compiled - {"jit"} and compiled <= set(jit.COMPILED)
 
 
 CACHED_MODULE = """

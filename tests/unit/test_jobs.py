@@ -5,8 +5,12 @@ import logging
 import pandas as pd
 import pytest
 
-from bouncing_ball.io import UnreadableFileError, read_tables_of_one_restitution, write_table
-from bouncing_ball.jobs import job_log
+from bouncing_ball.workflow.io import (
+    UnreadableFileError,
+    read_tables_of_one_restitution,
+    write_table,
+)
+from bouncing_ball.workflow.jobs import job_log
 
 
 def test_a_failing_job_leaves_its_traceback_in_its_log(tmp_path):

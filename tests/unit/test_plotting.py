@@ -6,8 +6,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bouncing_ball import exact, plotting
+from bouncing_ball import exact
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION, exponents_table
+from bouncing_ball.workflow import plotting
 
 
 @pytest.fixture(scope="module")

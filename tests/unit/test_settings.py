@@ -5,8 +5,8 @@ import yaml
 from workflow_support import REPOSITORY
 
 from bouncing_ball.bins import LogBins
-from bouncing_ball.config import read_config, shard_settings
 from bouncing_ball.settings import ShardSettings
+from bouncing_ball.workflow.config import read_config, shard_settings
 
 
 def _default():

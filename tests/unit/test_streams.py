@@ -4,12 +4,12 @@ shards are grouped into jobs."""
 import numpy as np
 from conftest import DEFAULT_SETTINGS
 
-from bouncing_ball.batches import batch_to_frame, simulate_batch
 from bouncing_ball.histograms import position_moments_summary
-from bouncing_ball.io import write_table
-from bouncing_ball.shards import read_shards
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 from bouncing_ball.tallies import tallies_to_frame
+from bouncing_ball.workflow.batches import batch_to_frame, simulate_batch
+from bouncing_ball.workflow.io import write_table
+from bouncing_ball.workflow.shards import read_shards
 
 SETTINGS = DEFAULT_SETTINGS.replace(shard_time=500.0, equilibration_time=10.0, criterion_c=5.0)
 

@@ -1,5 +1,5 @@
-"""The studies' analysis (bouncing_ball.studies) on hand-computed cases, and their config
-(bouncing_ball.config.study_runs)."""
+"""The studies' analysis (bouncing_ball.workflow.studies) on hand-computed cases, and their config
+(bouncing_ball.workflow.config.study_runs)."""
 
 import copy
 from dataclasses import replace
@@ -11,10 +11,10 @@ import pytest
 import yaml
 from workflow_support import REPOSITORY, SMALL
 
-from bouncing_ball import studies
 from bouncing_ball.bins import LinearBins, LogBins
-from bouncing_ball.config import shard_settings, study_runs
 from bouncing_ball.tallies import ShardTallies
+from bouncing_ball.workflow import studies
+from bouncing_ball.workflow.config import shard_settings, study_runs
 
 BINS = LogBins(1.0, 10.0, 1)
 STUDIES = yaml.safe_load((REPOSITORY / "config" / "studies.yaml").read_text())

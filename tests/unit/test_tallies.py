@@ -9,7 +9,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from benchmarks import reference_loop
-from bouncing_ball.batches import batch_to_frame
 from bouncing_ball.bins import LinearBins, LogBins
 from bouncing_ball.histograms import (
     distribution_histogram,
@@ -19,9 +18,7 @@ from bouncing_ball.histograms import (
     position_moments_summary,
     return_speed_table,
 )
-from bouncing_ball.io import UnreadableFileError, read_table, write_table
 from bouncing_ball.settings import ShardSettings
-from bouncing_ball.shards import read_shards
 from bouncing_ball.tallies import (
     CONTROL_VARIATE_SUMS as CONTROL_VARIATES,
 )
@@ -32,6 +29,9 @@ from bouncing_ball.tallies import (
     tallies_from_frame,
     tallies_to_frame,
 )
+from bouncing_ball.workflow.batches import batch_to_frame
+from bouncing_ball.workflow.io import UnreadableFileError, read_table, write_table
+from bouncing_ball.workflow.shards import read_shards
 
 SPEED_BINS = LogBins(1e-2, 1e1, 2)
 POSITION_BINS = LogBins(1e-1, 1e2, 1)
@@ -189,7 +189,7 @@ def test_outgoing_speed_density_counts_rate_over_bin():
 
 
 def test_truncated_file_gives_an_error_that_names_it(tmp_path):
-    from bouncing_ball.io import UnreadableFileError
+    from bouncing_ball.workflow.io import UnreadableFileError
 
     path = tmp_path / "shard3.parquet"
     write_table(

@@ -7,8 +7,8 @@ import pytest
 from workflow_support import SMALL, copy_repository, snakemake
 
 import bouncing_ball as bb
-from bouncing_ball.io import read_table
 from bouncing_ball.restitution import parse_restitution, restitution_label
+from bouncing_ball.workflow.io import read_table
 
 R = SMALL["restitution"][0]
 LABEL = restitution_label(parse_restitution(R))

@@ -17,7 +17,7 @@ import pytest
 import yaml
 from workflow_support import SMALL, copy_repository, planned_jobs, snakemake
 
-from bouncing_ball.io import read_table
+from bouncing_ball.workflow.io import read_table
 
 # three shards of r = 1/2 that each compute for a few seconds, so a job can be killed mid-run
 # (two jobs: shards 0-1 and 2-2, simulation.shards_per_job 2)

@@ -8,7 +8,7 @@ import pytest
 import yaml
 from workflow_support import SMALL, copy_repository, planned_jobs, snakemake
 
-from bouncing_ball.io import read_table
+from bouncing_ball.workflow.io import read_table
 
 # 2-4 shards per run of 1e3-2e3 time units; batches and groups of 2 shards so that every
 # column of the r075 report has a number for run c3 and the pooled runs

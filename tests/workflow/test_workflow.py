@@ -24,8 +24,8 @@ from workflow_support import (
 )
 
 from bouncing_ball.comparison import MOMENT_COLUMNS, VALIDATION_CHECKS, VALIDATION_COLUMNS
-from bouncing_ball.config import check_config, read_yaml
-from bouncing_ball.io import read_table
+from bouncing_ball.workflow.config import check_config, read_yaml
+from bouncing_ball.workflow.io import read_table
 
 
 def test_run_produces_the_documented_tables(finished_run):

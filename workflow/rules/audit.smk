@@ -1,11 +1,11 @@
-# Before any job: do the results on disk belong to this config? (bouncing_ball.audit)
+# Before any job: do the results on disk belong to this config? (bouncing_ball.workflow.audit)
 # Included last: it reads the figure rules' inputs.
 import sys
 from base64 import urlsafe_b64encode
 from pathlib import Path
 from types import SimpleNamespace
 
-from bouncing_ball.audit import (
+from bouncing_ball.workflow.audit import (
     figure_differences,
     older_than_inputs,
     stale_message,

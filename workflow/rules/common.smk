@@ -2,8 +2,9 @@
 from fractions import Fraction
 from types import SimpleNamespace
 
-from bouncing_ball import source_digest, stages
-from bouncing_ball.config import (
+from bouncing_ball import source_digest
+from bouncing_ball.workflow import stages
+from bouncing_ball.workflow.config import (
     check_config,
     exact_settings,
     known_restitutions,
@@ -43,7 +44,7 @@ KNOWN_RESTITUTION = known_restitutions(config)
 
 def code(modules, script):
     """A rule's `code` parameter: a digest of its stage's library modules
-    (bouncing_ball.stages names them without importing them) and of its script, so that
+    (bouncing_ball.workflow.stages names them without importing them) and of its script, so that
     an edit of either re-runs that rule and what depends on it, and a touch (a checkout,
     a branch switch) re-runs nothing: the default profile turns off Snakemake's
     script-mtime trigger."""

@@ -3,7 +3,7 @@
 # run with  snakemake --cores 2 studies
 from snakemake.exceptions import WorkflowError
 
-from bouncing_ball.config import check_types, read_yaml, study_runs
+from bouncing_ball.workflow.config import check_types, read_yaml, study_runs
 
 STUDIES_FILE = "config/studies.yaml"
 try:

@@ -15,8 +15,8 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from . import __version__
-from .restitution import parse_restitution
+from .. import __version__
+from ..restitution import parse_restitution
 
 METADATA_KEY = b"bouncing_ball"
 

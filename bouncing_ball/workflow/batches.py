@@ -14,13 +14,13 @@ column ``shard``.
 import numpy as np
 import pandas as pd
 
-from .tallies import ShardTallies, tallies_from_frame, tallies_to_frame
+from ..tallies import ShardTallies, tallies_from_frame, tallies_to_frame
 
 
 def simulate_batch(restitution: float, seed: int, label: str, shards, settings):
     """Yield ``(shard, tallies)`` for each shard of ``shards`` in turn, each on its own stream
     (pure: no I/O; the caller may time each step)."""
-    from .simulation import shard_seed_sequence, simulate_shard  # numba: only where it runs
+    from ..simulation import shard_seed_sequence, simulate_shard  # numba: only where it runs
 
     for shard in shards:
         yield shard, simulate_shard(restitution, shard_seed_sequence(seed, label, shard), settings)

@@ -8,9 +8,9 @@ importing numba, scipy or matplotlib.
 
 # "bins" also builds the config's grids; "restitution" parses r and makes the labels
 # that key the random streams; "jit" is how the compiled modules are compiled
-# "batches" is how a job's shards are run and stored (one file per job)
+# "workflow.batches" is how a job's shards are run and stored (one file per job)
 SIMULATION = (
-    "batches",
+    "workflow.batches",
     "bins",
     "free_flight",
     "jit",
@@ -20,15 +20,15 @@ SIMULATION = (
     "tallies",
 )
 MERGE = (
-    "audit",
-    "batches",
+    "workflow.audit",
+    "workflow.batches",
     "bins",
     "equilibration",
     "histograms",
-    "io",
+    "workflow.io",
     "restitution",
     "settings",
-    "shards",
+    "workflow.shards",
     "tallies",
 )
 SOLVER = (
@@ -45,52 +45,47 @@ EXACT = ("bins", "exact")
 THEORY = ("asymptotics", "bins")
 FITS = (
     "asymptotics",
-    "audit",
-    "batches",
+    "workflow.audit",
+    "workflow.batches",
     "bins",
     "fits",
     "histograms",
-    "io",
+    "workflow.io",
     "restitution",
     "settings",
-    "shards",
+    "workflow.shards",
     "tallies",
 )
-PLOTTING = ("io", "plotting", "restitution")
-COMPARISON = ("comparison", "fits", "io", "restitution")
+PLOTTING = ("workflow.io", "workflow.plotting", "restitution")
+COMPARISON = ("comparison", "fits", "workflow.io", "restitution")
 # the studies' reports (workflow/rules/studies.smk); their shards are SIMULATION's
 STUDIES = (
-    "audit",
-    "batches",
+    "workflow.audit",
+    "workflow.batches",
     "bins",
     "comparison",
     "exact",
     "fits",
     "histograms",
-    "io",
+    "workflow.io",
     "restitution",
     "settings",
-    "shards",
-    "studies",
+    "workflow.shards",
+    "workflow.studies",
     "tallies",
 )
 # results/tables/validation: the comparison, the exact bin averages, the solver curve's bin
 # averages, and the shards read back for the sign-flip p-values
 VALIDATION = (
-    "batches",
+    "workflow.batches",
     "bins",
     "comparison",
     "exact",
     "fits",
     "histograms",
-    "io",
+    "workflow.io",
     "restitution",
     "settings",
-    "shards",
+    "workflow.shards",
     "tallies",
 )
-
-# what numba compiles: the modules with compiled functions and what those call into or read
-# constants from (the key of numba's cache folder, bouncing_ball.jit); an edit elsewhere does
-# not recompile
-COMPILED = ("distribution", "free_flight", "jit", "kernel", "simulation", "tallies")

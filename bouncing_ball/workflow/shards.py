@@ -1,12 +1,12 @@
 """Reading the shards of one r back from their batch files, with every check a downstream
 step needs (the files: ``batches``)."""
 
-from .asymptotics import CRITICAL_RESTITUTION
+from ..asymptotics import CRITICAL_RESTITUTION
+from ..restitution import parse_restitution
+from ..settings import ShardSettings
 from .audit import differences, stale_message
 from .batches import batch_from_frame
 from .io import UnreadableFileError, read_provenance, read_table
-from .restitution import parse_restitution
-from .settings import ShardSettings
 
 
 def _provenance_shards(path, provenance) -> list[int]:

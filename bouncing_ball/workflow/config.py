@@ -19,8 +19,8 @@ from pathlib import Path
 import jsonschema
 import yaml
 
-from .bins import linear_bins, log_bins
-from .restitution import (
+from ..bins import linear_bins, log_bins
+from ..restitution import (
     EXACT_RESTITUTIONS,
     SOLVER_RESTITUTION_RANGE,
     check_solver_restitution,
@@ -30,8 +30,8 @@ from .restitution import (
     restitution_label,
     shared_label_message,
 )
-from .settings import DEFAULT_FLIGHT_TIME_BINS, DEFAULT_VELOCITY_BINS, ShardSettings
-from .tallies import HISTOGRAMS, HISTOGRAMS_2D
+from ..settings import DEFAULT_FLIGHT_TIME_BINS, DEFAULT_VELOCITY_BINS, ShardSettings
+from ..tallies import HISTOGRAMS, HISTOGRAMS_2D
 
 # the config's schema, in the repository that holds this package
 SCHEMA = Path(__file__).resolve().parents[1] / "workflow" / "schemas" / "config.schema.yaml"
