@@ -108,9 +108,16 @@ _TAU_X, _TAU_W = 0.5 * (_TAU_X + 1.0), 0.5 * _TAU_W
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(PANEL_NODES)
 
 
-# below, on the outgoing side v > 0, the F integral of eq. (fpsol) oscillates too fast for
-# quad (at x = 1e-8, v = 2 it returns a negative density); x = 0 is eq. (bc) and P(0, v)
-SMALLEST_POSITION = 1e-4
+# On the outgoing side v > 0 the Airy factor of the F integral of eq. (fpsol) oscillates; up to
+# F = 60 / x its phase (2/3) F^(1/2) v^(3/2) reaches (2/3) (60 / x)^(1/2) v^(3/2).  quad follows
+# it to ~4e4 (against P(0, v) as x -> 0: 1e-7 at (x, v) = (1e-8, 0.8), (1e-7, 1.7)) and fails
+# beyond (1e-5 wrong at (1e-6, 6), phase 7.6e4; a negative density at (1e-8, 2), phase 1.5e5)
+LARGEST_AIRY_PHASE = 4.0e4
+
+
+def _airy_phase(x, v):
+    """(2/3) (60 / x)^(1/2) v^(3/2): the phase of the Airy factor at the F integral's end."""
+    return (2.0 / 3.0) * np.sqrt(60.0 / x) * np.maximum(v, 0.0) ** 1.5
 
 
 def check_restitution(restitution) -> float:
@@ -617,6 +624,9 @@ class WeightFunction:
     series: tuple  # np.polynomial.Chebyshev per panel, of ln w + S / F against ln F
     small_force_power: float  # gamma in w ~ F^gamma e^(-S/F) as F -> 0
     small_force_series: np.polynomial.Polynomial  # ln w + S/F - gamma ln F against F, F < F_min
+    # the largest |interpolated - direct ln w| at two points of every panel between the nodes:
+    # an estimate of the relative error of w, and so of P(x) (NaN: not estimated)
+    interpolation_error: float = float("nan")
 
     @property
     def smallest_force(self) -> float:
@@ -754,6 +764,15 @@ def interpolated_weight_function(solution, panel_nodes=PANEL_CHEBYSHEV_NODES) ->
         np.polynomial.Chebyshev.fit(yk, vk, panel_nodes - 1, domain=[a, b])
         for yk, vk, a, b in zip(y, values.reshape(y.shape), edges[:-1], edges[1:])
     )
+    # the interpolation error, estimated against w computed directly between the nodes
+    probes = 0.5 * (edges[:-1, None] + edges[1:, None]) + 0.3 * np.diff(edges)[:, None] * np.array(
+        [-1.0, 1.0]
+    )
+    direct = log_weight_function(np.exp(probes.ravel()), solution, density).reshape(probes.shape)
+    direct += decay * np.exp(-probes)
+    interpolated = np.array([piece(yk) for piece, yk in zip(series, probes)])
+    deviation = np.abs(interpolated - direct)
+    error = float(np.max(deviation)) if np.all(np.isfinite(deviation)) else np.inf
     # below F_min: gamma ln F + a polynomial in F, fitted on the first panel
     gamma = small_force_power(solution.restitution)
     f_fit = np.exp(np.linspace(edges[0], edges[1], 40))
@@ -768,6 +787,7 @@ def interpolated_weight_function(solution, panel_nodes=PANEL_CHEBYSHEV_NODES) ->
         series,
         gamma,
         below,
+        error,
     )
 
 
@@ -894,16 +914,17 @@ def _distribution_integrand(log_force, x, v, weight, width=0.0):
 
 def check_force_integral_point(x: float, v: float) -> None:
     """ValueError naming x unless the F integral of eq. (fpsol) converges at (x, v) and quad
-    evaluates it: x >= SMALLEST_POSITION where v > 0 (below, psi_F(-v) oscillates too fast),
-    any x > 0 where v <= 0, and x = 0 only with v < 0."""
+    evaluates it: x > 0 where the phase of psi_F(-v) stays below LARGEST_AIRY_PHASE (any x > 0
+    where v <= 0; x >= 1e-4 up to v = 18), and x = 0 only with v < 0."""
     if not x >= 0.0 or (x == 0.0 and not v < 0.0):
         raise ValueError(
             f"x = {x}: the F integral of eq. (fpsol) needs x > 0, or x = 0 with v < 0 (v = {v})"
         )
-    if 0.0 < x < SMALLEST_POSITION and v > 0.0:
+    if x > 0.0 and _airy_phase(x, v) > LARGEST_AIRY_PHASE:
+        smallest = 60.0 * ((2.0 / 3.0) * v**1.5 / LARGEST_AIRY_PHASE) ** 2
         raise ValueError(
-            f"x = {x}: below x = {SMALLEST_POSITION:g} the F integral of eq. (fpsol) oscillates "
-            f"too fast to evaluate at v = {v} > 0; use x = 0 (P(0, v)) or x >= {SMALLEST_POSITION:g}"
+            f"x = {x}: at v = {v} the F integral of eq. (fpsol) oscillates too fast to evaluate "
+            f"below x = {smallest:.2g}; use x = 0 (P(0, v)) or a larger x"
         )
 
 
@@ -954,10 +975,10 @@ def distribution_cell_average(x_lo, x_hi, v_lo, v_hi, weight, speed_nodes=CELL_S
     )
     if np.any(~(x_lo > 0.0) | ~(x_hi > x_lo) | ~(v_hi > v_lo) | ~np.isfinite(x_hi + v_lo + v_hi)):
         raise ValueError("cells need 0 < x_lo < x_hi < inf and finite v_lo < v_hi")
-    if np.any((x_lo < SMALLEST_POSITION) & (v_hi > 0.0)):
+    if np.any(_airy_phase(x_lo, v_hi) > LARGEST_AIRY_PHASE):
         raise ValueError(
-            f"x_lo: cells reaching v > 0 need x_lo >= {SMALLEST_POSITION:g} (below, the F "
-            "integral of eq. (fpsol) oscillates too fast to evaluate)"
+            "x_lo: a cell reaches an x and v > 0 at which the F integral of eq. (fpsol) "
+            "oscillates too fast to evaluate (check_force_integral_point)"
         )
     nodes, node_weights = np.polynomial.legendre.leggauss(speed_nodes)
     lower = np.log(_total_decay(weight) / 150.0)
@@ -1173,8 +1194,9 @@ def solve_table_defects(summary, tables, target=1e-8) -> list:
     tables : dict of str to pandas.DataFrame
         p0v, flight_time, return_speed, position, distribution, weight.
     target : float
-        The accuracy asked for (``solver.ACCURACY_TARGET``); the moments are held to the larger
-        of it and the summary's accuracy_estimate.
+        The accuracy asked for (``solver.ACCURACY_TARGET``); the moments are held to the largest
+        of it, the summary's accuracy_estimate (of P(0, v)) and its weight_interpolation_error
+        (of w(F), and so of P(x): ``WeightFunction.interpolation_error``).
 
     Checks: no NaN where a value is defined (P(0, 0) is not, nor rho(T) where I is infinite, below
     r_c); int P dx = 1, and <x>, Delta x from P(x) equal the Ito values from P(0, v), within the
@@ -1192,7 +1214,11 @@ def solve_table_defects(summary, tables, target=1e-8) -> list:
     }
     for name, table in tables.items():
         defects += _nan_defects(name, table, allowed.get(name))
-    tolerance = max(target, summary.get("accuracy_estimate", 0.0))
+    tolerance = max(
+        target,
+        summary.get("accuracy_estimate", 0.0),
+        summary.get("weight_interpolation_error", 0.0),
+    )
     for what, value in (
         ("int P dx", summary["position_normalization"]),
         ("<x> from P(x) / <x> from P(0, v)", summary["mean_x_from_position"] / summary["mean_x"]),

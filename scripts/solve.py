@@ -45,6 +45,7 @@ with job_log(snakemake.log[0]):
     row["position_normalization"] = averages["normalization"]
     row["mean_x_from_position"] = averages["mean_x"]
     row["delta_x_from_position"] = averages["delta_x"]
+    row["weight_interpolation_error"] = weight.interpolation_error
     measured = distribution.measured_exponents(weight)
     for key, value in distribution.predicted_exponents(exact).items():
         row[f"{key}_measured"], row[f"{key}_predicted"] = measured[key], value
@@ -101,7 +102,8 @@ with job_log(snakemake.log[0]):
         )
     logging.info(
         "r=%s: w(F), P(x), P(x, v) in %.1f s; from P(x): int P dx - 1 = %.1e, <x> = %.10g, "
-        "Delta x = %.10g (Ito: %.10g, %.10g); P(x, v) quadrature error estimate %.1e; "
+        "Delta x = %.10g (Ito: %.10g, %.10g); w(F) interpolation error estimate %.1e; "
+        "P(x, v) quadrature error estimate %.1e; "
         "large-x decay rate %.6g (predicted %.6g), power %.4g (predicted %.4g)",
         label,
         time.perf_counter() - started_distribution,
@@ -110,6 +112,7 @@ with job_log(snakemake.log[0]):
         row["delta_x_from_position"],
         row["mean_x"],
         row["delta_x"],
+        row["weight_interpolation_error"],
         worst,
         row["large_x_rate_measured"],
         row["large_x_rate_predicted"],
