@@ -59,25 +59,6 @@ with job_log(snakemake.log[0]):
         "distribution": joint,
         "weight": weights,
     }
-    # nothing is written unless every table passes (an error naming r and the failed checks)
-    distribution.check_solve_tables(label, row, tables, solver.ACCURACY_TARGET)
-    provenance = {
-        "rule": "solve",
-        "r": exact_string(exact),
-        "r_label": label,
-        "quadrature_step": settings["quadrature_step"],
-        "highest_speed": float(solution.speeds[-1]),
-        "weight_panel_nodes": settings["weight_panel_nodes"],
-        "code": snakemake.params.code,
-        "normalisation": "momentum balance M_2 = r / (1 + r)",
-    }
-    write_tables(
-        {
-            snakemake.output.summary: pd.DataFrame([row]),
-            **{getattr(snakemake.output, name): table for name, table in tables.items()},
-        },
-        provenance,
-    )
     logging.info(
         "r=%s: %d nodes, solved in %.1f ms (first call: includes loading the compiled kernel); "
         "<x> = %.10g, Delta x = %.10g, I = %.10g; energy balance residual %.1e, "
@@ -118,4 +99,23 @@ with job_log(snakemake.log[0]):
         row["large_x_rate_predicted"],
         row["large_x_power_measured"],
         row["large_x_power_predicted"],
+    )
+    # nothing is written unless every table passes (an error naming r and the failed checks)
+    distribution.check_solve_tables(label, row, tables, solver.ACCURACY_TARGET)
+    provenance = {
+        "rule": "solve",
+        "r": exact_string(exact),
+        "r_label": label,
+        "quadrature_step": settings["quadrature_step"],
+        "highest_speed": float(solution.speeds[-1]),
+        "weight_panel_nodes": settings["weight_panel_nodes"],
+        "code": snakemake.params.code,
+        "normalisation": "momentum balance M_2 = r / (1 + r)",
+    }
+    write_tables(
+        {
+            snakemake.output.summary: pd.DataFrame([row]),
+            **{getattr(snakemake.output, name): table for name, table in tables.items()},
+        },
+        provenance,
     )
