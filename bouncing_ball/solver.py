@@ -74,8 +74,21 @@ UNDERFLOW_EFOLDS = 700.0  # exp(-700) ~ 1e-304 is still a normal double
 
 
 def speed_of_coordinate(s, b=SQRT_WEIGHT):
-    """u(s) for s = ln u + b u^(1/2), through the Lambert W function."""
-    w = (2.0 / b) * special.lambertw(0.5 * b * np.exp(0.5 * np.asarray(s, dtype=float))).real
+    """u(s) for s = ln u + b u^(1/2), through the Lambert W function: u = (2 W(z) / b)^2 with
+    z = (b / 2) e^(s/2); where z overflows (u above ~2e6), W from ln z by Newton's method on
+    W + ln W = ln z."""
+    s = np.asarray(s, dtype=float)
+    log_z = np.log(0.5 * b) + 0.5 * s
+    huge = log_z > 700.0
+    w = special.lambertw(0.5 * b * np.exp(np.where(huge, 0.0, 0.5 * s))).real
+    if np.any(huge):
+        large = log_z[huge]
+        root = large - np.log(large)
+        for _ in range(8):
+            root -= (root + np.log(root) - large) / (1.0 + 1.0 / root)
+        w = np.where(huge, 0.0, w)
+        w[huge] = root
+    w = (2.0 / b) * w
     return w * w
 
 
