@@ -233,3 +233,11 @@ def test_the_large_x_power_is_checked_only_where_it_has_set_in():
     assert distribution.solve_table_defects(summary, tables) == []
     summary["large_x_rate_measured"] = predicted["large_x_rate"] * 1.01
     assert len(distribution.solve_table_defects(summary, tables)) == 1
+
+
+def test_the_coordinate_of_the_grid_inverts_beyond_the_overflow_of_its_exponential():
+    """u(s) went through (b / 2) e^(s/2), infinite above u ~ 2e6: the grid of the far solution
+    at r = 0.9999 had infinite nodes and a NaN density."""
+    speeds = np.array([1e-12, 1.0, 1e6, 2.1e6, 5e6, 1e8])
+    back = solver.speed_of_coordinate(solver.coordinate_of_speed(speeds))
+    assert np.max(np.abs(back / speeds - 1.0)) < 1e-14
