@@ -129,7 +129,7 @@ def check_restitution(restitution) -> float:
         raise ValueError(
             f"restitution {restitution}: w(F), P(x) and P(x, v) are computed to 1e-8 only for "
             f"{low} <= r <= {high} (docs/distribution.md#where-it-degrades); P(0, v) alone "
-            "(bouncing_ball.solver) reaches further"
+            "(bouncing_ball.solver) reaches r = 0.9999"
         )
     return float(exact)
 
@@ -427,8 +427,20 @@ def _real_segment_terms(density, force, v1):
         + _log_psi(force, 0.0)
         + (2.0 - beta) * np.log(SMALLEST_SPEED)
         - np.log(abs(2.0 - beta))
+        + np.log1p(-_small_speed_slope(force, beta))
     )
     return log_terms, signs, small, np.sign(2.0 - beta)
+
+
+def _small_speed_slope(force, beta):
+    """The linear term of psi_F(v) = psi_F(0) (1 + v psi'/psi + ...) in the closed-form part
+    int_0^eps C v^(1-beta) psi_F(v) dv below eps = SMALLEST_SPEED, relative to its constant term:
+    ((2 - beta)/(3 - beta)) eps F^(1/3) Ai'(c)/Ai(c), c = F^(-2/3)/4.  Without it the part is
+    off by (eps F^(1/3))^(3 - beta) of the whole, which matters where beta nears 5/2 (r -> 0)
+    and F^(1/3) eps is not small (F up to 1e30 in T(G))."""
+    scaled = special.airye(0.25 * force ** (-2.0 / 3.0))
+    ratio = scaled[1] / scaled[0]
+    return (2.0 - beta) / (3.0 - beta) * SMALLEST_SPEED * force ** (1.0 / 3.0) * ratio
 
 
 def _contour(force, v1, q):
@@ -508,6 +520,7 @@ def _compute_kernel_transform_table(density):
             np.exp(density.log_amplitude + _log_psi(gk, 0.0))
             * SMALLEST_SPEED ** (2.0 - beta)
             / (2.0 - beta)
+            * (1.0 + _small_speed_slope(gk, beta))
         )
         transforms[k] = body + small
     weights = wg * g * np.exp(-1.0 / (12.0 * g)) / (2.0 * np.pi)

@@ -230,11 +230,12 @@ def solve_outgoing_speed_density(
             "where P(0, v) follows its power law v^-beta to the solver's accuracy"
         )
     ceiling = UNDERFLOW_EFOLDS / large_speed_decay_rate(r)
-    if not default_highest_speed(r) <= highest <= ceiling:
+    floor = min(max(60.0, 20.0 + DROP_EFOLDS / large_speed_decay_rate(r)), 0.9 * ceiling)
+    if not floor <= highest <= ceiling:
         raise ValueError(
-            f"highest_speed = {highest_speed}: must lie in [{default_highest_speed(r):.6g}, "
-            f"{ceiling:.6g}] at r = {r}: from where P(0, v) has fallen by e^-{DROP_EFOLDS:g} "
-            "below its value at v = 20 to where it leaves the range of doubles"
+            f"highest_speed = {highest_speed}: must lie in [{floor:.6g}, {ceiling:.6g}] at "
+            f"r = {r}: from where P(0, v) has fallen by e^-{DROP_EFOLDS:g} below its value at "
+            "v = 20 (or nearly left the range of doubles) to where it leaves the range of doubles"
         )
     s_lo, s_hi = coordinate_of_speed(lowest), coordinate_of_speed(highest)
     count = int(np.floor((s_hi - s_lo) / step)) + 1  # last node <= highest
