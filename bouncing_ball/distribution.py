@@ -1183,6 +1183,12 @@ EXPONENT_TOLERANCES = {
 }
 
 
+# P(x, v) by the F integral of eq. (fpsol) is accurate to about this fraction of the largest
+# value of its table (the oscillating Airy factor cancels): far-tail values below it are noise,
+# of either sign (at r = 0.05, x = 0.0126, v = 6: -3e-14 where the peak is 3.4)
+DISTRIBUTION_NOISE = 1e-12
+
+
 def _nan_defects(name, table, allowed=None) -> list:
     """'name: n NaN in column c' for every column with NaN outside the rows ``allowed`` marks."""
     defects = []
@@ -1212,7 +1218,8 @@ def solve_table_defects(summary, tables, target=1e-8) -> list:
         (of w(F), and so of P(x): ``WeightFunction.interpolation_error``).
 
     Checks: no NaN where a value is defined (P(0, 0) is not, nor rho(T) where I is infinite, below
-    r_c); int P dx = 1, and <x>, Delta x from P(x) equal the Ito values from P(0, v), within the
+    r_c, nor the return-speed law given a u-bin above the highest node, where P(0, u) underflows);
+    no P(x, v) below -DISTRIBUTION_NOISE of the table's largest value; int P dx = 1, and <x>, Delta x from P(x) equal the Ito values from P(0, v), within the
     tolerance; every measured exponent within ``EXPONENT_TOLERANCES`` of its prediction.
     """
     defects = [
@@ -1224,9 +1231,21 @@ def solve_table_defects(summary, tables, target=1e-8) -> list:
     allowed = {
         "flight_time": lambda table, column: column == "density" and infinite_rate,
         "distribution": lambda table, column: (table.x == 0.0) & (table.v == 0.0),
+        # a u-bin above the highest node, where P(0, u) is below the smallest double: the
+        # probabilities given u are 0/0 there
+        "return_speed": lambda table, column: table.u_lo >= summary["highest_speed"],
     }
     for name, table in tables.items():
         defects += _nan_defects(name, table, allowed.get(name))
+    if "distribution" in tables:
+        pxv = tables["distribution"].pxv.to_numpy(dtype=float)
+        floor = -DISTRIBUTION_NOISE * np.nanmax(np.abs(pxv), initial=0.0)
+        negative = pxv < floor
+        if negative.any():
+            defects.append(
+                f"distribution: {int(negative.sum())} of {pxv.size} pxv are negative beyond "
+                f"{DISTRIBUTION_NOISE:g} of the largest (down to {np.nanmin(pxv):.3g})"
+            )
     tolerance = max(
         target,
         summary.get("accuracy_estimate", 0.0),

@@ -145,6 +145,7 @@ def _passing_tables():
         "delta_x": 108.0**0.5,
         "collision_rate": 1.0 / 3.0,
         "accuracy_estimate": 2e-11,
+        "highest_speed": 65.0,
         "position_normalization": 1.0 + 1e-13,
         "mean_x_from_position": 6.0 * (1.0 + 1e-12),
         "delta_x_from_position": 108.0**0.5,
@@ -162,6 +163,9 @@ def _passing_tables():
             {"x": [0.0, 0.0, 0.1], "v": [0.0, 1.0, 0.0], "pxv": [np.nan, 0.1, 0.2]}
         ),
         "weight": pd.DataFrame({"F": [1.0], "w": [0.1], "log_w": [-2.3]}),
+        "return_speed": pd.DataFrame(
+            {"u_lo": [1.0, 70.0], "u_hi": [2.0, 80.0], "probability": [0.5, np.nan]}
+        ),
     }
     return summary, tables
 
@@ -249,3 +253,23 @@ def test_position_moments_near_the_lower_end_of_the_range():
     closed-form part of T(G) below the smallest speed lacked the linear term of psi_G(v), which
     matters at the large G that carry B(F) when beta nears 5/2.  Now 1e-8."""
     check_position_moments(0.03)
+
+
+def test_a_negative_density_beyond_the_noise_is_an_error():
+    """P(x, v) from the F integral is accurate to 1e-12 of its largest value: a negative value
+    below that (-0.418 came out at x = 1e-8) is an error, one within it is noise."""
+    summary, tables = _passing_tables()
+    tables["distribution"].loc[2, "pxv"] = -1e-13
+    assert distribution.solve_table_defects(summary, tables) == []
+    tables["distribution"].loc[2, "pxv"] = -1e-3
+    assert distribution.solve_table_defects(summary, tables) == [
+        "distribution: 1 of 3 pxv are negative beyond 1e-12 of the largest (down to -0.001)"
+    ]
+
+
+def test_the_return_speed_law_may_be_undefined_only_above_the_highest_node():
+    summary, tables = _passing_tables()
+    summary["highest_speed"] = 75.0
+    assert distribution.solve_table_defects(summary, tables) == [
+        "return_speed: 1 of 2 probability are NaN"
+    ]
