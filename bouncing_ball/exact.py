@@ -14,13 +14,16 @@ import numpy as np
 import pandas as pd
 from scipy import integrate, special
 
-from .restitution import EXACT_RESTITUTIONS  # noqa: F401 (re-exported: exact.EXACT_RESTITUTIONS)
+from .distribution import check_force_integral_point
+from .restitution import EXACT_RESTITUTIONS, parse_restitution
 
 
 @functools.lru_cache(maxsize=64)  # called per point by the scalar integrands below
 def _which(restitution) -> Fraction:
-    value = Fraction(restitution).limit_denominator(1000)
-    if value not in EXACT_RESTITUTIONS or abs(float(value) - float(restitution)) > 1e-12:
+    """r (a float, or a fraction string such as "1/3") as 1/2 or 1/3; ValueError otherwise."""
+    given = parse_restitution(restitution, "restitution")
+    value = given.limit_denominator(1000)
+    if value not in EXACT_RESTITUTIONS or abs(float(value) - float(given)) > 1e-12:
         raise ValueError(f"exact solutions exist only for r = 1/2 and 1/3, not r = {restitution}")
     return value
 
@@ -33,8 +36,13 @@ def normalization_constant(restitution) -> float:
 
 
 def outgoing_speed_density(v, restitution):
-    """P(0, v) for v > 0 (outgoing side), eq. (P(0,v))."""
+    """P(0, v) for v > 0 (outgoing side), eq. (P(0,v)); the incoming side is eq. (bc)."""
     v = np.asarray(v, dtype=float)
+    if np.any(~(v >= 0.0)):
+        raise ValueError(
+            "v: P(0, v) is the density of outgoing speeds, v >= 0; "
+            "the incoming side is r^2 P(0, r |v|), eq. (bc)"
+        )
     a = normalization_constant(restitution)
     if _which(restitution) == Fraction(1, 2):
         return a * np.exp(-v) / v
@@ -213,10 +221,7 @@ def distribution_by_force_integral(x, v, restitution):
     Returns (value, estimated absolute error).
     """
     xi, vi = float(x), float(v)
-    if xi < 0.0 or (xi == 0.0 and vi >= 0.0):
-        raise ValueError(
-            f"the F integral of eq. (fpsol) needs x > 0, or x = 0 with v < 0 (x = {x}, v = {v})"
-        )
+    check_force_integral_point(xi, vi)
     # w(F) vanishes like e^{-1/(6F)} at small F; e^{-F x} cuts large F (at x = 0, v < 0 the
     # Airy factor ~ exp(-(2/3) F^(1/2) |v|^(3/2)) does)
     upper = np.log(60.0 / xi) if xi > 0.0 else np.log((90.0 / abs(vi) ** 1.5) ** 2 + 1.0)
@@ -241,6 +246,9 @@ def distribution_with_error(x, v, restitution):
     converges only conditionally there); P(0, 0) diverges and is NaN.
     """
     x, v = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(v, dtype=float))
+    for index in np.ndindex(x.shape):
+        if x[index] != 0.0:
+            check_force_integral_point(float(x[index]), float(v[index]))
     values, errors = np.empty(x.shape), np.zeros(x.shape)
     r = float(_which(restitution))
     for index in np.ndindex(x.shape):

@@ -143,14 +143,14 @@ import pandas as pd
 from scipy import integrate, special
 
 from .asymptotics import large_speed_decay_rate, large_speed_exponent
-from .kernel import TAIL, return_speed_kernel
+from .kernel import TAIL, TIME_MOMENT_TAU_NODES, return_speed_kernel
 from .solver import coordinate_of_speed, speed_of_coordinate
 
 SQRT3 = np.sqrt(3.0)
 GOLDEN_RESTITUTION = 0.5 * (np.sqrt(5.0) - 1.0)  # q(r) = 3/4: where (long1) gives way to (long2)
 
-# Gauss-Legendre on [0, 1] for the tau integral of (timemoments) (kernel.py uses 20 for k = 0)
-_TAU_NODES, _TAU_WEIGHTS = np.polynomial.legendre.leggauss(24)
+# Gauss-Legendre on [0, 1] for the tau integral of (timemoments)
+_TAU_NODES, _TAU_WEIGHTS = np.polynomial.legendre.leggauss(TIME_MOMENT_TAU_NODES)
 _TAU_NODES, _TAU_WEIGHTS = 0.5 * (_TAU_NODES + 1.0), 0.5 * _TAU_WEIGHTS
 # Gauss-Legendre on [0, 1] for the v-integral of f(t | u), in w = v^(1/2): 40 nodes give 1e-13
 _SPEED_NODES, _SPEED_WEIGHTS = np.polynomial.legendre.leggauss(48)

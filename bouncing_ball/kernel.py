@@ -41,8 +41,12 @@ import numpy as np
 
 from .jit import njit, prange
 
-# Gauss-Legendre order of the tau integral: 2e-13 of a 64-node rule (``tests/unit/test_kernel.py``)
+# Gauss-Legendre order of the tau integral: 2e-13 of a 64-node rule (``tests/unit/test_kernel.py``);
+# the continuation to complex v (bouncing_ball.distribution) uses the same rule
 TAU_NODES = 20
+# the same tau integral weighted by powers of the flight time, eq. (timemoments) (k up to 3:
+# bouncing_ball.flight_time), takes a few more nodes
+TIME_MOMENT_TAU_NODES = 24
 # exp(-TAIL^2) ~ 1e-18: the cut of the tau integral for large z0
 TAIL = 6.4
 

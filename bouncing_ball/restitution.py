@@ -11,11 +11,23 @@ from fractions import Fraction
 # the r with an exact solution, eq. (P(0,v)) (bouncing_ball.exact)
 EXACT_RESTITUTIONS = (Fraction(1, 2), Fraction(1, 3))
 
-# the r for which the solver (bouncing_ball.solver) meets its 1e-8 accuracy target: below
-# 0.02 P(0, v) ~ exp(-v / (2r)) leaves the range of doubles within the speeds that matter
-# (the answer is wrong by 2% at 0.015, by 50% at 0.01); above 0.9999 the dense grid,
-# ~ (1 - r)^(-1/2) nodes, outgrows a job
+# the r for which the solver of eq. (inteq) (bouncing_ball.solver) meets its 1e-8 accuracy
+# target: below 0.02 P(0, v) ~ exp(-v / (2r)) leaves the range of doubles within the speeds that
+# matter (the answer is wrong by 2% at 0.015, by 50% at 0.01); above 0.9999 the dense grid,
+# ~ (1 - r)^(-1/2) nodes, outgrows a job.  The bounds are exact decimals: 0.02 is 1/50.
 SOLVER_RESTITUTION_RANGE = (0.02, 0.9999)
+# the r for which the whole distribution from P(0, v) (bouncing_ball.distribution: w(F), P(x),
+# P(x, v)) meets the same target, and so every table of rule solve: the r of a run.  Above, int
+# P dx drifts from 1 (by 5e-8 at r = 0.93, 3e-6 at 0.95, 1e-4 at 0.99): the weight of P(x)
+# moves to forces F where w(F) is not computed accurately
+DISTRIBUTION_RESTITUTION_RANGE = (0.02, 0.9)
+
+
+def in_range(exact, bounds) -> bool:
+    """``low <= exact <= high`` for the exact r and the decimal bounds read as written (so that
+    r = 1/50 is inside a range that starts at 0.02, whose float is a little above 1/50)."""
+    low, high = (Fraction(str(bound)) for bound in bounds)
+    return low <= Fraction(exact) <= high
 
 
 def parse_restitution(value, where: str = "restitution") -> Fraction:
@@ -45,16 +57,26 @@ def parse_restitution(value, where: str = "restitution") -> Fraction:
 
 
 def check_solver_restitution(value, where: str = "restitution") -> Fraction:
-    """``value`` parsed, if the solver answers it to its accuracy target; ValueError
-    naming ``where`` and the range otherwise."""
+    """``value`` parsed, if rule solve answers it to its accuracy target (P(0, v) and the whole
+    distribution: ``DISTRIBUTION_RESTITUTION_RANGE``); ValueError naming ``where`` and the range
+    otherwise."""
     exact = parse_restitution(value, where)
-    low, high = SOLVER_RESTITUTION_RANGE
-    if not low <= exact <= high:
+    low, high = DISTRIBUTION_RESTITUTION_RANGE
+    if not in_range(exact, DISTRIBUTION_RESTITUTION_RANGE):
+        solver_low, solver_high = SOLVER_RESTITUTION_RANGE
         raise ValueError(
             f"{where}: r = {value!r} is outside the solver's range {low} <= r <= {high}, "
-            "where it meets its 1e-8 accuracy target (docs/methods.md#the-solver)"
+            "where its P(0, v), P(x) and P(x, v) meet the 1e-8 accuracy target "
+            f"(P(0, v) alone, solver.restitution_grid: {solver_low} <= r <= {solver_high}; "
+            "docs/distribution.md#where-it-degrades)"
         )
     return exact
+
+
+def restitution_value(value, where: str = "restitution") -> float:
+    """r as a float from a float, an int, a ``Fraction`` or a fraction string ("1/3"), as the
+    pipeline reads it (``parse_restitution``); the library's public entry points take r so."""
+    return float(parse_restitution(value, where))
 
 
 def restitution_label(value) -> str:

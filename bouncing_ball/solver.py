@@ -57,9 +57,12 @@ from scipy import linalg, special
 
 from .asymptotics import large_speed_decay_rate, small_speed_exponent
 from .kernel import kernel_small_u_limit, return_speed_kernel_matrix
-from .restitution import SOLVER_RESTITUTION_RANGE
+from .restitution import SOLVER_RESTITUTION_RANGE, in_range, parse_restitution
 
 DEFAULT_STEP = 0.25  # trapezoidal step in s; ~1e-11 relative error at r = 1/2, 1/3
+# the largest step accepted: the error grows like exp(-2 pi^2 / (3 h)) (1e-6 at h = 0.5), and the
+# complex Nystrom sum of bouncing_ball.distribution loses accuracy faster still
+LARGEST_STEP = 0.5
 SQRT_WEIGHT = 1.0  # b in s = ln u + b u^(1/2)
 TAIL_EFOLDS = 25.0  # lower tail summed node by node over this many e-folds of u
 DROP_EFOLDS = 45.0  # P(0, v_max) ~ exp(-45) P(0, 20); M_6 then misses < 1e-12
@@ -67,8 +70,21 @@ UNDERFLOW_EFOLDS = 700.0  # exp(-700) ~ 1e-304 is still a normal double
 
 
 def speed_of_coordinate(s, b=SQRT_WEIGHT):
-    """u(s) for s = ln u + b u^(1/2), through the Lambert W function."""
-    w = (2.0 / b) * special.lambertw(0.5 * b * np.exp(0.5 * np.asarray(s, dtype=float))).real
+    """u(s) for s = ln u + b u^(1/2), through the Lambert W function: u = (2 W(z) / b)^2 with
+    z = (b / 2) e^(s/2); where z overflows (u above ~2e6), W from ln z by Newton's method on
+    W + ln W = ln z."""
+    s = np.asarray(s, dtype=float)
+    log_z = np.log(0.5 * b) + 0.5 * s
+    huge = log_z > 700.0
+    w = special.lambertw(0.5 * b * np.exp(np.where(huge, 0.0, 0.5 * s))).real
+    if np.any(huge):
+        large = log_z[huge]
+        root = large - np.log(large)
+        for _ in range(8):
+            root -= (root + np.log(root) - large) / (1.0 + 1.0 / root)
+        w = np.where(huge, 0.0, w)
+        w[huge] = root
+    w = (2.0 / b) * w
     return w * w
 
 
@@ -139,8 +155,13 @@ class OutgoingSpeedSolution:
         return rows
 
     def outgoing_speed_density(self, v):
-        """P(0, v) anywhere, by the Nystrom formula: r^-2 int du u G_g(v / r, u) P(0, u)."""
+        """P(0, v) anywhere (v >= 0), by the Nystrom formula: r^-2 int du u G_g(v / r, u) P(0, u)."""
         v = np.asarray(v, dtype=float)
+        if np.any(~(v >= 0.0)):
+            raise ValueError(
+                "v: P(0, v) is the density of outgoing speeds, v >= 0; "
+                "the incoming side is r^2 P(0, r |v|), eq. (bc)"
+            )
         r = self.restitution
         flat = self._rows(np.ascontiguousarray(v.ravel()) / r) @ self.density / (r * r)
         return flat.reshape(v.shape)
@@ -160,26 +181,58 @@ class OutgoingSpeedSolution:
 def solve_outgoing_speed_density(
     restitution, step=DEFAULT_STEP, lowest_speed=None, highest_speed=None
 ):
-    """Solve eq. (inteq) for P(0, v), v > 0, normalised by the momentum balance M_2 = r / (1 + r)."""
-    r = float(restitution)
-    if not 0.0 < r < 1.0:
-        raise ValueError(f"restitution must lie in (0, 1), got {restitution}")
+    """Solve eq. (inteq) for P(0, v), v > 0, normalised by the momentum balance M_2 = r / (1 + r).
+
+    Parameters
+    ----------
+    restitution : float or str
+        r, a float or an exact fraction string ("1/3"), in ``SOLVER_RESTITUTION_RANGE``.
+    step : float
+        Trapezoidal step in s = ln u + u^(1/2), 0 < step <= ``LARGEST_STEP``.
+    lowest_speed, highest_speed : float, optional
+        The lowest and highest node; at most ``default_lowest_speed`` (the built-in power law
+        below it holds only there) and between ``default_highest_speed`` and where P(0, v)
+        leaves the range of doubles (UNDERFLOW_EFOLDS / q).
+
+    Raises
+    ------
+    ValueError
+        Naming the argument, for an r, step or node the solver cannot answer to its accuracy.
+    """
+    exact = parse_restitution(restitution, "restitution")
+    r = float(exact)
     low, high = SOLVER_RESTITUTION_RANGE
-    if r > high:
+    if not in_range(exact, (0.0, high)):
         raise ValueError(
             f"restitution {restitution} is too close to 1 for the solver: its dense grid grows like "
             f"(1 - r)^(-1/2) nodes; {low} <= r <= {high} is supported"
         )
-    if r < low:
+    if not in_range(exact, (low, 1.0)):
         raise ValueError(
             f"restitution {restitution} is too small for the solver: P(0, v) ~ exp(-v / (2r)) "
             f"leaves the range of doubles; {low} <= r <= {high} is supported"
         )
-    if not step > 0.0:
-        raise ValueError(f"quadrature step must be positive, got {step}")
+    if not 0.0 < step <= LARGEST_STEP:
+        raise ValueError(
+            f"step = {step}: the quadrature step must lie in (0, {LARGEST_STEP}] (the error grows "
+            "like exp(-2 pi^2 / (3 step)))"
+        )
     beta = small_speed_exponent(r)
     lowest = default_lowest_speed(beta) if lowest_speed is None else float(lowest_speed)
     highest = default_highest_speed(r) if highest_speed is None else float(highest_speed)
+    if not 0.0 < lowest <= default_lowest_speed(beta):
+        raise ValueError(
+            f"lowest_speed = {lowest_speed}: must lie in (0, {default_lowest_speed(beta):g}], "
+            "where P(0, v) follows its power law v^-beta to the solver's accuracy"
+        )
+    ceiling = UNDERFLOW_EFOLDS / large_speed_decay_rate(r)
+    floor = min(max(60.0, 20.0 + DROP_EFOLDS / large_speed_decay_rate(r)), 0.9 * ceiling)
+    if not floor <= highest <= ceiling:
+        raise ValueError(
+            f"highest_speed = {highest_speed}: must lie in [{floor:.6g}, {ceiling:.6g}] at "
+            f"r = {r}: from where P(0, v) has fallen by e^-{DROP_EFOLDS:g} below its value at "
+            "v = 20 (or nearly left the range of doubles) to where it leaves the range of doubles"
+        )
     s_lo, s_hi = coordinate_of_speed(lowest), coordinate_of_speed(highest)
     count = int(np.floor((s_hi - s_lo) / step)) + 1  # last node <= highest
     speeds = speed_of_coordinate(s_lo + step * np.arange(count))

@@ -20,7 +20,9 @@ with job_log(snakemake.log[0]):
     exact = parse_restitution(snakemake.params.restitution)
     label = restitution_label(exact)
     started = time.perf_counter()
-    solution = solver.solve_outgoing_speed_density(float(exact), step=settings["quadrature_step"])
+    # eq. (inteq), solved once: the highest node where P(0, v) reaches e^-690, as w(F) at small
+    # F needs (distribution.outgoing_speed_solution), with the config's quadrature step
+    solution = distribution.outgoing_speed_solution(exact, step=settings["quadrature_step"])
     elapsed = time.perf_counter() - started
     speeds = log_grid(settings["output_speeds"])
     row = solver.solution_summary(solution)
@@ -31,46 +33,32 @@ with job_log(snakemake.log[0]):
     returns = flight_time.return_speed_table(solution, log_bins(snakemake.params.speed_bins))
     # the whole distribution from P(0, v) (bouncing_ball.distribution): w(F), then P(x), P(x, v)
     started_distribution = time.perf_counter()
-    far = distribution.outgoing_speed_solution(float(exact))  # P(0, v) out to ~e^-690
     weight = distribution.interpolated_weight_function(
-        far, panel_nodes=settings["weight_panel_nodes"]
+        solution, panel_nodes=settings["weight_panel_nodes"]
     )
     position = distribution.position_table(weight, log_grid(settings["position_grid"]))
     joint, worst = distribution.distribution_table(
-        weight, far, settings["positions"], linear_grid(settings["speeds"])
+        weight, solution, settings["positions"], linear_grid(settings["speeds"])
     )
     weights = distribution.weight_table(weight, log_grid(settings["forces"]))
     averages = distribution.position_averages(weight)
     row["position_normalization"] = averages["normalization"]
     row["mean_x_from_position"] = averages["mean_x"]
     row["delta_x_from_position"] = averages["delta_x"]
+    row["weight_interpolation_error"] = weight.interpolation_error
     measured = distribution.measured_exponents(weight)
-    for key, value in distribution.predicted_exponents(float(exact)).items():
+    for key, value in distribution.predicted_exponents(exact).items():
         row[f"{key}_measured"], row[f"{key}_predicted"] = measured[key], value
-    provenance = {
-        "rule": "solve",
-        "r": exact_string(exact),
-        "r_label": label,
-        "quadrature_step": settings["quadrature_step"],
-        "weight_panel_nodes": settings["weight_panel_nodes"],
-        "settings": settings,
-        "speed_bins": snakemake.params.speed_bins,
-        "code": snakemake.params.code,
-        "normalisation": "momentum balance M_2 = r / (1 + r)",
-    }
+    row["large_x_window_lo"], row["large_x_window_hi"] = measured["large_x_window"]
     p0v = pd.DataFrame({"v": speeds, "p0v": solution.outgoing_speed_density(speeds)})
-    write_tables(
-        {
-            snakemake.output.p0v: p0v,
-            snakemake.output.summary: pd.DataFrame([row]),
-            snakemake.output.flight_time: flights,
-            snakemake.output.return_speed: returns,
-            snakemake.output.position: position,
-            snakemake.output.distribution: joint,
-            snakemake.output.weight: weights,
-        },
-        provenance,
-    )
+    tables = {
+        "p0v": p0v,
+        "flight_time": flights,
+        "return_speed": returns,
+        "position": position,
+        "distribution": joint,
+        "weight": weights,
+    }
     logging.info(
         "r=%s: %d nodes, solved in %.1f ms (first call: includes loading the compiled kernel); "
         "<x> = %.10g, Delta x = %.10g, I = %.10g; energy balance residual %.1e, "
@@ -87,14 +75,16 @@ with job_log(snakemake.log[0]):
     )
     if not row["accuracy_estimate"] <= solver.ACCURACY_TARGET:
         logging.warning(
-            "r=%s: accuracy estimate %.1e misses the %.0e target",
+            "r=%s: accuracy estimate %.1e misses the %.0e target (solver.quadrature_step %g)",
             label,
             row["accuracy_estimate"],
             solver.ACCURACY_TARGET,
+            settings["quadrature_step"],
         )
     logging.info(
         "r=%s: w(F), P(x), P(x, v) in %.1f s; from P(x): int P dx - 1 = %.1e, <x> = %.10g, "
-        "Delta x = %.10g (Ito: %.10g, %.10g); P(x, v) quadrature error estimate %.1e; "
+        "Delta x = %.10g (Ito: %.10g, %.10g); w(F) interpolation error estimate %.1e; "
+        "P(x, v) quadrature error estimate %.1e; "
         "large-x decay rate %.6g (predicted %.6g), power %.4g (predicted %.4g)",
         label,
         time.perf_counter() - started_distribution,
@@ -103,9 +93,31 @@ with job_log(snakemake.log[0]):
         row["delta_x_from_position"],
         row["mean_x"],
         row["delta_x"],
+        row["weight_interpolation_error"],
         worst,
         row["large_x_rate_measured"],
         row["large_x_rate_predicted"],
         row["large_x_power_measured"],
         row["large_x_power_predicted"],
+    )
+    # nothing is written unless every table passes (an error naming r and the failed checks)
+    distribution.check_solve_tables(label, row, tables, solver.ACCURACY_TARGET)
+    provenance = {
+        "rule": "solve",
+        "r": exact_string(exact),
+        "r_label": label,
+        "quadrature_step": settings["quadrature_step"],
+        "highest_speed": float(solution.speeds[-1]),
+        "weight_panel_nodes": settings["weight_panel_nodes"],
+        "settings": settings,
+        "speed_bins": snakemake.params.speed_bins,
+        "code": snakemake.params.code,
+        "normalisation": "momentum balance M_2 = r / (1 + r)",
+    }
+    write_tables(
+        {
+            snakemake.output.summary: pd.DataFrame([row]),
+            **{getattr(snakemake.output, name): table for name, table in tables.items()},
+        },
+        provenance,
     )

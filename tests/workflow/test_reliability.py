@@ -178,34 +178,48 @@ def test_a_corrupt_merged_table_is_named_by_the_rule_that_reads_it(finished_run,
 
 
 def test_extreme_r_runs_end_to_end_within_its_budget(tmp_path):
-    """r = 0.05 (below r_c, with a floor on delta) and r = 0.98 (slow relaxation, <x> ~ 4000):
-    every stage finishes; the solver meets its accuracy; I is infinite below r_c."""
-    config = yaml.safe_load(yaml.safe_dump(SMALL)) | {"restitution": [0.05, 0.98]}
+    """r = 0.05 (below r_c, with a floor on delta) and r = 0.85 (slow relaxation): every stage
+    finishes; the solver's tables pass their checks; I is infinite below r_c."""
+    config = yaml.safe_load(yaml.safe_dump(SMALL)) | {"restitution": [0.05, 0.85]}
     config["simulation"]["per_restitution"] = {"0.05": {"min_step_floor": 1.0e-12}}
     directory = copy_repository(tmp_path, config)
     targets = [
         f"results/{kind}/r{label}/summary.parquet"
         for kind in ("simulation", "solver")
-        for label in ("0.05", "0.98")
+        for label in ("0.05", "0.85")
     ]
     result = snakemake(
         directory,
         *targets,
         "results/fits/r0.05.parquet",
-        "results/fits/r0.98.parquet",
+        "results/fits/r0.85.parquet",
         "results/tables/moments.csv",
     )
     assert result.returncode == 0, result.stderr[-3000:]
-    for label in ("0.05", "0.98"):
+    for label in ("0.05", "0.85"):
         simulated, _ = read_table(directory / f"results/simulation/r{label}/summary.parquet")
         assert simulated.shards_out_of_budget.iloc[0] == 0
         assert simulated.total_time.iloc[0] == pytest.approx(3 * 2.0e3)
         solved, _ = read_table(directory / f"results/solver/r{label}/summary.parquet")
         assert solved.accuracy_estimate.iloc[0] < 1e-8
+        # int P dx, within the interpolation error of w(F) at the test config's few nodes
+        tolerance = max(1e-8, solved.weight_interpolation_error.iloc[0])
+        assert abs(solved.position_normalization.iloc[0] - 1.0) <= tolerance
     below, _ = read_table(directory / "results/solver/r0.05/summary.parquet")
     assert below.collision_rate.iloc[0] == float("inf")
     table = pd.read_csv(directory / "results/tables/moments.csv")
     assert np.isnan(table[(table.r_label == 0.05) & (table.quantity == "collision_rate")].z.iloc[0])
+
+
+def test_r_outside_the_solver_range_is_refused_before_any_job(tmp_path):
+    """r = 0.95 gave all-NaN P(x) and a job that succeeded; 0.9999 crashed the solve job:
+    refused before any job, naming the target and the range."""
+    directory = copy_repository(tmp_path, SMALL)
+    for label in ("0.95", "0.9999", "0.015"):
+        result = snakemake(directory, f"results/solver/r{label}/summary.parquet")
+        assert result.returncode != 0
+        assert "outside the solver's range 0.02 <= r <= 0.9" in result.stdout + result.stderr
+    assert not (directory / "results/solver").exists()
 
 
 def test_every_reader_refuses_a_table_of_the_wrong_kind_or_r(finished_run, tmp_path):

@@ -641,7 +641,7 @@ BAD = [
     # r the solver cannot answer to its accuracy, r whose label is not an r
     (
         _with(["restitution"], [0.99995]),
-        "restitution[0]: r = 0.99995 is outside the solver's range 0.02 <= r <= 0.9999",
+        "restitution[0]: r = 0.99995 is outside the solver's range 0.02 <= r <= 0.9",
     ),
     (_with(["restitution"], [0.001]), "restitution[0]: r = 0.001 is outside the solver's range"),
     (_with(["figures", "fig4"], [0.01]), "figures.fig4[0]: r = 0.01 is outside the solver's range"),
