@@ -15,11 +15,9 @@ matplotlib.use("Agg")
 import numpy as np  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
-from .. import __version__, stages  # noqa: E402
+from .. import __version__  # noqa: E402
 from ..restitution import exact_string  # noqa: E402
 from .io import atomic_paths  # noqa: E402
-
-SOURCES = stages.PLOTTING
 
 STYLE = {
     "font.family": "serif",

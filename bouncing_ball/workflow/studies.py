@@ -21,10 +21,7 @@ from .. import exact
 from ..comparison import QUANTITIES, SYMBOLS, exact_outgoing_speed_residuals, value_with_error
 from ..histograms import outgoing_speed_histogram, position_moments_summary
 from ..restitution import parse_restitution
-from . import stages
 from .shards import read_shards
-
-SOURCES = stages.STUDIES
 
 
 def read_runs(paths, runs) -> dict:

@@ -1,0 +1,79 @@
+"""The package's layout: the top level is the physics and the public API, the pipeline's
+plumbing is in ``bouncing_ball.workflow``, and the physics never imports the plumbing."""
+
+import ast
+import importlib
+import pkgutil
+
+import pytest
+
+import bouncing_ball
+import bouncing_ball.workflow
+
+# the public API's modules: SimulationResult.batch_frame gives the workflow's batch format
+API_MODULES = {"equilibrium", "monte_carlo"}
+TOP_LEVEL = sorted(
+    module.name
+    for module in pkgutil.iter_modules(bouncing_ball.__path__)
+    if module.name != "workflow"
+)
+WORKFLOW = sorted(module.name for module in pkgutil.iter_modules(bouncing_ball.workflow.__path__))
+PHYSICS = [name for name in TOP_LEVEL if name not in API_MODULES]
+
+
+@pytest.mark.parametrize(
+    "name",
+    [f"bouncing_ball.{name}" for name in TOP_LEVEL]
+    + [f"bouncing_ball.workflow.{name}" for name in WORKFLOW],
+)
+def test_every_module_imports(name):
+    importlib.import_module(name)
+
+
+def imports_the_workflow(source: str) -> bool:
+    """Whether a top-level module's source imports ``bouncing_ball.workflow`` (or a module in
+    it), absolutely or relatively."""
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.ImportFrom):
+            module = node.module or ""
+            names = {alias.name for alias in node.names}
+            if node.level == 1 and (module.split(".")[0] == "workflow" or "workflow" in names):
+                return True
+            if node.level == 0 and module.startswith("bouncing_ball.workflow"):
+                return True
+            if node.level == 0 and module == "bouncing_ball" and "workflow" in names:
+                return True
+        elif isinstance(node, ast.Import) and any(
+            alias.name.startswith("bouncing_ball.workflow") for alias in node.names
+        ):
+            return True
+    return False
+
+
+@pytest.mark.parametrize(
+    "source, expected",
+    [
+        ("from .workflow.io import read_table", True),
+        ("from .workflow import stages", True),
+        ("from . import workflow", True),
+        ("import bouncing_ball.workflow.io", True),
+        ("from bouncing_ball.workflow import io", True),
+        ("from .tallies import SCALARS\nfrom . import exact", False),
+    ],
+)
+def test_imports_the_workflow_sees_every_form(source, expected):
+    assert imports_the_workflow(source) is expected
+
+
+@pytest.mark.parametrize("name", PHYSICS)
+def test_physics_does_not_import_the_workflow(name):
+    source = (bouncing_ball.PACKAGE / f"{name}.py").read_text()
+    assert not imports_the_workflow(source), f"bouncing_ball.{name} imports the workflow's plumbing"
+
+
+def test_public_api_is_the_top_level():
+    assert {"Equilibrium", "ExactEquilibrium", "simulate", "SimulationResult"} <= set(
+        bouncing_ball.__all__
+    )
+    for name in bouncing_ball.__all__:
+        assert getattr(bouncing_ball, name) is not None
