@@ -554,8 +554,9 @@ class Equilibrium(_EquilibriumState):
                 check_solver_restitution(self.r, "r")
             except ValueError as error:
                 raise ValueError(
-                    f"{error}: Equilibrium.{what} needs w(F) of eq. (weightfunc); at this r "
-                    "P(0, v), the time averages, the flight times and the exponents are given"
+                    f"{error}: Equilibrium.{what} needs w(F) of eq. (weightfunc), computed "
+                    f"only there; at r = {self.label} Equilibrium gives P(0, v), the time "
+                    "averages, the flight times and the exponents"
                 ) from None
 
     # --- lazily built
