@@ -89,8 +89,9 @@ def test_scalars_are_the_workflow_summary(solved):
 
 def test_the_rule_tables_are_the_table_methods_with_its_settings(solved):
     """Every frame the rule writes is the table method's for the grids its provenance records,
-    column by column to rtol 1e-12 (the residual and accuracy columns of the summary to their
-    rounding, above), and the solution reaches the highest speed it records."""
+    column by column to rtol 1e-12 (the summary's residual and accuracy columns, above, and the
+    return-speed law to their rounding), and the solution reaches the highest speed it
+    records."""
     tables, eq = solved
     settings, provenance = tables["provenance"]["settings"], tables["provenance"]
     assert float(eq.solution.speeds[-1]) == provenance["highest_speed"]
@@ -104,7 +105,10 @@ def test_the_rule_tables_are_the_table_methods_with_its_settings(solved):
         "weight": eq.weight_table(log_grid(settings["forces"])),
     }
     for name, table in ours.items():
+        # the return-speed probabilities are differences of the cumulative law, of order 1: the
+        # far bins' are its rounding (-5.6e-13 at r = 1/2), equal to the rounding of the law
+        atol = RESIDUAL if name == "return_speed" else 0.0
         pd.testing.assert_frame_equal(
-            table, tables[name], check_exact=False, rtol=1e-12, atol=0.0, obj=name
+            table, tables[name], check_exact=False, rtol=1e-12, atol=atol, obj=name
         )
     assert list(eq.summary()) == list(tables["summary"].columns)
