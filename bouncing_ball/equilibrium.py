@@ -575,15 +575,23 @@ class Equilibrium(_EquilibriumState):
         return _weight_function(self.restitution, self.quadrature_step, self.weight_panel_nodes)
 
     @functools.cached_property
+    def _position_averages(self) -> dict:
+        """int P dx, <x> and Delta x from P(x) of eq. (P(x)1) (``distribution.position_averages``)."""
+        from . import distribution
+
+        self._check_distribution("position_accuracy")
+        return distribution.position_averages(self.weight_function)
+
+    @property
     def position_accuracy(self) -> float:
         """max(|int P dx - 1|, |<x>_P / <x> - 1|, |Delta x_P / Delta x - 1|): P(x) of
         eq. (P(x)1) against the normalisation and the solver's Ito identities (builds w(F))."""
-        row = self.summary()
+        averages = self._position_averages
         return float(
             max(
-                abs(row["position_normalization"] - 1.0),
-                abs(row["mean_x_from_position"] / self.mean_x - 1.0),
-                abs(row["delta_x_from_position"] / self.delta_x - 1.0),
+                abs(averages["normalization"] - 1.0),
+                abs(averages["mean_x"] / self.mean_x - 1.0),
+                abs(averages["delta_x"] / self.delta_x - 1.0),
             )
         )
 
@@ -628,7 +636,7 @@ class Equilibrium(_EquilibriumState):
         collisions = flight_time.flight_time_summary(self.solution)
         row.update({key: value for key, value in collisions.items() if key not in row})
         weight = self.weight_function
-        averages = distribution.position_averages(weight)
+        averages = self._position_averages
         row["position_normalization"] = averages["normalization"]
         row["mean_x_from_position"] = averages["mean_x"]
         row["delta_x_from_position"] = averages["delta_x"]
@@ -897,6 +905,8 @@ class ExactEquilibrium(_EquilibriumState):
     >>> print(eq.px([0.1, 1.0]).round(6))
     [0.815666 0.199051]
     """
+
+    distribution_available = True
 
     def __init__(self, r):
         self._set_restitution(_exact_restitution(r))

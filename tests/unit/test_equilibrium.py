@@ -355,7 +355,7 @@ def test_above_the_distribution_range_the_speed_quantities_are_given(near_one):
         ("distribution_table", lambda eq: eq.distribution_table([0.1], [1.0])),
         ("weight_table", lambda eq: eq.weight_table([1.0])),
         ("summary", lambda eq: eq.summary()),
-        ("summary", lambda eq: eq.position_accuracy),
+        ("position_accuracy", lambda eq: eq.position_accuracy),
     ],
 )
 def test_above_the_distribution_range_the_position_quantities_are_refused(near_one, name, call):
