@@ -2,13 +2,15 @@
 and ``ExactEquilibrium`` (the paper's r = 1/2 and 1/3 solutions), with the same attributes and
 methods, so that one can stand in for the other.
 
-``Equilibrium(r)`` solves eq. (inteq) for P(0, v) once (``solver``), and builds the weight
-function w(F) of eq. (weightfunc) (``distribution``) the first time a position-dependent
-quantity is asked for (P(x), <v^2>_x, P(x, v), w(F): several seconds).  Every number is the
-one the workflow's solve stage writes to ``results/solver/r{r}/`` for the same settings: the
-same functions are called on the same solutions (P(0, v), the time averages and the flight
-times from the solve at ``quadrature_step``; w(F), P(x), <v^2>_x and P(x, v) from the solve
-that reaches P(0, v) ~ e^-690, ``distribution.outgoing_speed_solution``).
+``Equilibrium(r)`` solves eq. (inteq) for P(0, v) once, with the given quadrature step
+(``distribution.outgoing_speed_solution``: its nodes reach where P(0, v) falls to e^-690, as
+w(F) at small F needs), and builds the weight function w(F) of eq. (weightfunc) from that
+solution (``distribution``) the first time a position-dependent quantity is asked for (P(x),
+<v^2>_x, P(x, v), w(F): several seconds).  It is the workflow's solve rule (scripts/solve.py
+writes its tables to ``results/solver/r{r}/``), so every number is the one the rule writes for
+the same settings.  Above ``restitution.DISTRIBUTION_RESTITUTION_RANGE`` (up to
+``SOLVER_RESTITUTION_RANGE``) it gives P(0, v), the time averages, the flight times and the
+exponents, and its position-dependent methods raise ValueError naming r and the range.
 
 Its accuracy is measured, not assumed: ``accuracy`` is the solver's own estimate, the largest
 relative change of P(0, v) for 1e-3 <= v <= 20 against a finer solve
@@ -29,9 +31,11 @@ import numpy as np
 from scipy import integrate
 
 from .restitution import (
+    DISTRIBUTION_RESTITUTION_RANGE,
     EXACT_RESTITUTIONS,
     SOLVER_RESTITUTION_RANGE,
     check_solver_restitution,
+    in_range,
     parse_restitution,
     restitution_label,
 )
@@ -136,6 +140,9 @@ class _EquilibriumState:
     def _flight_rate(self, times):  # nu(T), T > 0
         raise NotImplementedError
 
+    def _check_distribution(self, what: str) -> None:  # ValueError where P(x) is not computed
+        pass
+
     # --- the public methods
     def p0v(self, v):
         """P(0, v) on the outgoing side of the floor, eq. (P(0,v)) (exact) or eq. (inteq).
@@ -183,6 +190,7 @@ class _EquilibriumState:
         >>> print(ExactEquilibrium("1/2").px([0.1, 1.0, 10.0]).round(6))
         [0.503776 0.183784 0.018862]
         """
+        self._check_distribution("px")
         x = _checked(x, "x", low=0.0)
         result = np.full(x.shape, self._floor_density())
         positive = x > 0.0
@@ -210,6 +218,7 @@ class _EquilibriumState:
         >>> print(ExactEquilibrium("1/2").v2_given_x([0.1, 1.0]).round(6))
         [1.853157 3.710784]
         """
+        self._check_distribution("v2_given_x")
         x = _checked(x, "x", low=0.0)
         result = np.full(x.shape, 1.0 / self._floor_density())
         positive = x > 0.0
@@ -239,6 +248,7 @@ class _EquilibriumState:
         >>> print(ExactEquilibrium("1/2").pxv(0.1, [-1.0, 0.0, 1.0]).round(6))
         [0.074292 0.198028 0.146809]
         """
+        self._check_distribution("pxv")
         x = _checked(x, "x", low=0.0)
         v = _checked(v, "v")
         x, v = _broadcast(x, v, ("x", "v"))
@@ -266,6 +276,7 @@ class _EquilibriumState:
         >>> print(ExactEquilibrium("1/2").weight([0.1, 1.0]).round(6))
         [0.229053 0.153341]
         """
+        self._check_distribution("weight")
         force = _checked(F, "F", low=0.0, strictly=True)
         return _out(np.asarray(self._weight(force), dtype=float))
 
@@ -381,23 +392,51 @@ class _EquilibriumState:
 # any r: the solver
 
 
-@functools.lru_cache(maxsize=16)
-def _weight_function(r: float, panel_nodes: int):
-    """(the far-reaching solution, its interpolated w(F)): built once per process and r."""
+@functools.lru_cache(maxsize=8)
+def _solution(exact: Fraction, step: float):
+    """P(0, v) of eq. (inteq) at r = ``exact``, trapezoidal step ``step``: solved once per process
+    and (r, step).  Where the whole distribution is computed (``DISTRIBUTION_RESTITUTION_RANGE``)
+    its nodes reach where P(0, v) falls to e^-690, as w(F) at small F needs
+    (``distribution.outgoing_speed_solution``); above, up to the solver's own highest node
+    (``solver.solve_outgoing_speed_density``), which holds P(0, v) and the time averages."""
+    from . import distribution, solver
+
+    if in_range(exact, DISTRIBUTION_RESTITUTION_RANGE):
+        return distribution.outgoing_speed_solution(exact, step=step)
+    return solver.solve_outgoing_speed_density(exact, step=step)
+
+
+@functools.lru_cache(maxsize=8)
+def _accuracy(exact: Fraction, step: float) -> float:
+    """``solver.accuracy_estimate`` of ``_solution(exact, step)`` (a second, finer solve)."""
+    from . import solver
+
+    return solver.accuracy_estimate(_solution(exact, step))
+
+
+@functools.lru_cache(maxsize=8)
+def _weight_function(exact: Fraction, step: float, panel_nodes: int):
+    """The interpolated w(F) of ``_solution(exact, step)``: built once per process."""
     from . import distribution
 
-    far = distribution.outgoing_speed_solution(r)
-    return far, distribution.interpolated_weight_function(far, panel_nodes=panel_nodes)
+    return distribution.interpolated_weight_function(
+        _solution(exact, step), panel_nodes=panel_nodes
+    )
 
 
 def _solver_restitution(r) -> Fraction:
     """r parsed and within the solver's range; the range is named whatever is wrong with r."""
+    low, high = SOLVER_RESTITUTION_RANGE
     try:
-        parse_restitution(r, "r")
+        exact = parse_restitution(r, "r")
     except ValueError as error:
-        low, high = SOLVER_RESTITUTION_RANGE
         raise ValueError(f"{error}; the solver answers {low} <= r <= {high}") from None
-    return check_solver_restitution(r, "r")
+    if not in_range(exact, SOLVER_RESTITUTION_RANGE):
+        raise ValueError(
+            f"r: r = {r!r} is outside the solver's range {low} <= r <= {high}, where P(0, v) of "
+            "eq. (inteq) meets its 1e-8 accuracy target (restitution.SOLVER_RESTITUTION_RANGE)"
+        )
+    return exact
 
 
 class Equilibrium(_EquilibriumState):
@@ -409,15 +448,18 @@ class Equilibrium(_EquilibriumState):
     r : float or str
         The coefficient of restitution, eq. (restitution): a decimal (read as written: 0.3 is
         3/10) or an exact fraction string such as ``"1/3"``, within the solver's range
-        (``restitution.SOLVER_RESTITUTION_RANGE``).
+        (``restitution.SOLVER_RESTITUTION_RANGE``).  The position-dependent quantities (P(x),
+        <v^2>_x, P(x, v), w(F)) are computed in ``restitution.DISTRIBUTION_RESTITUTION_RANGE``;
+        above it they raise ValueError, and P(0, v), the time averages, the flight times and the
+        exponents remain.
     exact : bool, optional
         If True, return the paper's exact solution, ``ExactEquilibrium(r)`` (r = 1/2 or 1/3).
     quadrature_step : float, optional
         The trapezoidal step of the solver in s = ln v + v^(1/2) (``solver.DEFAULT_STEP``; the
-        config's ``solver.quadrature_step``).
+        config's ``solver.quadrature_step``), 0 < step <= ``solver.LARGEST_STEP``.
     weight_panel_nodes : int, optional
-        Chebyshev nodes per panel of the interpolated w(F) (the config's
-        ``solver.weight_panel_nodes``).
+        Chebyshev nodes per panel of the interpolated w(F) (``distribution.PANEL_CHEBYSHEV_NODES``;
+        the config's ``solver.weight_panel_nodes``).
 
     Attributes
     ----------
@@ -441,8 +483,14 @@ class Equilibrium(_EquilibriumState):
     position_accuracy : float
         The largest of |int P dx - 1| and the relative differences of <x>, Delta x from P(x)
         (eq. (P(x)1)) and from the Ito identities (builds w(F) on first use).
+    distribution_available : bool
+        Whether r lies in ``restitution.DISTRIBUTION_RESTITUTION_RANGE``, where P(x), <v^2>_x,
+        P(x, v) and w(F) are computed.
     solution : solver.OutgoingSpeedSolution
-        P(0, v) at the solver's nodes.
+        P(0, v) at the solver's nodes: the one solve everything here is computed from (the
+        workflow's solve rule writes the same numbers).
+    quadrature_step : float
+    weight_panel_nodes : int
 
     Examples
     --------
@@ -479,13 +527,20 @@ class Equilibrium(_EquilibriumState):
         nodes = (
             distribution.PANEL_CHEBYSHEV_NODES if weight_panel_nodes is None else weight_panel_nodes
         )
-        if isinstance(step, bool) or not isinstance(step, (int, float)) or not 0.0 < step < 1.0:
-            raise ValueError(f"quadrature_step must be a number in (0, 1), got {step!r}")
+        if (
+            isinstance(step, bool)
+            or not isinstance(step, (int, float))
+            or not 0.0 < step <= solver.LARGEST_STEP
+        ):
+            raise ValueError(
+                f"quadrature_step must be a number in (0, {solver.LARGEST_STEP}], got {step!r}"
+            )
         if isinstance(nodes, bool) or not isinstance(nodes, int) or nodes < 2:
             raise ValueError(f"weight_panel_nodes must be a whole number >= 2, got {nodes!r}")
         self.quadrature_step = float(step)
         self.weight_panel_nodes = nodes
-        self.solution = solver.solve_outgoing_speed_density(self.r, step=self.quadrature_step)
+        self.distribution_available = in_range(self.restitution, DISTRIBUTION_RESTITUTION_RANGE)
+        self.solution = _solution(self.restitution, self.quadrature_step)
         averages = solver.time_averages(self.solution)
         self.collision_rate = float(averages["collision_rate"])
         self.mean_x = float(averages["mean_x"])
@@ -493,34 +548,45 @@ class Equilibrium(_EquilibriumState):
         self.mean_flight_time = float(flight_time.mean_flight_time(self.solution))
         self.flight_time_second_moment = float(flight_time.flight_time_second_moment(self.solution))
 
+    def _check_distribution(self, what: str) -> None:
+        if not self.distribution_available:
+            try:
+                check_solver_restitution(self.r, "r")
+            except ValueError as error:
+                raise ValueError(
+                    f"{error}: Equilibrium.{what} needs w(F) of eq. (weightfunc), computed "
+                    f"only there; at r = {self.label} Equilibrium gives P(0, v), the time "
+                    "averages, the flight times and the exponents"
+                ) from None
+
     # --- lazily built
-    @functools.cached_property
+    @property
     def accuracy(self) -> float:
         """The solver's error estimate (``solver.accuracy_estimate``): the largest relative
         change of P(0, v) over 1e-3 <= v <= 20 against a finer solve (computed on first use)."""
-        from . import solver
-
-        return solver.accuracy_estimate(self.solution)
+        return _accuracy(self.restitution, self.quadrature_step)
 
     @property
     def weight_function(self):
-        """w(F) of eq. (weightfunc), interpolated (``distribution.WeightFunction``); built on
-        first use (several seconds), then kept for the process."""
-        return _weight_function(self.r, self.weight_panel_nodes)[1]
-
-    @property
-    def far_solution(self):
-        """P(0, v) solved out to where it reaches e^-690 (``distribution.outgoing_speed_solution``):
-        what w(F) and P(x, v) at x = 0 are computed from."""
-        return _weight_function(self.r, self.weight_panel_nodes)[0]
+        """w(F) of eq. (weightfunc), interpolated from ``solution``
+        (``distribution.WeightFunction``); built on first use (several seconds), then kept for
+        the process."""
+        self._check_distribution("weight_function")
+        return _weight_function(self.restitution, self.quadrature_step, self.weight_panel_nodes)
 
     @functools.cached_property
+    def _position_averages(self) -> dict:
+        """int P dx, <x> and Delta x from P(x) of eq. (P(x)1) (``distribution.position_averages``)."""
+        from . import distribution
+
+        self._check_distribution("position_accuracy")
+        return distribution.position_averages(self.weight_function)
+
+    @property
     def position_accuracy(self) -> float:
         """max(|int P dx - 1|, |<x>_P / <x> - 1|, |Delta x_P / Delta x - 1|): P(x) of
         eq. (P(x)1) against the normalisation and the solver's Ito identities (builds w(F))."""
-        from . import distribution
-
-        averages = distribution.position_averages(self.weight_function)
+        averages = self._position_averages
         return float(
             max(
                 abs(averages["normalization"] - 1.0),
@@ -549,7 +615,7 @@ class Equilibrium(_EquilibriumState):
     def _joint(self, x, v):
         from . import distribution
 
-        return distribution.distribution(x, v, self.weight_function, self.far_solution)
+        return distribution.distribution(x, v, self.weight_function, self.solution)
 
     def _weight(self, force):
         return self.weight_function(force)
@@ -560,16 +626,38 @@ class Equilibrium(_EquilibriumState):
         return flight_time.flight_rate_density(self.solution, times)
 
     # --- the workflow's tables (results/solver/r{r}/)
+    @functools.cached_property
+    def _summary(self) -> dict:
+        from . import distribution, flight_time, solver
+
+        self._check_distribution("summary")
+        row = solver.solution_summary(self.solution, with_accuracy_estimate=False)
+        row["accuracy_estimate"] = self.accuracy
+        collisions = flight_time.flight_time_summary(self.solution)
+        row.update({key: value for key, value in collisions.items() if key not in row})
+        weight = self.weight_function
+        averages = self._position_averages
+        row["position_normalization"] = averages["normalization"]
+        row["mean_x_from_position"] = averages["mean_x"]
+        row["delta_x_from_position"] = averages["delta_x"]
+        row["weight_interpolation_error"] = weight.interpolation_error
+        measured = distribution.measured_exponents(weight)
+        for key, value in distribution.predicted_exponents(self.restitution).items():
+            row[f"{key}_measured"], row[f"{key}_predicted"] = measured[key], value
+        row["large_x_window_lo"], row["large_x_window_hi"] = measured["large_x_window"]
+        return row
+
     def summary(self) -> dict:
-        """The solve stage's summary row: ``solver.solution_summary`` (with the accuracy
+        """The solve rule's summary row: ``solver.solution_summary`` (with the accuracy
         estimate), the collision statistics (``flight_time.flight_time_summary``), <x>, Delta x
-        and the normalisation from P(x) (eqs. (P(x)1), (xandDeltax)), and the measured and
-        predicted exponents of P(x) (``distribution.measured_exponents``).
+        and the normalisation from P(x) (eqs. (P(x)1), (xandDeltax)), the interpolation error
+        of w(F) (``WeightFunction.interpolation_error``), and the measured and predicted
+        exponents of P(x) with the large-x fit window (``distribution.measured_exponents``).
 
         Returns
         -------
         dict
-            One row of ``results/solver/r{r}/summary.parquet``.
+            One row of ``results/solver/r{r}/summary.parquet`` (a copy: computed once).
 
         Examples
         --------
@@ -578,19 +666,34 @@ class Equilibrium(_EquilibriumState):
         >>> print(f"{row['mean_x']:.8f} {row['mean_x_from_position']:.8f}")
         6.00000000 6.00000000
         """
-        from . import distribution, flight_time, solver
+        return dict(self._summary)
 
-        row = solver.solution_summary(self.solution)
-        collisions = flight_time.flight_time_summary(self.solution)
-        row.update({key: value for key, value in collisions.items() if key not in row})
-        averages = distribution.position_averages(self.weight_function)
-        row["position_normalization"] = averages["normalization"]
-        row["mean_x_from_position"] = averages["mean_x"]
-        row["delta_x_from_position"] = averages["delta_x"]
-        measured = distribution.measured_exponents(self.weight_function)
-        for key, value in distribution.predicted_exponents(self.r).items():
-            row[f"{key}_measured"], row[f"{key}_predicted"] = measured[key], value
-        return row
+    def check(self, tables) -> None:
+        """The solve rule's checks of its tables and of ``summary()``: no NaN where a value is
+        defined, int P dx = 1 and the moments from P(x) equal the Ito moments within the
+        accuracy estimate, the measured exponents within their tolerance of the predicted ones
+        (``distribution.check_solve_tables``, held to ``solver.ACCURACY_TARGET``).
+
+        Parameters
+        ----------
+        tables : dict of str to pandas.DataFrame
+            Any of p0v, flight_time, return_speed, position, distribution, weight, as the table
+            methods give them.
+
+        Raises
+        ------
+        ValueError
+            Naming r and every check that fails.
+
+        Examples
+        --------
+        >>> from bouncing_ball import Equilibrium
+        >>> eq = Equilibrium("1/2")
+        >>> eq.check({"position": eq.position_table([0.1, 1.0])})
+        """
+        from . import distribution, solver
+
+        distribution.check_solve_tables(self.label, self.summary(), tables, solver.ACCURACY_TARGET)
 
     def p0v_table(self, speeds):
         """P(0, v) of eq. (inteq) as a table (``results/solver/r{r}/p0v``).
@@ -642,6 +745,7 @@ class Equilibrium(_EquilibriumState):
         """
         from . import distribution
 
+        self._check_distribution("position_table")
         positions = _checked(positions, "positions", low=0.0, strictly=True)
         return distribution.position_table(self.weight_function, positions)
 
@@ -672,10 +776,11 @@ class Equilibrium(_EquilibriumState):
         """
         from . import distribution
 
+        self._check_distribution("distribution_table")
         positions = _checked(positions, "positions", low=0.0)
         speeds = _checked(speeds, "speeds")
         return distribution.distribution_table(
-            self.weight_function, self.far_solution, positions, speeds
+            self.weight_function, self.solution, positions, speeds
         )
 
     def weight_table(self, forces):
@@ -700,6 +805,7 @@ class Equilibrium(_EquilibriumState):
         """
         from . import distribution
 
+        self._check_distribution("weight_table")
         forces = _checked(forces, "forces", low=0.0, strictly=True)
         return distribution.weight_table(self.weight_function, forces)
 
@@ -799,6 +905,8 @@ class ExactEquilibrium(_EquilibriumState):
     >>> print(eq.px([0.1, 1.0]).round(6))
     [0.815666 0.199051]
     """
+
+    distribution_available = True
 
     def __init__(self, r):
         self._set_restitution(_exact_restitution(r))

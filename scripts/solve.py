@@ -1,68 +1,53 @@
-"""Rule solve: eq. (inteq) solved for P(0, v) at one r, with <x>, Delta x, I, accuracy checks,
-the collision statistics and the whole distribution -> results/solver/r{r}/: p0v (v, p0v),
-summary (one row), flight_time (the equilibrium flight-time density on solver.flight_times),
-position (P(x), <v^2>_x, eqs. (P(x)1), (moment2)), distribution (P(x, v), eq. (fpsol)) and
-weight (w(F), eq. (weightfunc))."""
+"""Rule solve: the equilibrium at one r from eq. (inteq), bouncing_ball.Equilibrium with the
+config's solver settings, its tables checked and written -> results/solver/r{r}/: p0v (v, p0v),
+summary (one row: <x>, Delta x, I, the collision statistics, the accuracy checks), flight_time
+(the flight-time density on solver.flight_times), return_speed (on the simulation's speed
+bins), position (P(x), <v^2>_x, eqs. (P(x)1), (moment2)), distribution (P(x, v), eq. (fpsol))
+and weight (w(F), eq. (weightfunc))."""
 
 import logging
 import time
 
 import pandas as pd
 
-from bouncing_ball import distribution, flight_time, solver
+from bouncing_ball import solver
 from bouncing_ball.bins import linear_grid, log_bins, log_grid
-from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
+from bouncing_ball.equilibrium import Equilibrium
+from bouncing_ball.restitution import exact_string, parse_restitution
 from bouncing_ball.workflow.io import write_tables
 from bouncing_ball.workflow.jobs import job_log
 
 with job_log(snakemake.log[0]):
     settings = snakemake.params.settings
     exact = parse_restitution(snakemake.params.restitution)
-    label = restitution_label(exact)
     started = time.perf_counter()
-    # eq. (inteq), solved once: the highest node where P(0, v) reaches e^-690, as w(F) at small
-    # F needs (distribution.outgoing_speed_solution), with the config's quadrature step
-    solution = distribution.outgoing_speed_solution(exact, step=settings["quadrature_step"])
+    # eq. (inteq), solved once with the config's quadrature step, its time averages, and its
+    # accuracy estimate (a second, finer solve)
+    equilibrium = Equilibrium(
+        exact,
+        quadrature_step=settings["quadrature_step"],
+        weight_panel_nodes=settings["weight_panel_nodes"],
+    )
+    accuracy = equilibrium.accuracy
     elapsed = time.perf_counter() - started
-    speeds = log_grid(settings["output_speeds"])
-    row = solver.solution_summary(solution)
-    # the collision statistics: McKean's first-passage law with gravity (bouncing_ball.flight_time)
-    collisions = flight_time.flight_time_summary(solution)
-    row.update({key: value for key, value in collisions.items() if key not in row})
-    flights = flight_time.flight_time_table(solution, log_grid(settings["flight_times"]))
-    returns = flight_time.return_speed_table(solution, log_bins(snakemake.params.speed_bins))
-    # the whole distribution from P(0, v) (bouncing_ball.distribution): w(F), then P(x), P(x, v)
-    started_distribution = time.perf_counter()
-    weight = distribution.interpolated_weight_function(
-        solution, panel_nodes=settings["weight_panel_nodes"]
-    )
-    position = distribution.position_table(weight, log_grid(settings["position_grid"]))
-    joint, worst = distribution.distribution_table(
-        weight, solution, settings["positions"], linear_grid(settings["speeds"])
-    )
-    weights = distribution.weight_table(weight, log_grid(settings["forces"]))
-    averages = distribution.position_averages(weight)
-    row["position_normalization"] = averages["normalization"]
-    row["mean_x_from_position"] = averages["mean_x"]
-    row["delta_x_from_position"] = averages["delta_x"]
-    row["weight_interpolation_error"] = weight.interpolation_error
-    measured = distribution.measured_exponents(weight)
-    for key, value in distribution.predicted_exponents(exact).items():
-        row[f"{key}_measured"], row[f"{key}_predicted"] = measured[key], value
-    row["large_x_window_lo"], row["large_x_window_hi"] = measured["large_x_window"]
-    p0v = pd.DataFrame({"v": speeds, "p0v": solution.outgoing_speed_density(speeds)})
+    label = equilibrium.label
     tables = {
-        "p0v": p0v,
-        "flight_time": flights,
-        "return_speed": returns,
-        "position": position,
-        "distribution": joint,
-        "weight": weights,
+        "p0v": equilibrium.p0v_table(log_grid(settings["output_speeds"])),
+        "flight_time": equilibrium.flight_time_table(log_grid(settings["flight_times"])),
+        "return_speed": equilibrium.return_speed_table(log_bins(snakemake.params.speed_bins)),
     }
+    # the whole distribution from the same P(0, v): w(F), then P(x), P(x, v)
+    started_distribution = time.perf_counter()
+    tables["position"] = equilibrium.position_table(log_grid(settings["position_grid"]))
+    tables["distribution"], worst = equilibrium.distribution_table(
+        settings["positions"], linear_grid(settings["speeds"])
+    )
+    tables["weight"] = equilibrium.weight_table(log_grid(settings["forces"]))
+    row = equilibrium.summary()
     logging.info(
-        "r=%s: %d nodes, solved in %.1f ms (first call: includes loading the compiled kernel); "
-        "<x> = %.10g, Delta x = %.10g, I = %.10g; energy balance residual %.1e, "
-        "eigenvalue - 1 = %.1e, accuracy estimate %.1e",
+        "r=%s: %d nodes, solved with its time averages and accuracy estimate in %.1f ms (first "
+        "call: includes loading the compiled kernel); <x> = %.10g, Delta x = %.10g, I = %.10g; "
+        "energy balance residual %.1e, eigenvalue - 1 = %.1e, accuracy estimate %.1e",
         label,
         row["grid_size"],
         1e3 * elapsed,
@@ -71,13 +56,13 @@ with job_log(snakemake.log[0]):
         row["collision_rate"],
         row["energy_balance_residual"],
         row["eigenvalue_residual"],
-        row["accuracy_estimate"],
+        accuracy,
     )
-    if not row["accuracy_estimate"] <= solver.ACCURACY_TARGET:
+    if not accuracy <= solver.ACCURACY_TARGET:
         logging.warning(
             "r=%s: accuracy estimate %.1e misses the %.0e target (solver.quadrature_step %g)",
             label,
-            row["accuracy_estimate"],
+            accuracy,
             solver.ACCURACY_TARGET,
             settings["quadrature_step"],
         )
@@ -101,13 +86,13 @@ with job_log(snakemake.log[0]):
         row["large_x_power_predicted"],
     )
     # nothing is written unless every table passes (an error naming r and the failed checks)
-    distribution.check_solve_tables(label, row, tables, solver.ACCURACY_TARGET)
+    equilibrium.check(tables)
     provenance = {
         "rule": "solve",
         "r": exact_string(exact),
         "r_label": label,
         "quadrature_step": settings["quadrature_step"],
-        "highest_speed": float(solution.speeds[-1]),
+        "highest_speed": float(equilibrium.solution.speeds[-1]),
         "weight_panel_nodes": settings["weight_panel_nodes"],
         "settings": settings,
         "speed_bins": snakemake.params.speed_bins,

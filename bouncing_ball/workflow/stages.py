@@ -35,6 +35,7 @@ SOLVER = (
     "asymptotics",
     "bins",
     "distribution",
+    "equilibrium",
     "flight_time",
     "jit",
     "kernel",

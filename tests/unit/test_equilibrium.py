@@ -13,7 +13,13 @@ from scipy import integrate
 from workflow_support import TEST_CONFIG
 
 import bouncing_ball as bb
-from bouncing_ball.restitution import SOLVER_RESTITUTION_RANGE
+from bouncing_ball import solver
+from bouncing_ball.asymptotics import (
+    large_speed_decay_rate,
+    large_speed_exponent,
+    small_speed_exponent,
+)
+from bouncing_ball.restitution import DISTRIBUTION_RESTITUTION_RANGE, SOLVER_RESTITUTION_RANGE
 from bouncing_ball.workflow.batches import batch_to_frame, simulate_batch
 from bouncing_ball.workflow.config import read_config, shard_settings
 
@@ -225,7 +231,22 @@ def test_bad_arguments_are_refused_with_their_name(kind, call, error, match, hal
 LOW, HIGH = SOLVER_RESTITUTION_RANGE
 
 
-@pytest.mark.parametrize("r", [1.5, 0.0, -0.2, 0.5 * LOW, float("nan"), "a half", None, [0.5]])
+@pytest.mark.parametrize(
+    "r",
+    [
+        1.5,
+        0.0,
+        -0.2,
+        0.5 * LOW,
+        0.0199,
+        "99991/100000",
+        0.99995,
+        float("nan"),
+        "a half",
+        None,
+        [0.5],
+    ],
+)
 def test_bad_restitution_is_refused_with_the_range_named(r):
     with pytest.raises(ValueError, match=r"^r: ") as refused:
         bb.Equilibrium(r)
@@ -286,3 +307,73 @@ def test_simulate_defaults_are_the_default_config():
     default = shard_settings(config, "0.5").replace(shard_time=1.0)
     assert _shard_settings(1.0, None) == default
     assert set(DEFAULT_SETTINGS) < set(default.names())
+
+
+# --- above the range of the whole distribution: P(0, v), the time averages, the flight times
+
+DISTRIBUTION_HIGH = DISTRIBUTION_RESTITUTION_RANGE[1]
+
+
+@pytest.fixture(scope="module")
+def near_one():
+    """r = 0.95, above DISTRIBUTION_RESTITUTION_RANGE (where w(F) misses its accuracy)."""
+    return bb.Equilibrium(0.95)
+
+
+def test_above_the_distribution_range_the_speed_quantities_are_given(near_one):
+    """P(0, v), the time averages, the flight times and the exponents at r = 0.95: the solution
+    balances energy (an identity the solve does not impose) to the solver's target, and the
+    exponents are the asymptotic ones."""
+    eq = near_one
+    assert not eq.distribution_available
+    assert abs(solver.energy_balance_residual(eq.solution)) < solver.ACCURACY_TARGET
+    assert 0.0 < eq.accuracy < solver.ACCURACY_TARGET
+    speeds = np.array([1e-3, 0.1, 1.0, 10.0, 100.0])
+    p0v = eq.p0v(speeds)
+    assert np.all(np.isfinite(p0v)) and np.all(p0v > 0.0)
+    for name in ("collision_rate", "mean_x", "delta_x", "mean_flight_time"):
+        assert np.isfinite(getattr(eq, name)) and getattr(eq, name) > 0.0
+    assert eq.mean_flight_time == pytest.approx(1.0 / eq.collision_rate, rel=1e-10)
+    density = eq.flight_time_density([0.1, 1.0, 100.0])
+    assert np.all(np.isfinite(density)) and np.all(density > 0.0)
+    assert eq.beta == small_speed_exponent(0.95) and eq.m == large_speed_exponent(0.95)
+    assert eq.q == large_speed_decay_rate(0.95)
+    assert set(eq.p0v_table(speeds).columns) == {"v", "p0v"}
+    assert np.all(np.isfinite(eq.flight_time_table([1.0, 10.0])["density"]))
+
+
+@pytest.mark.parametrize(
+    ("name", "call"),
+    [
+        ("px", lambda eq: eq.px(1.0)),
+        ("px", lambda eq: eq.px(0.0)),
+        ("v2_given_x", lambda eq: eq.v2_given_x([1.0, 2.0])),
+        ("pxv", lambda eq: eq.pxv(0.0, 1.0)),
+        ("weight", lambda eq: eq.weight(1.0)),
+        ("weight_function", lambda eq: eq.weight_function),
+        ("position_table", lambda eq: eq.position_table([1.0])),
+        ("distribution_table", lambda eq: eq.distribution_table([0.1], [1.0])),
+        ("weight_table", lambda eq: eq.weight_table([1.0])),
+        ("summary", lambda eq: eq.summary()),
+        ("position_accuracy", lambda eq: eq.position_accuracy),
+    ],
+)
+def test_above_the_distribution_range_the_position_quantities_are_refused(near_one, name, call):
+    """At r = 0.95 P(x) came out NaN: refused, naming r, the range of the whole distribution
+    and the method."""
+    with pytest.raises(ValueError, match=rf"^r: r = 0.95 .* {LOW} <= r <= {DISTRIBUTION_HIGH}\b"):
+        call(near_one)
+    with pytest.raises(ValueError, match=rf"Equilibrium.{name} needs w\(F\)"):
+        call(near_one)
+
+
+def test_the_upper_end_of_the_solver_range_is_solved():
+    """r = 0.9999, the solver's upper bound (given as the exact fraction, and as the decimal):
+    the solution balances energy to the solver's target."""
+    eq = bb.Equilibrium("9999/10000")
+    assert eq.restitution == Fraction(9999, 10000) and not eq.distribution_available
+    assert bb.Equilibrium(0.9999).solution is eq.solution
+    assert abs(solver.energy_balance_residual(eq.solution)) < solver.ACCURACY_TARGET
+    assert np.isfinite(eq.mean_x) and np.isfinite(eq.mean_flight_time)
+    with pytest.raises(ValueError, match=rf"{LOW} <= r <= {DISTRIBUTION_HIGH}"):
+        eq.px(1.0)

@@ -1,18 +1,23 @@
-"""The public API gives the workflow's numbers: Equilibrium(r) with the config's solver
-settings against the tables the solve rule writes (results/solver/r{r}/), at the first r of
-the small config, in a temporary copy of the repository (one solve job)."""
+"""The solve rule is Equilibrium: a fresh Equilibrium(r) in the test process, with the settings
+the rule's files record, against the tables the rule writes (results/solver/r{r}/) at the
+first r of the small config, in a temporary copy of the repository (one solve job).  The rule
+builds its tables with the same methods, so this checks that they are reproduced in another
+process (the solve, w(F) and the quadratures are deterministic), and that the pointwise methods
+(px, pxv, weight, ...) give the tables' rows."""
 
 import numpy as np
+import pandas as pd
 import pytest
 from workflow_support import SMALL, copy_repository, snakemake
 
 import bouncing_ball as bb
+from bouncing_ball.bins import linear_grid, log_bins, log_grid
 from bouncing_ball.restitution import parse_restitution, restitution_label
 from bouncing_ball.workflow.io import read_table
 
 R = SMALL["restitution"][0]
 LABEL = restitution_label(parse_restitution(R))
-TABLES = ("p0v", "summary", "flight_time", "position", "distribution", "weight")
+TABLES = ("p0v", "summary", "flight_time", "return_speed", "position", "distribution", "weight")
 
 
 @pytest.fixture(scope="module")
@@ -21,12 +26,17 @@ def solved(tmp_path_factory):
     targets = [f"results/solver/r{LABEL}/{name}.parquet" for name in TABLES]
     result = snakemake(directory, *targets)
     assert result.returncode == 0, result.stderr[-3000:]
-    tables = {name: read_table(directory / target)[0] for name, target in zip(TABLES, targets)}
+    read = {name: read_table(directory / target) for name, target in zip(TABLES, targets)}
+    tables = {name: table for name, (table, _) in read.items()}
+    provenance = read["summary"][1]
+    assert provenance["quadrature_step"] == SMALL["solver"]["quadrature_step"]
+    assert provenance["weight_panel_nodes"] == SMALL["solver"]["weight_panel_nodes"]
     equilibrium = bb.Equilibrium(
         R,
-        quadrature_step=SMALL["solver"]["quadrature_step"],
-        weight_panel_nodes=SMALL["solver"]["weight_panel_nodes"],
+        quadrature_step=provenance["quadrature_step"],
+        weight_panel_nodes=provenance["weight_panel_nodes"],
     )
+    tables["provenance"] = provenance
     return tables, equilibrium
 
 
@@ -75,3 +85,30 @@ def test_scalars_are_the_workflow_summary(solved):
     assert set(summary) == set(tables["summary"].columns)
     for name, value in summary.items():
         _same(value, row[name], atol=RESIDUAL if "residual" in name or "accuracy" in name else 0.0)
+
+
+def test_the_rule_tables_are_the_table_methods_with_its_settings(solved):
+    """Every frame the rule writes is the table method's for the grids its provenance records,
+    column by column to rtol 1e-12 (the summary's residual and accuracy columns, above, and the
+    return-speed law to their rounding), and the solution reaches the highest speed it
+    records."""
+    tables, eq = solved
+    settings, provenance = tables["provenance"]["settings"], tables["provenance"]
+    assert float(eq.solution.speeds[-1]) == provenance["highest_speed"]
+    joint, _ = eq.distribution_table(settings["positions"], linear_grid(settings["speeds"]))
+    ours = {
+        "p0v": eq.p0v_table(log_grid(settings["output_speeds"])),
+        "flight_time": eq.flight_time_table(log_grid(settings["flight_times"])),
+        "return_speed": eq.return_speed_table(log_bins(provenance["speed_bins"])),
+        "position": eq.position_table(log_grid(settings["position_grid"])),
+        "distribution": joint,
+        "weight": eq.weight_table(log_grid(settings["forces"])),
+    }
+    for name, table in ours.items():
+        # the return-speed probabilities are differences of the cumulative law, of order 1: the
+        # far bins' are its rounding (-5.6e-13 at r = 1/2), equal to the rounding of the law
+        atol = RESIDUAL if name == "return_speed" else 0.0
+        pd.testing.assert_frame_equal(
+            table, tables[name], check_exact=False, rtol=1e-12, atol=atol, obj=name
+        )
+    assert list(eq.summary()) == list(tables["summary"].columns)
