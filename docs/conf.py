@@ -21,7 +21,8 @@ extensions = [
     "sphinx.ext.mathjax",
 ]
 
-source_suffix = {".md": "myst-nb", ".rst": "restructuredtext"}
+# .rst first: autosummary writes its generated pages (reStructuredText) with the first suffix
+source_suffix = {".rst": "restructuredtext", ".md": "myst-nb"}
 exclude_patterns = ["_build", "requirements.txt"]
 root_doc = "index"
 
@@ -36,6 +37,9 @@ nb_execution_raise_on_error = True
 nb_merge_streams = True
 
 autosummary_generate = True
+# a module's page (docs/_templates/autosummary/module_page.rst) lists the names of its __all__
+autosummary_ignore_module_all = False
+templates_path = ["_templates"]
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 

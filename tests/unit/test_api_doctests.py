@@ -1,12 +1,17 @@
-"""The Examples of the public API's docstrings run as doctests (cheap ones: the exact solutions,
-the solve at r = 1/2, and tiny simulations)."""
+"""The Examples of the public API's and the physics modules' docstrings run as doctests (cheap
+ones: the exact solutions, the solve at r = 1/2, tiny simulations, and pure numpy/scipy
+functions; none compiles a numba function)."""
 
 import doctest
 import importlib
 
 import pytest
 
-MODULES = ["bouncing_ball.equilibrium", "bouncing_ball.monte_carlo"]
+MODULES = [
+    "bouncing_ball.equilibrium",
+    "bouncing_ball.monte_carlo",
+    "bouncing_ball.asymptotics",
+]
 
 
 @pytest.mark.parametrize("name", MODULES)
