@@ -11,6 +11,10 @@ MODULES = [
     "bouncing_ball.equilibrium",
     "bouncing_ball.monte_carlo",
     "bouncing_ball.asymptotics",
+    "bouncing_ball.bins",
+    "bouncing_ball.equilibration",
+    "bouncing_ball.jit",
+    "bouncing_ball.settings",
 ]
 
 
