@@ -12,7 +12,9 @@ MODULES = [
     "bouncing_ball.monte_carlo",
     "bouncing_ball.asymptotics",
     "bouncing_ball.bins",
+    "bouncing_ball.comparison",
     "bouncing_ball.equilibration",
+    "bouncing_ball.fits",
     "bouncing_ball.jit",
     "bouncing_ball.settings",
 ]
