@@ -15,6 +15,7 @@ MODULES = [
     "bouncing_ball.comparison",
     "bouncing_ball.equilibration",
     "bouncing_ball.fits",
+    "bouncing_ball.flight_time",
     "bouncing_ball.jit",
     "bouncing_ball.settings",
 ]
