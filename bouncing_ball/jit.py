@@ -153,6 +153,11 @@ class RecoveringFunctionCache(FunctionCache):
     ``njit`` gives every cached function this class.  A damaged index (a truncated write, a
     full disk) is reported with its folder and removed, and the function recompiled, where
     numba would raise ``UnpicklingError`` in every job.
+
+    Parameters
+    ----------
+    py_func : function
+        The Python function compiled (as for ``numba.core.caching.FunctionCache``).
     """
 
     def load_overload(self, sig, target_context):
