@@ -60,8 +60,7 @@ MOMENT_COLUMNS = (
 
 
 def moment_rows(label, restitution, simulation, solver, exact=None):
-    """The time averages <x>, Delta x and I of eq. (xandDeltax) for one r, held against the
-    reference.
+    """The time averages <x>, Delta x and I of eq. (xandDeltax) of one r, with their z.
 
     z = (simulation - reference) / simulation_err, the reference being the exact value where
     there is one and the solver's otherwise.
@@ -326,8 +325,10 @@ _FLIPS_PER_BLOCK = 1000  # flips evaluated at once (memory: block x bins)
 
 
 def sign_flip_test(deviations, flips=SIGN_FLIPS, seed=SIGN_FLIP_SEED):
-    """chi^2 per bin of shard-level deviations from a prediction, and the p-values of chi^2
-    and of the largest z^2 against their sign-flip null distributions.
+    """The sign-flip test of shard-level deviations from a prediction.
+
+    chi^2 per bin of the deviations, and the p-values of chi^2 and of the largest z^2 against
+    their sign-flip null distributions.
 
     Parameters
     ----------

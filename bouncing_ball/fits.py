@@ -717,10 +717,9 @@ def bin_averages_of_curve(speeds, density, lower, upper):
 
 
 def fit_errors(errors, reference, expected):
-    """The per-bin standard errors that weight a fit: the jackknife's, except where it has
-    none to give.
+    """The per-bin standard errors that weight a fit.
 
-    With few shards a bin's jackknife error can be exactly 0 (every shard put the same
+    The jackknife's, except where it has none to give.  With few shards a bin's jackknife error can be exactly 0 (every shard put the same
     number of collisions there) or undefined; such a bin is weighted by its Poisson error
     from the collisions it should hold, ``reference / sqrt(expected)``, so that it stays in
     the fit (dropping it because of what its counts happened to be would select on the data).

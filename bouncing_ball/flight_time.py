@@ -1328,7 +1328,9 @@ def _speed_sub_bins(lower, upper, panels=10, efolds=40.0):
 
 
 def return_speed_bin_probabilities(outgoing_density, u_lower, u_upper, v_lower, v_upper):
-    """Matrix [i, j]: probability that the return speed lies in v-bin j, given an outgoing speed in
+    """The return-speed law v G_g(v, u) of eq. (kernel3) between bins of u and of v.
+
+    Matrix [i, j]: probability that the return speed lies in v-bin j, given an outgoing speed in
     u-bin i distributed as u P(0, u) (the rate of collisions, eq. (collrate)) within the bin:
 
         int_(u-bin) du u P(0, u) int_(v-bin) dv v G_g(v, u) / int_(u-bin) du u P(0, u).

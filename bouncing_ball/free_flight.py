@@ -168,8 +168,9 @@ def _householder_root(x, v, c, s, iterations):
 
 @njit(cache=True, inline="always")
 def criterion_root(x, v, c, start):
-    """The largest step allowed by eq. (criterion): the positive root s* of
-    f(s) = x + v s^2 - c s^3 - s^4/2 (s = sqrt(Delta)), and the slope f' there.
+    """The root s* = sqrt(Delta) of eq. (criterion) that sets the largest step, and f'(s*).
+
+    s* is the positive root of f(s) = x + v s^2 - c s^3 - s^4/2 (s = sqrt(Delta)).
 
     By Descartes' rule f has exactly one positive root, where f' < 0 (and f' < 0,
     f'' < 0 on [s*, inf)).  At x = 0 (x below the smallest normal double counts as
@@ -215,7 +216,9 @@ def criterion_root(x, v, c, start):
 
 @njit(cache=True, inline="always")
 def root_predictor(root, slope_at_root, x, v):
-    """The coefficients (k0, k1, k2) of the next step's start for ``criterion_root``,
+    """The first-order prediction of the next step's root of eq. (criterion).
+
+    The coefficients (k0, k1, k2) of the next step's start for ``criterion_root``,
     s ~ k0 - k1 x1 - k2 v1 at the step's end (x1, v1): f(s; x, v) is linear in x and v and
     f(root; x, v) = 0, so to first order s ~ root - (x1 - x + root^2 (v1 - v)) / f'(root).
     They depend only on the step's start, so they are ready (division included) before
@@ -580,7 +583,9 @@ def quintic_antiderivative_value(s1, s2, s3, s4, s5, t):
 
 @njit(cache=True, inline="always")
 def piece_inverse(t_lo, t_hi, x_lo, x_hi, d_lo, d_hi):
-    """What ``level_time`` needs of a monotone piece [t_lo, t_hi] of the mean path, from
+    """The inverse of a monotone piece of the mean path, as ``level_time`` needs it.
+
+    What ``level_time`` needs of a monotone piece [t_lo, t_hi] of the mean path, from
     x_lo, x_hi and the slopes d_lo, d_hi at its ends (its divisions, done once a piece):
     (t_lo, width, x_lo, rise, 1 / rise, m0, m1), where m0 and m1 are the end slopes of
     the inverse t(m) on [0, 1] x [0, 1] (0, 0 where an end slope is below 0.1 of the
@@ -627,7 +632,9 @@ def _level_time_estimate(level, inverse):
 
 @njit(cache=True, inline="always")
 def level_time_one_step(a0, a1, a2, a3, level, inverse):
-    """``_level_time_estimate`` and one Halley step from it, with no test and no iteration
+    """The time the mean path crosses a level, to one Halley step (no test, no iteration).
+
+    ``_level_time_estimate`` and one Halley step from it, with no test and no iteration
     (it may leave the piece, or be NaN where m' vanishes: the caller clips it).  On the
     crossings of simulated steps (r = 1/2, c = 5) its error is below 1e-9 of the piece for
     about 70 % of them and below 3e-3 for 99 %; next to a turning point it can be a few
@@ -658,7 +665,9 @@ def level_time_one_step(a0, a1, a2, a3, level, inverse):
 
 @njit(cache=True, inline="always")
 def level_time(a0, a1, a2, a3, level, inverse):
-    """The t where the mean path m(t) = level on a monotone piece that brackets it
+    """The time the mean path crosses a level on a monotone piece, to about 1e-9 of the piece.
+
+    The t where the mean path m(t) = level on a monotone piece that brackets it
     (``inverse``: the piece's ``piece_inverse``), to about 1e-9 of the piece: where a
     collision cuts a step (``first_crossing_time``), and the P(x) tally's edge crossings
     in such a step; its other crossings use ``level_time_one_step``.

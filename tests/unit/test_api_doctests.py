@@ -49,10 +49,12 @@ def test_examples_run(name, capsys):
 
 
 def _missing_sections(obj) -> list[str]:
-    """The numpydoc sections a public function or class lacks: a summary line, Parameters
+    """The numpydoc sections a public function or class lacks: a one-line summary, Parameters
     where it takes arguments, Returns (or Yields) for a function (an exception: a summary)."""
     doc = inspect.getdoc(obj) or ""
     missing = [] if doc.strip() else ["docstring"]
+    if "\n" in doc.split("\n\n")[0]:
+        missing.append("one-line summary")
     function = getattr(obj, "py_func", obj)  # a numba dispatcher documents its Python function
     if inspect.isclass(obj) and issubclass(obj, BaseException):
         return missing
