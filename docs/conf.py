@@ -3,6 +3,8 @@
 import re
 from pathlib import Path
 
+import sphinx.ext.autosummary
+
 import bouncing_ball
 
 DOCS = Path(__file__).resolve().parent
@@ -40,6 +42,8 @@ autosummary_generate = True
 # a module's page (docs/_templates/autosummary/module_page.rst) lists the names of its __all__
 autosummary_ignore_module_all = False
 templates_path = ["_templates"]
+# a summary line of the API tables ends at its first sentence, and "eq. (label)" does not end one
+sphinx.ext.autosummary.WELL_KNOWN_ABBREVIATIONS += ("eq.", "eqs.", "Eq.", "Eqs.", "Fig.", "Figs.")
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 
