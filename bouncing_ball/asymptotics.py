@@ -7,7 +7,16 @@ for v -> infinity, eqs. (asym3)-(asym6).
 import numpy as np
 import pandas as pd
 
-# eq. (rc): beta(r_c) = 2
+__all__ = [
+    "CRITICAL_RESTITUTION",
+    "small_speed_exponent",
+    "large_speed_exponent",
+    "large_speed_decay_rate",
+    "exponents_table",
+]
+
+#: r_c = exp(-pi / sqrt(3)) = 0.163..., eq. (rc): beta(r_c) = 2.  Below r_c the collision rate
+#: I is infinite (P(0, v) ~ v^-beta is not integrable against v at v = 0).
 CRITICAL_RESTITUTION = float(np.exp(-np.pi / np.sqrt(3.0)))
 
 
@@ -33,7 +42,34 @@ def _restitution(restitution) -> float:
 
 
 def small_speed_exponent(restitution) -> float:
-    """beta(r) of eq. (asym2): the physical root in (0, 5/2), P(0, v) ~ v^-beta at small v."""
+    """The exponent beta(r) of P(0, v) ~ v^-beta at small v, eqs. (asym1), (asym2).
+
+    The physical root of eq. (asym2) in (0, 5/2) (the equation holds at beta = 2 for every r;
+    that root is divided out).
+
+    Parameters
+    ----------
+    restitution : float
+        The restitution coefficient r, 0 < r < 1.
+
+    Returns
+    -------
+    float
+        beta(r): 1 at r = 1/2, 2 at r = r_c (eq. (rc)), growing as r falls.
+
+    Raises
+    ------
+    ValueError
+        If r is not in (0, 1).
+
+    Examples
+    --------
+    >>> from bouncing_ball.asymptotics import small_speed_exponent, CRITICAL_RESTITUTION
+    >>> print(round(small_speed_exponent(0.5), 12), round(small_speed_exponent(1 / 3), 12))
+    1.0 1.5
+    >>> print(round(small_speed_exponent(CRITICAL_RESTITUTION), 9))
+    2.0
+    """
     from scipy import optimize  # here: the jobs that need only r_c do not load scipy
 
     r = _restitution(restitution)
@@ -45,7 +81,30 @@ def small_speed_exponent(restitution) -> float:
 
 
 def large_speed_decay_rate(restitution) -> float:
-    """q(r) of eqs. (asym4), (asym6): P(0, v) ~ v^-m e^(-q v) at large v."""
+    """The decay rate q(r) of P(0, v) ~ v^-m e^(-q v) at large v, eqs. (asym4), (asym6).
+
+    Parameters
+    ----------
+    restitution : float
+        The restitution coefficient r, 0 < r < 1.
+
+    Returns
+    -------
+    float
+        q(r) = 3 (1 - r) / (2 (1 - r + r^2)) for r >= 1/2 (eq. (asym4)), 1 / (2 r) below
+        (eq. (asym6)); q and dq/dr are continuous at r = 1/2.
+
+    Raises
+    ------
+    ValueError
+        If r is not in (0, 1).
+
+    Examples
+    --------
+    >>> from bouncing_ball.asymptotics import large_speed_decay_rate
+    >>> print(large_speed_decay_rate(0.5), large_speed_decay_rate(0.25))
+    1.0 2.0
+    """
     r = _restitution(restitution)
     if r >= 0.5:
         return 1.5 * (1.0 - r) / (1.0 - r + r * r)
@@ -53,7 +112,31 @@ def large_speed_decay_rate(restitution) -> float:
 
 
 def large_speed_exponent(restitution) -> float:
-    """m(r) of eqs. (asym4)-(asym6)."""
+    """The power m(r) of P(0, v) ~ v^-m e^(-q v) at large v, eqs. (asym4)-(asym6).
+
+    Parameters
+    ----------
+    restitution : float
+        The restitution coefficient r, 0 < r < 1.
+
+    Returns
+    -------
+    float
+        m(r) = 1 - ln r / ln(x / r) with x of eq. (asym5) for r > 1/2 (eq. (asym4)), 1 at
+        r = 1/2 (x(1/2) = 0 in eq. (asym5): the limit r -> 1/2 from above), 3/2 below
+        (eq. (asym6)): m jumps at r = 1/2.
+
+    Raises
+    ------
+    ValueError
+        If r is not in (0, 1).
+
+    Examples
+    --------
+    >>> from bouncing_ball.asymptotics import large_speed_exponent
+    >>> print(large_speed_exponent(0.25), large_speed_exponent(0.5))
+    1.5 1.0
+    """
     r = _restitution(restitution)
     if r < 0.5:
         return 1.5
@@ -66,7 +149,27 @@ def large_speed_exponent(restitution) -> float:
 
 
 def exponents_table(restitutions):
-    """beta, m, q of eqs. (asym2)-(asym6) for each r: columns r, beta, m, q."""
+    """The exponents beta, m, q of eqs. (asym2)-(asym6) for each r, as a table (Figs. 1, 2).
+
+    Parameters
+    ----------
+    restitutions : array_like of float
+        Restitution coefficients, each in (0, 1).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns r, beta (``small_speed_exponent``), m (``large_speed_exponent``) and q
+        (``large_speed_decay_rate``), one row per r in the order given.
+
+    Examples
+    --------
+    >>> from bouncing_ball.asymptotics import exponents_table
+    >>> print(exponents_table([0.25, 0.5]).round(6).to_string(index=False))
+       r  beta   m   q
+    0.25  1.75 1.5 2.0
+    0.50  1.00 1.0 1.0
+    """
     r = np.asarray(restitutions, dtype=float)
     return pd.DataFrame(
         {

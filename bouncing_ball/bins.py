@@ -11,9 +11,53 @@ from dataclasses import dataclass
 
 import numpy as np
 
+__all__ = [
+    "LogBins",
+    "LinearBins",
+    "log_bins",
+    "linear_bins",
+    "log_grid",
+    "linear_grid",
+    "outgoing_speed_bin_average",
+]
+
 
 @dataclass(frozen=True)
 class LogBins:
+    """Logarithmically spaced bins on [lo, hi), with an underflow and an overflow bin.
+
+    The bins of the tallies of outgoing speeds, heights and flight times.
+
+    Parameters
+    ----------
+    lo, hi : float
+        The lowest and highest finite edge, 0 < lo < hi (hi is rounded up to a whole bin).
+    per_decade : int
+        Bins per factor 10, at least 1.
+
+    Attributes
+    ----------
+    n : int
+        The number of finite bins.
+    edges : numpy.ndarray
+        The n + 1 finite edges, lo 10^(j / per_decade).
+    lower, upper : numpy.ndarray
+        The lower and upper edge of each of the n + 2 bins: index 0 is the underflow bin
+        [0, lo) (it also holds 0 and negative values), index n + 1 the overflow bin [hi, inf).
+
+    Raises
+    ------
+    ValueError
+        If not 0 < lo < hi, or per_decade < 1.
+
+    Examples
+    --------
+    >>> from bouncing_ball.bins import LogBins
+    >>> bins = LogBins(0.01, 1.0, 1)
+    >>> print(bins.n, bins.edges, bins.lower, bins.upper)
+    2 [0.01 0.1  1.  ] [0.   0.01 0.1  1.  ] [0.01 0.1  1.    inf]
+    """
+
     lo: float
     hi: float
     per_decade: int
@@ -47,6 +91,40 @@ class LogBins:
 
 @dataclass(frozen=True)
 class LinearBins:
+    """Evenly spaced bins on [lo, hi), with an underflow and an overflow bin.
+
+    The velocity bins of the tallied P(x, v).
+
+    Parameters
+    ----------
+    lo, hi : float
+        The lowest and highest finite edge, lo < hi (hi is rounded up to a whole bin).
+    width : float
+        The width of a bin, > 0.
+
+    Attributes
+    ----------
+    n : int
+        The number of finite bins.
+    edges : numpy.ndarray
+        The n + 1 finite edges, lo + j width.
+    lower, upper : numpy.ndarray
+        The lower and upper edge of each of the n + 2 bins: index 0 is the underflow bin
+        (-inf, lo), index n + 1 the overflow bin [hi, inf).
+
+    Raises
+    ------
+    ValueError
+        If not lo < hi, or not width > 0.
+
+    Examples
+    --------
+    >>> from bouncing_ball.bins import LinearBins
+    >>> bins = LinearBins(-1.0, 1.0, 0.5)
+    >>> print(bins.n, bins.edges, bins.lower[:2], bins.upper[-2:])
+    4 [-1.  -0.5  0.   0.5  1. ] [-inf -1.] [ 1. inf]
+    """
+
     lo: float
     hi: float
     width: float
@@ -78,20 +156,77 @@ class LinearBins:
         return np.concatenate([self.edges, [np.inf]])
 
 
-# the config's specifications of bins and grids, e.g. {lo, hi, per_decade} and {min, max, points}
 def log_bins(spec: dict) -> LogBins:
+    """``LogBins`` from the config's specification of a bin set.
+
+    Parameters
+    ----------
+    spec : dict
+        The keys lo, hi and per_decade (as in the config's ``simulation`` section).
+
+    Returns
+    -------
+    LogBins
+
+    Examples
+    --------
+    >>> from bouncing_ball.bins import log_bins
+    >>> log_bins({"lo": 1e-3, "hi": 1e3, "per_decade": 5}).n
+    30
+    """
     return LogBins(float(spec["lo"]), float(spec["hi"]), int(spec["per_decade"]))
 
 
 def linear_bins(spec: dict) -> LinearBins:
+    """``LinearBins`` from the config's specification of a bin set.
+
+    Parameters
+    ----------
+    spec : dict
+        The keys lo, hi and width (as in the config's ``simulation`` section).
+
+    Returns
+    -------
+    LinearBins
+    """
     return LinearBins(float(spec["lo"]), float(spec["hi"]), float(spec["width"]))
 
 
 def log_grid(spec: dict):
+    """The points of a logarithmic grid from the config's specification (tables, figures).
+
+    Parameters
+    ----------
+    spec : dict
+        The keys min, max and points.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``numpy.geomspace(min, max, points)``.
+
+    Examples
+    --------
+    >>> from bouncing_ball.bins import log_grid
+    >>> print(log_grid({"min": 0.1, "max": 10.0, "points": 3}))
+    [ 0.1  1.  10. ]
+    """
     return np.geomspace(float(spec["min"]), float(spec["max"]), int(spec["points"]))
 
 
 def linear_grid(spec: dict):
+    """The points of an evenly spaced grid from the config's specification (tables, figures).
+
+    Parameters
+    ----------
+    spec : dict
+        The keys min, max and points.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``numpy.linspace(min, max, points)``.
+    """
     return np.linspace(float(spec["min"]), float(spec["max"]), int(spec["points"]))
 
 
@@ -99,10 +234,34 @@ _GAUSS_NODES, _GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(8)
 
 
 def outgoing_speed_bin_average(density, lower, upper):
-    """int_lo^hi v P(0, v) dv / int_lo^hi v dv for each bin [lo, hi): what a bin of
-    outgoing speeds measures (eq. (collrate): collisions with v_out in the bin come at the
-    rate int v P(0, v) dv).  ``density`` is P(0, v) as a function of an array of v;
-    8-point Gauss-Legendre in ln v on each bin."""
+    """What a bin of outgoing speeds measures: the flux-weighted bin average of P(0, v).
+
+    Collisions with an outgoing speed in a bin come at the rate int_bin v P(0, v) dv
+    (eq. (collrate)), so the simulation's estimate of P(0, v) in a bin [lo, hi) is
+    int_lo^hi v P(0, v) dv / int_lo^hi v dv.  8-point Gauss-Legendre in ln v on each bin.
+
+    Parameters
+    ----------
+    density : callable
+        P(0, v) as a function of an array of speeds v > 0.
+    lower, upper : array_like
+        The finite edges of the bins, 0 < lo < hi.
+
+    Returns
+    -------
+    numpy.ndarray
+        The bin average of each bin.
+
+    Examples
+    --------
+    For P(0, v) = 1/v the average over [lo, hi) is 2 / (lo + hi):
+
+    >>> import numpy as np
+    >>> from bouncing_ball.bins import outgoing_speed_bin_average
+    >>> average = outgoing_speed_bin_average(lambda v: 1.0 / v, [0.5, 1.0], [1.0, 3.0])
+    >>> print(np.round(average, 12))
+    [1.33333333 0.5       ]
+    """
     lower = np.asarray(lower, dtype=float)[:, None]
     upper = np.asarray(upper, dtype=float)[:, None]
     half = 0.5 * np.log(upper / lower)

@@ -14,6 +14,26 @@ from . import exact
 from .fits import LARGE_SPEED, SMALL_SPEED, bin_averages_of_curve, usable_curve
 from .histograms import outgoing_speed_density
 
+__all__ = [
+    "moment_rows",
+    "moments_table",
+    "moments_markdown",
+    "value_with_error",
+    "outgoing_speed_residuals",
+    "exact_outgoing_speed_residuals",
+    "sign_flip_test",
+    "ratio_deviations",
+    "shard_ratios",
+    "outgoing_speed_checks",
+    "position_checks",
+    "fit_checks",
+    "validation_rows",
+    "validation_table",
+    "validation_markdown",
+    "position_asymptotics_table",
+    "position_asymptotics_markdown",
+]
+
 # the time averages of eq. (xandDeltax)
 QUANTITIES = ("mean_x", "delta_x", "collision_rate")
 SYMBOLS = {"mean_x": "<x>", "delta_x": "Delta x", "collision_rate": "I"}
@@ -40,12 +60,39 @@ MOMENT_COLUMNS = (
 
 
 def moment_rows(label, restitution, simulation, solver, exact=None):
-    """One row per time average of eq. (xandDeltax) for one r.
+    """The time averages <x>, Delta x and I of eq. (xandDeltax) of one r, with their z.
 
-    ``simulation``, ``solver`` and ``exact`` are the one-row summaries of
-    the merge, solve and exact stages (``exact`` None where r is not 1/2 or
-    1/3).  z = (simulation - reference) / simulation_err, the reference
-    being the exact value where there is one and the solver's otherwise.
+    z = (simulation - reference) / simulation_err, the reference being the exact value where
+    there is one and the solver's otherwise.
+
+    Parameters
+    ----------
+    label : str
+        The r label.
+    restitution : float or fractions.Fraction
+        r.
+    simulation : mapping
+        The merge stage's summary: each quantity and its ``<quantity>_err``.
+    solver : mapping
+        The solve stage's summary.
+    exact : mapping, optional
+        The exact stage's summary (None where r is not 1/2 or 1/3).
+
+    Returns
+    -------
+    list of dict
+        One row per quantity, keys ``MOMENT_COLUMNS`` (with the paper's rounded numbers at
+        r = 1/2 and 1/3).
+
+    Examples
+    --------
+    >>> from bouncing_ball.comparison import moment_rows
+    >>> simulation = {"mean_x": 6.01, "mean_x_err": 0.01, "delta_x": 10.4,
+    ...               "delta_x_err": 0.1, "collision_rate": 0.333, "collision_rate_err": 0.001}
+    >>> exact = {"mean_x": 6.0, "delta_x": 10.39, "collision_rate": 1 / 3}
+    >>> row = moment_rows("0.5", 0.5, simulation, exact, exact)[0]
+    >>> print(row["quantity"], row["paper"], row["reference"], round(row["z"], 6))
+    mean_x 6.0 exact 1.0
     """
     paper = PAPER_VALUES.get(Fraction(restitution))
     rows = []
@@ -73,6 +120,18 @@ def moment_rows(label, restitution, simulation, solver, exact=None):
 
 
 def moments_table(rows) -> pd.DataFrame:
+    """The rows of ``moment_rows`` (of every r) as results/tables/moments.csv.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Rows of ``moment_rows``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``MOMENT_COLUMNS``.
+    """
     return pd.DataFrame(rows, columns=list(MOMENT_COLUMNS))
 
 
@@ -81,7 +140,27 @@ def _number(value, digits=6):
 
 
 def value_with_error(value, error) -> str:
-    """'3.4280 ± 0.0030': the value to the second significant digit of its error."""
+    """A value with its error, to the second significant digit of the error.
+
+    Parameters
+    ----------
+    value, error : float
+        The value and its standard error.
+
+    Returns
+    -------
+    str
+        "value ± error"; the value alone (6 significant digits) where the error is not
+        finite and positive, "" where the value is not finite.
+
+    Examples
+    --------
+    >>> from bouncing_ball.comparison import value_with_error
+    >>> value_with_error(3.42803, 0.003)
+    '3.4280 ± 0.0030'
+    >>> value_with_error(1234.5, 25.0)
+    '1234 ± 25'
+    """
     if not (np.isfinite(value) and np.isfinite(error) and error > 0):
         return _number(value)
     decimals = max(0, 1 - int(np.floor(np.log10(error))))
@@ -89,7 +168,19 @@ def value_with_error(value, error) -> str:
 
 
 def moments_markdown(table: pd.DataFrame) -> str:
-    """The moments table for a reader: value +- error, the paper's rounded numbers, z."""
+    """The moments table for a reader, as results/tables/moments.md.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The table of ``moments_table``.
+
+    Returns
+    -------
+    str
+        A Markdown table: value ± error, the paper's rounded numbers, the exact and the
+        solver's values, z.
+    """
     shown = pd.DataFrame(
         {
             "r": table.r_label,
@@ -113,12 +204,22 @@ def moments_markdown(table: pd.DataFrame) -> str:
 def outgoing_speed_residuals(simulated: pd.DataFrame, solver_curve: pd.DataFrame) -> pd.DataFrame:
     """(simulation - solver) / sigma for every bin of the simulated P(0, v), Fig. 7.
 
-    ``simulated`` is a merged p0v table (bins ``v_lo``, ``v_hi``), ``solver_curve``
-    the solver's ``v, p0v`` grid; the solver enters as its average over each
-    bin (eq. (collrate)), like the data (column ``reference``; ``bin`` is the
-    bin's position in ``simulated``).  Bins without an error (no
-    collisions, the under- and overflow bins) and bins beyond the solver's
-    grid (or beyond where its P(0, v) underflows) are left out.
+    The solver's P(0, v) of eq. (inteq) enters as its average over each bin (eq. (collrate)),
+    like the data.  Bins without an error (no collisions, the under- and overflow bins) and
+    bins beyond the solver's grid (or beyond where its P(0, v) underflows) are left out.
+
+    Parameters
+    ----------
+    simulated : pandas.DataFrame
+        A merged p0v table (columns v, v_lo, v_hi, p0v, p0v_err, count).
+    solver_curve : pandas.DataFrame
+        The solver's grid (columns v, p0v).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns v, v_lo, v_hi, residual, count, reference (the solver's bin average) and bin
+        (the bin's position in ``simulated``).
     """
     speeds, density = usable_curve(solver_curve.v.to_numpy(), solver_curve.p0v.to_numpy())
     inside = (
@@ -143,10 +244,24 @@ def outgoing_speed_residuals(simulated: pd.DataFrame, solver_curve: pd.DataFrame
 
 
 def exact_outgoing_speed_residuals(simulated: pd.DataFrame, restitution) -> pd.DataFrame:
-    """(simulation - exact) / sigma per finite bin with an error of a merged p0v table at
-    r = 1/2 or 1/3, the exact bin averages of eq. (P(0,v)) in closed form
-    (``exact.outgoing_speed_bin_average``); columns v, residual, reference (the exact bin
-    average) and bin (the bin's position in ``simulated``)."""
+    """(simulation - exact) / sigma for every bin of the simulated P(0, v) at r = 1/2 or 1/3.
+
+    The exact bin averages of eq. (P(0,v)) are in closed form
+    (``exact.outgoing_speed_bin_average``).
+
+    Parameters
+    ----------
+    simulated : pandas.DataFrame
+        A merged p0v table; its finite bins with an error are compared.
+    restitution : float or fractions.Fraction
+        1/2 or 1/3.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns v, residual, reference (the exact bin average) and bin (the bin's position in
+        ``simulated``).
+    """
     usable = (
         (simulated.v_lo > 0.0)
         & np.isfinite(simulated.v_hi)
@@ -210,8 +325,10 @@ _FLIPS_PER_BLOCK = 1000  # flips evaluated at once (memory: block x bins)
 
 
 def sign_flip_test(deviations, flips=SIGN_FLIPS, seed=SIGN_FLIP_SEED):
-    """chi^2 per bin of shard-level deviations from a prediction, and the p-values of chi^2
-    and of the largest z^2 against their sign-flip null distributions.
+    """The sign-flip test of shard-level deviations from a prediction.
+
+    chi^2 per bin of the deviations, and the p-values of chi^2 and of the largest z^2 against
+    their sign-flip null distributions.
 
     Parameters
     ----------
@@ -236,6 +353,17 @@ def sign_flip_test(deviations, flips=SIGN_FLIPS, seed=SIGN_FLIP_SEED):
         collisions filling neighbouring bins).  p = (1 + number of flipped statistics >= the
         observed) / (1 + flips).  Flipping every sign leaves z^2 alone, so with n shards there
         are 2^(n - 1) distinct statistics and p is never much below 2^(1 - n).
+
+    Examples
+    --------
+    Two bins, deviations of alternating sign over four shards: no deviation on average.
+
+    >>> import numpy as np
+    >>> from bouncing_ball.comparison import sign_flip_test
+    >>> deviations = np.array([[1.0, 0.5], [-1.0, -0.5], [1.0, -0.5], [-1.0, 0.5]])
+    >>> chi2, p_chi2, p_worst = sign_flip_test(deviations)
+    >>> print(chi2, p_chi2, p_worst)
+    0.0 1.0 1.0
     """
     deviations = np.asarray(deviations, dtype=float)
     n = deviations.shape[0]
@@ -259,12 +387,32 @@ def sign_flip_test(deviations, flips=SIGN_FLIPS, seed=SIGN_FLIP_SEED):
 
 
 def ratio_deviations(numerators, denominators, reference):
-    """Each shard's share of the deviation of a ratio estimate from ``reference`` (bins):
-    (numerators_k - reference x denominators_k) / sum_k denominators_k for the estimate
-    sum_k numerators_k / sum_k denominators_k (shards x bins arrays).  The shares add up to
+    """Each shard's share of the deviation of a ratio estimate from a reference.
+
+    For the estimate sum_k numerators_k / sum_k denominators_k the share of shard k is
+    (numerators_k - reference x denominators_k) / sum_k denominators_k.  The shares add up to
     the estimate minus the reference; to first order they are what the delete-one jackknife
     sees of each shard, so ``sign_flip_test`` of them gives the merged table's z to first
-    order."""
+    order.
+
+    Parameters
+    ----------
+    numerators, denominators : array_like, shape (shards, bins)
+        Each shard's numerator and denominator (``shard_ratios``).
+    reference : array_like, shape (bins,)
+        The prediction.
+
+    Returns
+    -------
+    numpy.ndarray, shape (shards, bins)
+
+    Examples
+    --------
+    >>> from bouncing_ball.comparison import ratio_deviations
+    >>> shares = ratio_deviations([[3.0], [5.0]], [[1.0], [3.0]], [1.5])
+    >>> print(shares.ravel(), shares.sum(), 8.0 / 4.0 - 1.5)
+    [0.375 0.125] 0.5 0.5
+    """
     numerators = np.asarray(numerators, dtype=float)
     denominators = np.asarray(denominators, dtype=float)
     return (numerators - np.asarray(reference, dtype=float) * denominators) / denominators.sum(
@@ -273,11 +421,22 @@ def ratio_deviations(numerators, denominators, reference):
 
 
 def shard_ratios(shards) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Each shard's numerator and denominator (shards x bins, bins as in the merged tables)
-    of the estimates the validation checks, keyed as they are: ``p0v``, its collisions over
-    the time times int_bin v dv (eq. (collrate), ``histograms.outgoing_speed_density``);
-    ``px``, the time spent in the x bin over the time times the bin's width; ``v2_given_x``,
-    the integral of v^2 dt in the bin over the time spent there (eq. (moment2))."""
+    """Each shard's numerator and denominator of the estimates the validation checks.
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards of one r (with the same bins).
+
+    Returns
+    -------
+    dict
+        Keyed as the merged tables' columns, each a pair of (shards x bins) arrays, bins as
+        in the merged tables: ``p0v``, the collisions over the time times int_bin v dv
+        (eq. (collrate), ``histograms.outgoing_speed_density``); ``px``, the time spent in
+        the x bin over the time times the bin's width; ``v2_given_x``, the integral of
+        v^2 dt in the bin over the time spent there (eq. (moment2)).
+    """
     speeds, heights = shards[0].speed_bins, shards[0].position_bins
     times = np.array([s.time for s in shards], dtype=float)[:, None]
     in_bin = np.stack([s.position_time for s in shards])
@@ -345,17 +504,40 @@ def _shard_deviations(per_shard, quantity, bins, reference, count):
 
 
 def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None, per_shard=None):
-    """The simulated P(0, v) (a merged p0v table) against eq. (P(0,v)) at r = 1/2 and 1/3
-    (bin averages in closed form, ``exact.outgoing_speed_bin_average``), else against the
-    solver's P(0, v) of eq. (inteq) (``solver_curve``: v, p0v), averaged over each bin like
-    the data (eq. (collrate), ``outgoing_speed_residuals``, as in Fig. 7).
+    """The simulated P(0, v) against eq. (P(0,v)) at r = 1/2 and 1/3, else the solver's.
 
-    Rows (without r): chi^2/n and the worst z of z = (simulation - reference) / p0v_err over
-    the bins with an error (not the under- and overflow bins, nor bins beyond the solver's
-    grid), and the largest relative error p0v_err / p0v over the bins with
-    0.01 <= v <= 5 (an empty bin there counts as an infinite relative error).  ``shards`` is
-    the number of shards; ``per_shard`` (``shard_ratios`` of them) gives chi^2/n its
-    p_sign_flip (``sign_flip_test``).
+    At r = 1/2 and 1/3 the reference is the exact bin averages in closed form
+    (``exact.outgoing_speed_bin_average``), else the solver's P(0, v) of eq. (inteq)
+    averaged over each bin like the data (eq. (collrate), ``outgoing_speed_residuals``, as
+    in Fig. 7).
+
+    Parameters
+    ----------
+    simulated : pandas.DataFrame
+        A merged p0v table.
+    restitution : float or fractions.Fraction
+        r.
+    shards : int
+        The number of shards the errors come from.
+    solver_curve : pandas.DataFrame, optional
+        The solver's grid (columns v, p0v); needed where r is not 1/2 or 1/3.
+    per_shard : dict, optional
+        ``shard_ratios`` of the shards: gives chi^2/n its p_sign_flip (``sign_flip_test``).
+
+    Returns
+    -------
+    list of dict
+        Rows of ``VALIDATION_COLUMNS`` without r: chi^2/n and the worst z of
+        z = (simulation - reference) / p0v_err over the bins with an error (not the under-
+        and overflow bins, nor bins beyond the solver's grid), and the largest relative error
+        p0v_err / p0v over the bins with 0.01 <= v <= 5 (an empty bin there counts as an
+        infinite relative error).
+
+    Raises
+    ------
+    ValueError
+        Where r is not 1/2 or 1/3 and no solver curve is given, or ``per_shard`` holds
+        another number of shards.
     """
     if Fraction(restitution) in exact.EXACT_RESTITUTIONS:
         reference = "exact"
@@ -399,14 +581,29 @@ def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None, per
 
 
 def position_checks(position, restitution, shards, per_shard=None):
-    """The simulated P(x) and <v^2>_x (a merged position table) against the exact bin
-    averages of eq. (P(x)2) and eq. (moment2) (``exact.position_bin_average``,
-    ``exact.speed_squared_given_position_bin_average``) at r = 1/2 and 1/3; no rows
-    for another r (no exact P(x) there).
+    """The simulated P(x) and <v^2>_x against eqs. (P(x)2) and (moment2) at r = 1/2 and 1/3.
 
-    Rows (without r): chi^2/n and the worst z over the bins inside 1e-3 <= x <= 50 that
-    have an error, for P(x) and for <v^2>_x; chi^2/n with its p_sign_flip where
-    ``per_shard`` (``shard_ratios``) is given, as in ``outgoing_speed_checks``.
+    The references are the exact bin averages (``exact.position_bin_average``,
+    ``exact.speed_squared_given_position_bin_average``).
+
+    Parameters
+    ----------
+    position : pandas.DataFrame
+        A merged position table (columns x, x_lo, x_hi, px, px_err, v2_given_x,
+        v2_given_x_err).
+    restitution : float or fractions.Fraction
+        r.
+    shards : int
+        The number of shards the errors come from.
+    per_shard : dict, optional
+        ``shard_ratios`` of the shards, as in ``outgoing_speed_checks``.
+
+    Returns
+    -------
+    list of dict
+        Rows without r: chi^2/n (with its p_sign_flip where ``per_shard`` is given) and the
+        worst z over the bins inside 1e-3 <= x <= 50 that have an error, for P(x) and for
+        <v^2>_x; no rows for another r (no exact P(x) there).
     """
     if Fraction(restitution) not in exact.EXACT_RESTITUTIONS:
         return []
@@ -438,12 +635,23 @@ def position_checks(position, restitution, shards, per_shard=None):
 
 
 def fit_checks(fits):
-    """The free-exponent fits of the asymptotic forms to the simulated P(0, v) (a fits
-    table, ``fits.asymptotic_fits``): per window (small v, eqs. (asym1), (asym2); large v,
-    eqs. (asym3)-(asym6)) the joint p-value of the theory's exponents (Hotelling's T^2 on
-    the jackknife covariance) and the fit's chi^2 per degree of freedom (per-bin errors
-    only: indicative, it ignores the correlations between bins).  A window without a
-    usable fit gives NaN values."""
+    """The free-exponent fits of the asymptotic forms to the simulated P(0, v), as checks.
+
+    Per window (small v, eqs. (asym1), (asym2); large v, eqs. (asym3)-(asym6)) the joint
+    p-value of the theory's exponents (Hotelling's T^2 on the jackknife covariance) and the
+    fit's chi^2 per degree of freedom (per-bin errors only: indicative, it ignores the
+    correlations between bins).
+
+    Parameters
+    ----------
+    fits : pandas.DataFrame
+        A fits table (``fits.asymptotic_fits``).
+
+    Returns
+    -------
+    list of dict
+        Two rows per window, without r; a window without a usable fit gives NaN values.
+    """
     chosen = fits[(fits.source == "simulation") & (fits.fit == "free_exponents")]
     rows = []
     for side in FIT_SIDES:
@@ -495,10 +703,28 @@ def fit_checks(fits):
 def validation_rows(
     label, restitution, p0v, position, fits, shards, solver_curve=None, per_shard=None
 ) -> list[dict]:
-    """Every check of one r: ``outgoing_speed_checks``, ``position_checks`` and
-    ``fit_checks`` of the merged p0v and position tables and the fits table, each row
-    with the r label and r.  ``shards`` is the number of shards the errors come from,
-    ``per_shard`` their ``shard_ratios`` (for the p_sign_flip of the chi^2/n rows)."""
+    """Every check of one r: ``outgoing_speed_checks``, ``position_checks``, ``fit_checks``.
+
+    Parameters
+    ----------
+    label : str
+        The r label.
+    restitution : float or fractions.Fraction
+        r.
+    p0v, position, fits : pandas.DataFrame
+        The merged p0v and position tables and the fits table.
+    shards : int
+        The number of shards the errors come from.
+    solver_curve : pandas.DataFrame, optional
+        The solver's P(0, v) grid (where r is not 1/2 or 1/3).
+    per_shard : dict, optional
+        The shards' ``shard_ratios`` (for the p_sign_flip of the chi^2/n rows).
+
+    Returns
+    -------
+    list of dict
+        The rows, each with the r label and r.
+    """
     rows = [
         *outgoing_speed_checks(p0v, restitution, shards, solver_curve, per_shard),
         *position_checks(position, restitution, shards, per_shard),
@@ -508,7 +734,18 @@ def validation_rows(
 
 
 def validation_table(rows) -> pd.DataFrame:
-    """The rows of ``validation_rows`` as a table of VALIDATION_COLUMNS."""
+    """The rows of ``validation_rows`` (of every r) as results/tables/validation.csv.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Rows of ``validation_rows``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``VALIDATION_COLUMNS``.
+    """
     table = pd.DataFrame(rows, columns=list(VALIDATION_COLUMNS))
     return table.astype({"bins": "int64"}) if len(table) else table
 
@@ -525,8 +762,19 @@ def _shown_value(check, value):
 
 
 def validation_markdown(table: pd.DataFrame) -> str:
-    """The validation table for a reader: one line per r and check, values to 2-3 digits
-    (z to 2 decimals, relative errors in percent); no '|' in a cell."""
+    """The validation table for a reader, as results/tables/validation.md.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The table of ``validation_table``.
+
+    Returns
+    -------
+    str
+        A Markdown table, one line per r and check, values to 2-3 digits (z to 2 decimals,
+        relative errors in percent); no '|' in a cell.
+    """
     shown = pd.DataFrame(
         {
             "r": table.r_label.astype(str),
@@ -553,8 +801,20 @@ POSITION_EXPONENTS = {
 
 
 def position_asymptotics_table(summaries) -> pd.DataFrame:
-    """One row per r and exponent of P(x): measured from the solver's P(x) (eq. (P(x)1)) and
-    predicted (docs/distribution.md), from the solver summaries (r_label, summary row)."""
+    """The exponents of P(x) at small and large x, measured and predicted, for each r.
+
+    Parameters
+    ----------
+    summaries : iterable of (str, mapping)
+        The r label and the solver's summary row (with ``<exponent>_measured``, from the
+        solver's P(x) of eq. (P(x)1), and ``<exponent>_predicted``, docs/distribution.md).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per r and exponent of ``POSITION_EXPONENTS``: r_label, r, exponent, meaning,
+        measured, predicted, difference.
+    """
     rows = []
     for label, summary in summaries:
         for exponent, meaning in POSITION_EXPONENTS.items():
@@ -575,6 +835,18 @@ def position_asymptotics_table(summaries) -> pd.DataFrame:
 
 
 def position_asymptotics_markdown(table: pd.DataFrame) -> str:
+    """The exponents of P(x) for a reader, as results/tables/position_asymptotics.md.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The table of ``position_asymptotics_table``.
+
+    Returns
+    -------
+    str
+        A Markdown table and a note on how the exponents are measured.
+    """
     shown = pd.DataFrame(
         {
             "r": table.r_label,

@@ -26,8 +26,21 @@ from scipy import stats
 
 from .tallies import EARLY_FRACTION, ShardTallies
 
+__all__ = [
+    "early_check",
+    "early_check_record",
+    "early_check_message",
+    "window_estimates",
+    "WARN_P",
+    "REFUSE_P",
+    "QUANTITIES",
+]
+
+#: The p-value of ``early_check`` below which the merge warns.
 WARN_P = 1.0e-3
+#: The p-value of ``early_check`` below which the merge refuses.
 REFUSE_P = 1.0e-6
+#: The quantities compared: <x>, <x^2> and the collision rate I of eq. (collrate).
 QUANTITIES = ("mean_x", "mean_x2", "collision_rate")
 _SUMS = ("time", "collisions", "int_x", "int_x2")
 
@@ -37,9 +50,33 @@ def _estimates(time, collisions, int_x, int_x2) -> dict:
 
 
 def window_estimates(shards: list[ShardTallies]) -> pd.DataFrame:
-    """Per shard (a row, in the order given) <x>, <x^2> and I over the early part of its
-    recording and over the rest (columns ``early_<quantity>``, ``rest_<quantity>``), and
-    ``complete``: whether both recorded time (not so in a shard that stopped early)."""
+    """<x>, <x^2> and I of each shard over the early part of its recording and over the rest.
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards (anything with the sums time, collisions, int_x, int_x2 and their
+        ``early_`` parts).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per shard, in the order given: columns ``early_<quantity>`` and
+        ``rest_<quantity>`` for each of ``QUANTITIES``, and ``complete``: whether both parts
+        recorded time (not so in a shard that stopped early).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> from bouncing_ball.equilibration import window_estimates
+    >>> shard = SimpleNamespace(
+    ...     time=10.0, collisions=5, int_x=20.0, int_x2=80.0,
+    ...     early_time=2.0, early_collisions=1, early_int_x=4.0, early_int_x2=16.0,
+    ... )
+    >>> row = window_estimates([shard]).iloc[0]
+    >>> print(row.complete, row.early_mean_x, row.rest_mean_x, row.rest_collision_rate)
+    True 2.0 2.0 0.5
+    """
     total = {name: np.array([float(getattr(s, name)) for s in shards]) for name in _SUMS}
     early = {name: np.array([float(getattr(s, f"early_{name}")) for s in shards]) for name in _SUMS}
     rest = {name: total[name] - early[name] for name in _SUMS}
@@ -55,11 +92,13 @@ def window_estimates(shards: list[ShardTallies]) -> pd.DataFrame:
 def early_check(
     shards: list[ShardTallies], warn_p: float = WARN_P, refuse_p: float = REFUSE_P
 ) -> pd.DataFrame:
-    """Does the early part of the shards' recordings agree with the rest?  One row per
-    quantity of ``QUANTITIES``: the mean over the shards of (early - rest) and its standard
-    error, their ratio ``z`` (Student's t with shards - 1 degrees of freedom), the two-sided
-    ``p``, and the ``verdict``: "ok", "warn" (p < ``warn_p``) or "refuse" (p < ``refuse_p``);
-    "not checked" with fewer than two shards whose two parts both recorded time.
+    """Does the early part of the shards' recordings agree with the rest?
+
+    One row per quantity of ``QUANTITIES``: the mean over the shards of (early - rest) and its
+    standard error, their ratio ``z`` (Student's t with shards - 1 degrees of freedom), the
+    two-sided ``p``, and the ``verdict``: "ok", "warn" (p < ``warn_p``) or "refuse"
+    (p < ``refuse_p``); "not checked" with fewer than two shards whose two parts both
+    recorded time.  See the module's account of why.
 
     Parameters
     ----------
@@ -73,6 +112,24 @@ def early_check(
     pandas.DataFrame
         Columns quantity, shards, early, rest (the means over the shards), difference,
         difference_err, z, p, verdict.
+
+    Examples
+    --------
+    Three shards whose early parts agree with the rest within their scatter:
+
+    >>> from types import SimpleNamespace
+    >>> from bouncing_ball.equilibration import early_check
+    >>> def shard(early_x, rest_x):
+    ...     return SimpleNamespace(
+    ...         time=10.0, collisions=5, int_x=2.0 * early_x + 8.0 * rest_x, int_x2=80.0,
+    ...         early_time=2.0, early_collisions=1, early_int_x=2.0 * early_x,
+    ...         early_int_x2=16.0,
+    ...     )
+    >>> check = early_check([shard(2.1, 2.0), shard(1.9, 2.0), shard(2.0, 2.1)])
+    >>> print(check.quantity[0], check.shards[0], check.verdict[0])
+    mean_x 3 ok
+    >>> print(round(check.loc[0, "z"], 6), round(check.loc[0, "p"], 6))
+    -0.5 0.666667
     """
     windows = window_estimates(shards)
     used = windows[windows["complete"]]
@@ -112,8 +169,19 @@ VERDICTS = ("not checked", "ok", "warn", "refuse")
 
 
 def early_check_record(check: pd.DataFrame) -> dict:
-    """The check as a JSON-ready record for a file's provenance: the worst verdict, the
-    shards compared and, per quantity, z and p."""
+    """The check as a JSON-ready record for a file's provenance.
+
+    Parameters
+    ----------
+    check : pandas.DataFrame
+        The table of ``early_check``.
+
+    Returns
+    -------
+    dict
+        ``verdict`` (the worst of the quantities'), ``early_fraction``, ``shards`` (those
+        compared) and, per quantity, ``{"z": z, "p": p}`` (None where not finite).
+    """
     return {
         "verdict": max(check["verdict"], key=VERDICTS.index),
         "early_fraction": EARLY_FRACTION,
@@ -130,7 +198,20 @@ SYMBOLS = {"mean_x": "<x>", "mean_x2": "<x^2>", "collision_rate": "I"}
 
 
 def early_check_message(check: pd.DataFrame, label: str) -> str:
-    """What a log says about the check of r = ``label``: each quantity's two parts, z and p."""
+    """What a log says about the check of one r: each quantity's two parts, z and p.
+
+    Parameters
+    ----------
+    check : pandas.DataFrame
+        The table of ``early_check``.
+    label : str
+        The r label, as in the workflow's file names.
+
+    Returns
+    -------
+    str
+        One line.
+    """
     parts = [
         f"{SYMBOLS[row.quantity]} {row.early:.5g} early vs {row.rest:.5g} later "
         f"(z = {row.z:+.1f}, p = {row.p:.1e})"

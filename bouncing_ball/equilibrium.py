@@ -481,7 +481,7 @@ class Equilibrium(_EquilibriumState):
         The solver's error estimate: the largest relative change of P(0, v) over
         1e-3 <= v <= 20 against a finer solve (computed on first use: a second solve).
     position_accuracy : float
-        The largest of |int P dx - 1| and the relative differences of <x>, Delta x from P(x)
+        The largest of ``|int P dx - 1|`` and the relative differences of <x>, Delta x from P(x)
         (eq. (P(x)1)) and from the Ito identities (builds w(F) on first use).
     distribution_available : bool
         Whether r lies in ``restitution.DISTRIBUTION_RESTITUTION_RANGE``, where P(x), <v^2>_x,
@@ -584,7 +584,7 @@ class Equilibrium(_EquilibriumState):
 
     @property
     def position_accuracy(self) -> float:
-        """max(|int P dx - 1|, |<x>_P / <x> - 1|, |Delta x_P / Delta x - 1|): P(x) of
+        """``max(|int P dx - 1|, |<x>_P / <x> - 1|, |Delta x_P / Delta x - 1|)``: P(x) of
         eq. (P(x)1) against the normalisation and the solver's Ito identities (builds w(F))."""
         averages = self._position_averages
         return float(

@@ -44,9 +44,34 @@ from .asymptotics import large_speed_decay_rate, large_speed_exponent, small_spe
 from .bins import outgoing_speed_bin_average
 from .histograms import outgoing_speed_density
 
+__all__ = [
+    "SMALL_SPEED",
+    "LARGE_SPEED",
+    "WindowError",
+    "small_speed_form",
+    "large_speed_form",
+    "theory_exponents",
+    "bin_average",
+    "AsymptoticFit",
+    "fit_asymptotic_form",
+    "fit_shards",
+    "interval_factor",
+    "asymptotic_window",
+    "window_from_range",
+    "fit_rows",
+    "asymptotic_fits",
+    "usable_curve",
+    "bin_averages_of_curve",
+    "fit_errors",
+    "expected_collisions",
+    "FitBins",
+    "select_fit_bins",
+]
+
+#: The small-v side: P(0, v) = A v^-beta, eqs. (asym1), (asym2).
 SMALL_SPEED = "small_speed"
+#: The large-v side: P(0, v) = A v^-m e^(-q v), eqs. (asym3)-(asym6).
 LARGE_SPEED = "large_speed"
-INTERVAL_95 = 1.959963984540054  # scipy.stats.norm.ppf(0.975)
 
 
 class WindowError(ValueError):
@@ -54,12 +79,46 @@ class WindowError(ValueError):
 
 
 def small_speed_form(v, log_prefactor, beta):
-    """A v^-beta, eq. (asym1)."""
+    """The small-speed form A v^-beta of P(0, v), eq. (asym1).
+
+    Parameters
+    ----------
+    v : array_like
+        Speeds, > 0.
+    log_prefactor : float
+        ln A.
+    beta : float
+        The exponent (the theory's: eq. (asym2)).
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Examples
+    --------
+    >>> from bouncing_ball.fits import small_speed_form
+    >>> print(small_speed_form([0.25, 1.0], 0.0, 1.5))
+    [8. 1.]
+    """
     return np.exp(log_prefactor - beta * np.log(v))
 
 
 def large_speed_form(v, log_prefactor, m, q):
-    """A v^-m e^(-q v), eq. (asym3)."""
+    """The large-speed form A v^-m e^(-q v) of P(0, v), eq. (asym3).
+
+    Parameters
+    ----------
+    v : array_like
+        Speeds, > 0.
+    log_prefactor : float
+        ln A.
+    m, q : float
+        The power and the decay rate (the theory's: eqs. (asym4)-(asym6)).
+
+    Returns
+    -------
+    numpy.ndarray
+    """
     return np.exp(log_prefactor - m * np.log(v) - q * v)
 
 
@@ -68,19 +127,81 @@ EXPONENT_NAMES = {SMALL_SPEED: ("beta",), LARGE_SPEED: ("m", "q")}
 
 
 def theory_exponents(side, restitution):
-    """The exponents of the asymptotic form on ``side``: (beta,) or (m, q)."""
+    """The theory's exponents of the asymptotic form on one side.
+
+    Parameters
+    ----------
+    side : str
+        ``SMALL_SPEED`` or ``LARGE_SPEED``.
+    restitution : float
+        r, in (0, 1).
+
+    Returns
+    -------
+    tuple of float
+        (beta,) of eq. (asym2), or (m, q) of eqs. (asym4)-(asym6).
+
+    Examples
+    --------
+    >>> from bouncing_ball.fits import LARGE_SPEED, theory_exponents
+    >>> theory_exponents(LARGE_SPEED, 0.25)
+    (1.5, 2.0)
+    """
     if side == SMALL_SPEED:
         return (small_speed_exponent(restitution),)
     return (large_speed_exponent(restitution), large_speed_decay_rate(restitution))
 
 
 def bin_average(form, lower, upper, *parameters):
-    """The bin averages (``bins.outgoing_speed_bin_average``) of ``form(v, *parameters)``."""
+    """The bin averages of a form of P(0, v), as the simulation measures them (eq. (collrate)).
+
+    Parameters
+    ----------
+    form : callable
+        ``form(v, *parameters)``, e.g. ``small_speed_form``.
+    lower, upper : array_like
+        The bins' edges, 0 < lo < hi.
+    *parameters
+        The form's parameters after v.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``bins.outgoing_speed_bin_average`` of the form in each bin.
+    """
     return outgoing_speed_bin_average(lambda v: form(v, *parameters), lower, upper)
 
 
 @dataclass(frozen=True)
 class AsymptoticFit:
+    """One fit of an asymptotic form of P(0, v).
+
+    Parameters
+    ----------
+    side : str
+        ``SMALL_SPEED`` or ``LARGE_SPEED``.
+    free : bool
+        Whether the exponents were fitted (else the theory's, fixed).
+    parameters : dict
+        Name -> value: "prefactor" (A) and the exponents ("beta", or "m" and "q").
+    errors : dict
+        Name -> standard error (0 for a fixed exponent).
+    chi2 : float
+        chi^2 of the fit with the per-bin errors.
+    dof : int
+        Its degrees of freedom.
+    lower, upper : float
+        The window: the lowest and highest bin edge fitted.
+    joint_p_value : float
+        p-value of the theory's exponents taken together, Hotelling's T^2 on the jackknife
+        covariance (NaN where not computed).
+
+    Attributes
+    ----------
+    chi2_per_dof : float
+        chi^2 / dof (NaN without degrees of freedom).
+    """
+
     side: str
     free: bool
     parameters: dict  # name -> value: "prefactor" and the exponents
@@ -94,11 +215,46 @@ class AsymptoticFit:
 
     @property
     def chi2_per_dof(self):
+        """chi^2 per degree of freedom (NaN without degrees of freedom)."""
         return self.chi2 / self.dof if self.dof > 0 else np.nan
 
 
 def fit_asymptotic_form(side, lower, upper, values, errors, restitution, free):
-    """Weighted least-squares fit of the form on ``side`` to bin averages ``values`` +- ``errors``."""
+    """Weighted least-squares fit of an asymptotic form to bin averages of P(0, v).
+
+    The model is averaged over each bin like the data (``bin_average``).  With fixed
+    exponents only the prefactor is fitted (linear); with free ones, the exponents too, by
+    ``scipy.optimize.curve_fit`` from the theory's values, with errors from its covariance.
+
+    Parameters
+    ----------
+    side : str
+        ``SMALL_SPEED`` (eq. (asym1)) or ``LARGE_SPEED`` (eq. (asym3)).
+    lower, upper : array_like
+        The bins' edges.
+    values, errors : array_like
+        The bin averages and their standard errors (taken as absolute).
+    restitution : float
+        r: the theory's exponents, fixed or the start.
+    free : bool
+        Whether the exponents are fitted.
+
+    Returns
+    -------
+    AsymptoticFit
+
+    Examples
+    --------
+    Exact bin averages of 2 v^-1 at r = 1/2 (beta = 1) give the prefactor back:
+
+    >>> import numpy as np
+    >>> from bouncing_ball.fits import SMALL_SPEED, fit_asymptotic_form
+    >>> lower, upper = np.array([0.01, 0.02, 0.04]), np.array([0.02, 0.04, 0.08])
+    >>> values = 2.0 * 2.0 / (lower + upper)
+    >>> fit = fit_asymptotic_form(SMALL_SPEED, lower, upper, values, 0.01 * values, 0.5, True)
+    >>> print(round(fit.parameters["prefactor"], 6), round(fit.parameters["beta"], 6))
+    2.0 1.0
+    """
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
     values, errors = np.asarray(values, dtype=float), np.asarray(errors, dtype=float)
     form = FORMS[side]
@@ -153,12 +309,40 @@ def _parameter_vector(fit):
 
 
 def fit_shards(side, lower, upper, counts, times, errors, restitution, free):
-    """The fit of the pooled P(0, v) of shards (``counts``: shards x bins, ``times``: shards),
-    with delete-one jackknife errors over shards; ``errors`` are the weights.
+    """The fit of the shards' pooled P(0, v), with delete-one jackknife errors over shards.
 
     For free exponents also the p-value of the theory's exponents taken together:
     Hotelling's T^2 = d' C^-1 d with C the jackknife covariance of the fitted
     exponents, (n - p) T^2 / (p (n - 1)) ~ F(p, n - p) for n shards and p exponents.
+
+    Parameters
+    ----------
+    side : str
+        ``SMALL_SPEED`` or ``LARGE_SPEED``.
+    lower, upper : array_like
+        The bins' edges.
+    counts : array_like, shape (shards, bins)
+        Each shard's collisions per bin.
+    times : array_like, shape (shards,)
+        Each shard's recorded time.
+    errors : array_like
+        The per-bin standard errors that weight the fit (those of the full data, for every
+        jackknife fit).
+    restitution : float
+        r.
+    free : bool
+        Whether the exponents are fitted.
+
+    Returns
+    -------
+    AsymptoticFit
+        The fit of the pooled data, with the jackknife errors and, for free exponents,
+        ``joint_p_value``.
+
+    Raises
+    ------
+    ValueError
+        With fewer than 2 shards, or an error that is not finite and positive.
     """
     counts = np.asarray(counts, dtype=float)
     times = np.asarray(times, dtype=float)
@@ -206,17 +390,67 @@ def _f_survival(statistic, numerator, denominator) -> float:
 
 
 def interval_factor(shards, level=0.95):
-    """Student t factor of a ``level`` interval from a jackknife over ``shards`` shards
-    (``scipy.stats.t.ppf``)."""
+    """The Student t factor of a two-sided interval from a jackknife over shards.
+
+    Parameters
+    ----------
+    shards : int
+        The number of shards (shards - 1 degrees of freedom).
+    level : float
+        The interval's probability.
+
+    Returns
+    -------
+    float
+        ``scipy.stats.t.ppf(0.5 + level / 2, shards - 1)``.
+
+    Examples
+    --------
+    >>> from bouncing_ball.fits import interval_factor
+    >>> print(round(interval_factor(10), 6), round(interval_factor(10**6), 4))
+    2.262157 1.96
+    """
     return float(special.stdtrit(shards - 1, 0.5 + level / 2.0))
 
 
 def asymptotic_window(
     side, lower, upper, counts, times, errors, reference, restitution, max_bias=0.5, minimum_bins=4
 ):
-    """The default window on ``side`` as a slice of the usable bins; see the module docstring.
+    """The default window on one side, as a slice of the usable bins.
 
-    ``reference`` are noise-free bin averages of P(0, v) (the solver's) in the same bins.
+    The largest run of bins from the outermost one on that side over which the solver's
+    noise-free P(0, v), fitted with free exponents, drifts from the theory's exponents by at
+    most ``max_bias`` times the data's jackknife error on them (see the module's account).
+
+    Parameters
+    ----------
+    side : str
+        ``SMALL_SPEED`` (the run starts at the lowest bin) or ``LARGE_SPEED`` (it ends at the
+        highest).
+    lower, upper : numpy.ndarray
+        The usable bins' edges.
+    counts, times : numpy.ndarray
+        The shards' collisions per bin (shards x bins) and recorded times.
+    errors : numpy.ndarray
+        The per-bin standard errors.
+    reference : numpy.ndarray
+        Noise-free bin averages of P(0, v) (the solver's) in the same bins.
+    restitution : float
+        r.
+    max_bias : float
+        The drift allowed, in units of the data's error.
+    minimum_bins : int
+        The fewest bins of a window.
+
+    Returns
+    -------
+    slice
+        Into the usable bins.
+
+    Raises
+    ------
+    WindowError
+        With fewer than ``minimum_bins`` bins, or a drift too large already there.
     """
     count = len(lower)
     if count < minimum_bins:
@@ -250,7 +484,36 @@ def asymptotic_window(
 
 
 def window_from_range(side, lower, upper, speed_range):
-    """The usable bins inside a configured [min, max] window."""
+    """The usable bins inside a configured window.
+
+    Parameters
+    ----------
+    side : str
+        ``SMALL_SPEED`` or ``LARGE_SPEED``.
+    lower, upper : numpy.ndarray
+        The usable bins' edges.
+    speed_range : dict
+        The keys min and max: the window's speeds.
+
+    Returns
+    -------
+    slice
+        Into the usable bins.
+
+    Raises
+    ------
+    WindowError
+        If the window holds too few bins for the fit's parameters and one degree of freedom.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bouncing_ball.fits import SMALL_SPEED, window_from_range
+    >>> edges = np.geomspace(1e-3, 1.0, 7)
+    >>> window = window_from_range(SMALL_SPEED, edges[:-1], edges[1:], {"min": 1e-3, "max": 0.1})
+    >>> print(window.start, window.stop)
+    0 4
+    """
     inside = np.flatnonzero(
         (lower >= speed_range["min"] * (1 - 1e-12)) & (upper <= speed_range["max"] * (1 + 1e-12))
     )
@@ -268,6 +531,23 @@ def fit_rows(source, fit, theory, shards=None):
     Simulation rows (``shards`` given) carry jackknife errors and 95% intervals
     (Student t; the prefactor's on ln A, so it stays positive).  Solver rows are
     noise-free: their value is what the method gives, with no error.
+
+    Parameters
+    ----------
+    source : str
+        "simulation" or "solver".
+    fit : AsymptoticFit
+        The fit.
+    theory : dict
+        The theory's exponents by name.
+    shards : int, optional
+        The number of shards of the simulation's jackknife (None: noise-free rows).
+
+    Returns
+    -------
+    list of dict
+        Keys source, window, fit, parameter, value, error, lower_95, upper_95, theory,
+        joint_p_value, chi2_per_dof, dof, v_min, v_max.
     """
     factor = interval_factor(shards) if shards else np.nan
     rows = []
@@ -304,14 +584,35 @@ def fit_rows(source, fit, theory, shards=None):
 def asymptotic_fits(
     lower, upper, counts, times, errors, reference, restitution, windows, max_bias=0.5
 ):
-    """Every asymptotic fit of P(0, v) for one r, as a long table: each window (small and
-    large v), with the theory's exponents and with free ones, to the simulation and to the
-    solver.
+    """Every asymptotic fit of P(0, v) for one r, eqs. (asym1)-(asym6), as a long table.
 
-    ``counts`` (shards x bins) and ``times`` are the simulation's usable bins, ``errors``
-    its standard errors (the weights), ``reference`` the solver's bin averages;
-    ``windows`` maps each side to "auto" or {"min": .., "max": ..}.  A side without a
-    usable window gets NaN rows; the reasons are returned alongside.
+    Each window (small and large v), with the theory's exponents and with free ones, to the
+    simulation and to the solver.
+
+    Parameters
+    ----------
+    lower, upper : numpy.ndarray
+        The usable bins' edges.
+    counts, times : numpy.ndarray
+        The simulation's collisions per usable bin (shards x bins) and the shards' times.
+    errors : numpy.ndarray
+        Its per-bin standard errors (the weights, see ``fit_errors``).
+    reference : numpy.ndarray
+        The solver's bin averages in the same bins.
+    restitution : float
+        r.
+    windows : dict
+        Each side (``SMALL_SPEED``, ``LARGE_SPEED``) to "auto" (``asymptotic_window``) or
+        ``{"min": .., "max": ..}`` (``window_from_range``).
+    max_bias : float
+        Of ``asymptotic_window``.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        The rows of ``fit_rows``; a side without a usable window gets NaN rows.
+    problems : list of str
+        Why a side has no window.
     """
     rows, problems = [], []
     for side in (SMALL_SPEED, LARGE_SPEED):
@@ -356,9 +657,27 @@ def asymptotic_fits(
 
 
 def usable_curve(speeds, density):
-    """The part of a tabulated P(0, v) that can be interpolated in logs: up to the last
-    positive value (for r below ~0.035 the solver's P(0, v) ~ exp(-v / (2r)) underflows
-    to 0 before the grid ends)."""
+    """The part of a tabulated P(0, v) that can be interpolated in logs.
+
+    For r below ~0.035 the solver's P(0, v) ~ exp(-v / (2r)) underflows to 0 before the grid
+    ends.
+
+    Parameters
+    ----------
+    speeds, density : array_like
+        The table's v and P(0, v).
+
+    Returns
+    -------
+    speeds, density : numpy.ndarray
+        Up to the first value that is not finite and positive (not included).
+
+    Examples
+    --------
+    >>> from bouncing_ball.fits import usable_curve
+    >>> usable_curve([1.0, 2.0, 3.0], [0.5, 1e-300, 0.0])
+    (array([1., 2.]), array([5.e-001, 1.e-300]))
+    """
     speeds, density = np.asarray(speeds, dtype=float), np.asarray(density, dtype=float)
     bad = np.flatnonzero(~(np.isfinite(density) & (density > 0.0)))
     end = bad[0] if len(bad) else len(density)
@@ -366,8 +685,28 @@ def usable_curve(speeds, density):
 
 
 def bin_averages_of_curve(speeds, density, lower, upper):
-    """Bin averages of P(0, v) given on a dense log grid (the solver's output): a cubic spline
-    of ln P in ln v, averaged like the data (relative error ~1e-7 at 50 points per decade)."""
+    """Bin averages of P(0, v) given on a dense log grid (the solver's output).
+
+    A cubic spline of ln P in ln v, averaged like the data (``bins.outgoing_speed_bin_average``,
+    eq. (collrate)); relative error ~1e-7 at 50 points per decade.
+
+    Parameters
+    ----------
+    speeds, density : numpy.ndarray
+        The curve (see ``usable_curve``).
+    lower, upper : array_like
+        The bins' edges, inside the curve's speeds.
+
+    Returns
+    -------
+    numpy.ndarray
+        The bin averages.
+
+    Raises
+    ------
+    ValueError
+        If a bin reaches beyond the curve's speeds.
+    """
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
     if len(lower) == 0:
         return np.empty(0)
@@ -378,13 +717,32 @@ def bin_averages_of_curve(speeds, density, lower, upper):
 
 
 def fit_errors(errors, reference, expected):
-    """The per-bin standard errors that weight a fit: the jackknife's, except where it has
-    none to give.
+    """The per-bin standard errors that weight a fit.
 
-    With few shards a bin's jackknife error can be exactly 0 (every shard put the same
+    The jackknife's, except where it has none to give.  With few shards a bin's jackknife error can be exactly 0 (every shard put the same
     number of collisions there) or undefined; such a bin is weighted by its Poisson error
     from the collisions it should hold, ``reference / sqrt(expected)``, so that it stays in
     the fit (dropping it because of what its counts happened to be would select on the data).
+
+    Parameters
+    ----------
+    errors : array_like
+        The jackknife's errors per bin.
+    reference : array_like
+        The noise-free bin averages.
+    expected : array_like
+        The collisions each bin should hold (``expected_collisions``).
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bouncing_ball.fits import fit_errors
+    >>> print(fit_errors([0.1, 0.0, np.nan], [1.0, 2.0, 3.0], [100.0, 400.0, 900.0]))
+    [0.1 0.1 0.1]
     """
     errors = np.array(errors, dtype=float)
     missing = ~(np.isfinite(errors) & (errors > 0.0))
@@ -395,8 +753,30 @@ def fit_errors(errors, reference, expected):
 
 
 def expected_collisions(reference, lower, upper, total_time):
-    """Collisions a run of ``total_time`` should put in each bin, from noise-free bin averages
-    (eq. (collrate): rate = P-bar int_bin v dv)."""
+    """The collisions a run should put in each bin, from noise-free bin averages.
+
+    By eq. (collrate) collisions come in a bin at the rate P-bar int_bin v dv, P-bar the
+    bin average.
+
+    Parameters
+    ----------
+    reference : array_like
+        The bin averages of P(0, v).
+    lower, upper : array_like
+        The bins' edges.
+    total_time : float
+        The run's recorded time.
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Examples
+    --------
+    >>> from bouncing_ball.fits import expected_collisions
+    >>> print(expected_collisions([0.5], [1.0], [3.0], 100.0))
+    [200.]
+    """
     return (
         np.asarray(reference) * total_time * 0.5 * (np.asarray(upper) ** 2 - np.asarray(lower) ** 2)
     )
@@ -404,7 +784,21 @@ def expected_collisions(reference, lower, upper, total_time):
 
 @dataclass(frozen=True)
 class FitBins:
-    """The P(0, v) bins a fit uses, chosen by the collisions they should hold."""
+    """The P(0, v) bins a fit uses, chosen by the collisions they should hold.
+
+    Parameters
+    ----------
+    rows : numpy.ndarray
+        Indices into the merged p0v table (and a shard's speed counts).
+    lower, upper : numpy.ndarray
+        The bins' edges.
+    reference : numpy.ndarray
+        The reference curve's bin averages.
+    expected : numpy.ndarray
+        The collisions a run of the total time should put in each.
+    beyond : int
+        Populated bins above the curve's last speed, left out.
+    """
 
     rows: np.ndarray  # indices into the merged p0v table (and a shard's speed counts)
     lower: np.ndarray
@@ -415,10 +809,27 @@ class FitBins:
 
 
 def select_fit_bins(table, speeds, density, total_time, minimum_count) -> FitBins:
-    """The finite bins of a merged p0v ``table`` inside the reference curve's speeds (``speeds``,
-    ``density``: the solver's P(0, v), see ``usable_curve``) that should hold at least
-    ``minimum_count`` collisions in ``total_time``.  Chosen by the collisions a bin should hold,
-    not by those it happens to hold, so the choice does not select on the data."""
+    """The bins of a merged P(0, v) table a fit uses.
+
+    The finite bins inside the reference curve's speeds that should hold at least
+    ``minimum_count`` collisions in ``total_time``: chosen by the collisions a bin should
+    hold, not by those it happens to hold, so the choice does not select on the data.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A merged p0v table (columns v_lo, v_hi, count).
+    speeds, density : numpy.ndarray
+        The reference curve, the solver's P(0, v) (see ``usable_curve``).
+    total_time : float
+        The run's recorded time.
+    minimum_count : float
+        The fewest collisions a bin should hold.
+
+    Returns
+    -------
+    FitBins
+    """
     v_lo, v_hi = table.v_lo.to_numpy(), table.v_hi.to_numpy()
     finite = np.isfinite(v_hi)
     inside = finite & (v_lo >= speeds[0]) & (v_hi <= speeds[-1])

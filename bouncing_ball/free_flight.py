@@ -24,6 +24,9 @@ Everything here is numba-compiled scalar code (no allocation, no division by
 a constant: those are written as products with the reciprocal, which LLVM
 folds), because it runs once or more per step.  The mean path is carried as
 its four monomial coefficients ``a0 + a1 t + a2 t^2 + a3 t^3``.
+
+A compiled function compiles on its first call (seconds); its ``py_func`` is the Python
+function, which the Examples call so that they run at once.
 """
 
 import math
@@ -31,6 +34,30 @@ import math
 import numpy as np
 
 from .jit import njit
+
+__all__ = [
+    "free_flight_step",
+    "criterion_root",
+    "root_predictor",
+    "predicted_start",
+    "largest_safe_step",
+    "hermite_cubic",
+    "cubic_value",
+    "cubic_slope",
+    "mean_path_integrals",
+    "bridge_covariance",
+    "bridge_sample",
+    "bridge_speed_squared_given_position",
+    "speed_squared_coefficients",
+    "quintic_antiderivative_value",
+    "piece_inverse",
+    "level_time_one_step",
+    "level_time",
+    "cubic_level_time",
+    "slope_zeros",
+    "monotone_piece_end",
+    "first_crossing_time",
+]
 
 SQRT3 = math.sqrt(3.0)
 SQRT1_12 = math.sqrt(1.0 / 12.0)
@@ -54,12 +81,32 @@ _SMALLEST_NORMAL = np.finfo(np.float64).tiny
 
 @njit(cache=True)
 def free_flight_step(x, v, dt, normal_r, normal_s):
-    """One exact free-flight step, eqs. (xstep) and (vstep).
+    """One exact free-flight step of eq. (eqmo), eqs. (xstep) and (vstep).
 
-    ``normal_r`` and ``normal_s`` are independent standard normals; the same
-    ``normal_r`` enters both equations, which gives the correct x-v covariance.
-    The two noise amplitudes share one square root:
-    sqrt(dt^3 / 6) = dt sqrt(2 dt) / sqrt(12).
+    The same ``normal_r`` enters both equations, which gives the correct x-v covariance.
+    The two noise amplitudes share one square root: sqrt(dt^3 / 6) = dt sqrt(2 dt) / sqrt(12).
+
+    Parameters
+    ----------
+    x, v : float
+        Position and velocity at the step's start.
+    dt : float
+        The step Delta, > 0.
+    normal_r, normal_s : float
+        Independent standard normals (r and s of eqs. (xstep), (vstep)).
+
+    Returns
+    -------
+    x_new, v_new : float
+
+    Examples
+    --------
+    Without noise the step is the parabola of gravity:
+
+    >>> from bouncing_ball.free_flight import free_flight_step
+    >>> x, v = free_flight_step.py_func(1.0, 0.5, 0.01, 0.0, 0.0)
+    >>> print(round(x, 12), round(v, 12))
+    1.00495 0.49
     """
     root_2dt = math.sqrt(2.0 * dt)
     x_new = x + v * dt - 0.5 * dt * dt + dt * root_2dt * SQRT1_12 * (normal_s + SQRT3 * normal_r)
@@ -121,13 +168,16 @@ def _householder_root(x, v, c, s, iterations):
 
 @njit(cache=True, inline="always")
 def criterion_root(x, v, c, start):
-    """The positive root s* of f(s) = x + v s^2 - c s^3 - s^4/2, eq. (criterion) with
-    s = sqrt(Delta), and the slope f' there: (s*, f'(s*)).
+    """The root s* = sqrt(Delta) of eq. (criterion) that sets the largest step, and f'(s*).
+
+    s* is the positive root of f(s) = x + v s^2 - c s^3 - s^4/2 (s = sqrt(Delta)).
 
     By Descartes' rule f has exactly one positive root, where f' < 0 (and f' < 0,
     f'' < 0 on [s*, inf)).  At x = 0 (x below the smallest normal double counts as
-    0) it is that of a quadratic.  Otherwise Householder's third-order step,
+    0) it is that of a quadratic.  Otherwise Householder's third-order step ::
+
         s -= f (6 f1^2 - 3 f f2) / (6 f1^3 - 6 f f1 f2 + f^2 f3)
+
     (f1, f2, f3 the derivatives of f) converges quartically from ``start``: after
     a step of relative size e about e^4 is left, so it stops after a step
     <= ROOT_TOLERANCE s (s* to ~1e-11; tests/unit/test_free_flight.py checks the
@@ -138,6 +188,20 @@ def criterion_root(x, v, c, start):
     fits above (``_fitted_root``).  A Newton step stands in where the
     Householder denominator is not negative (far from s*), and a step past 0
     is replaced by halving s.
+
+    Parameters
+    ----------
+    x, v : float
+        Position (>= 0) and velocity.
+    c : float
+        The constant c of eq. (criterion), > 0.
+    start : float
+        A first guess of s* (<= 0: none, the rational fits give it).
+
+    Returns
+    -------
+    root, slope : float
+        s* and f'(s*).
     """
     if x < _SMALLEST_NORMAL:
         s = _floor_root(v, c)
@@ -152,11 +216,26 @@ def criterion_root(x, v, c, start):
 
 @njit(cache=True, inline="always")
 def root_predictor(root, slope_at_root, x, v):
-    """The coefficients (k0, k1, k2) of the next step's start for ``criterion_root``,
+    """The first-order prediction of the next step's root of eq. (criterion).
+
+    The coefficients (k0, k1, k2) of the next step's start for ``criterion_root``,
     s ~ k0 - k1 x1 - k2 v1 at the step's end (x1, v1): f(s; x, v) is linear in x and v and
     f(root; x, v) = 0, so to first order s ~ root - (x1 - x + root^2 (v1 - v)) / f'(root).
     They depend only on the step's start, so they are ready (division included) before
-    the step; ``predicted_start`` finishes the prediction."""
+    the step; ``predicted_start`` finishes the prediction.
+
+    Parameters
+    ----------
+    root, slope_at_root : float
+        s* and f'(s*) of ``criterion_root`` at the step's start.
+    x, v : float
+        The step's start.
+
+    Returns
+    -------
+    tuple of float
+        (k0, k1, k2).
+    """
     k1 = 1.0 / slope_at_root if slope_at_root < 0.0 else 0.0
     k2 = k1 * root * root
     return root + k1 * x + k2 * v, k1, k2
@@ -164,8 +243,23 @@ def root_predictor(root, slope_at_root, x, v):
 
 @njit(cache=True, inline="always")
 def predicted_start(predictor, root, x1, v1):
-    """The start of ``criterion_root`` at (x1, v1): the first-order prediction of
-    ``root_predictor``, or the previous root where the prediction is not positive."""
+    """The start of ``criterion_root`` at the end (x1, v1) of a step.
+
+    Parameters
+    ----------
+    predictor : tuple of float
+        (k0, k1, k2) of ``root_predictor``.
+    root : float
+        The previous root.
+    x1, v1 : float
+        The step's end.
+
+    Returns
+    -------
+    float
+        The first-order prediction k0 - k1 x1 - k2 v1, or the previous root where the
+        prediction is not positive.
+    """
     k0, k1, k2 = predictor
     predicted = k0 - k1 * x1 - k2 * v1
     return predicted if predicted > 0.0 else root
@@ -173,15 +267,53 @@ def predicted_start(predictor, root, x1, v1):
 
 @njit(cache=True, inline="always")
 def largest_safe_step(x, v, c):
-    """The largest step D(x, v) allowed by eq. (criterion): s*^2 of ``criterion_root``
-    from the fitted start (0 when x <= 0 and v <= 0)."""
+    """The largest step D(x, v) allowed by eq. (criterion).
+
+    Parameters
+    ----------
+    x, v : float
+        Position and velocity.
+    c : float
+        The constant c of eq. (criterion).
+
+    Returns
+    -------
+    float
+        s*^2 of ``criterion_root`` from the fitted start (0 when x <= 0 and v <= 0).
+    """
     s, _ = criterion_root(x, v, c, 0.0)
     return s * s
 
 
 @njit(cache=True)
 def hermite_cubic(x0, v0, x1, v1, dt):
-    """Monomial coefficients of the bridge mean path m(t) on [0, dt]."""
+    """Monomial coefficients of the bridge mean path m(t) on [0, dt].
+
+    The cubic Hermite interpolant of the step's ends: the mean of the Gaussian bridge of
+    eq. (eqmo) given both ends (see the module's account).
+
+    Parameters
+    ----------
+    x0, v0 : float
+        Position and velocity at t = 0.
+    x1, v1 : float
+        Position and velocity at t = dt.
+    dt : float
+        The step, > 0.
+
+    Returns
+    -------
+    a0, a1, a2, a3 : float
+        m(t) = a0 + a1 t + a2 t^2 + a3 t^3.
+
+    Examples
+    --------
+    The ends of a noiseless step of gravity give back its parabola, 1 - t^2/2:
+
+    >>> from bouncing_ball.free_flight import hermite_cubic
+    >>> hermite_cubic.py_func(1.0, 0.0, 0.5, -1.0, 1.0)
+    (1.0, 0.0, -0.5, 0.0)
+    """
     inv_dt = 1.0 / dt
     slope = (x1 - x0) * inv_dt
     a2 = (3.0 * slope - 2.0 * v0 - v1) * inv_dt
@@ -191,11 +323,43 @@ def hermite_cubic(x0, v0, x1, v1, dt):
 
 @njit(cache=True)
 def cubic_value(a0, a1, a2, a3, t):
+    """The mean path m(t) = a0 + a1 t + a2 t^2 + a3 t^3 (Horner).
+
+    Parameters
+    ----------
+    a0, a1, a2, a3 : float
+        The coefficients of ``hermite_cubic``.
+    t : float
+        The time in the step.
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> from bouncing_ball.free_flight import cubic_value
+    >>> cubic_value.py_func(1.0, 0.0, -0.5, 0.0, 1.0)
+    0.5
+    """
     return a0 + t * (a1 + t * (a2 + t * a3))
 
 
 @njit(cache=True)
 def cubic_slope(a1, a2, a3, t):
+    """The mean path's slope m'(t) = a1 + 2 a2 t + 3 a3 t^2: the mean velocity.
+
+    Parameters
+    ----------
+    a1, a2, a3 : float
+        The coefficients of ``hermite_cubic`` (a0 does not enter).
+    t : float
+        The time in the step.
+
+    Returns
+    -------
+    float
+    """
     return a1 + t * (2.0 * a2 + t * 3.0 * a3)
 
 
@@ -204,7 +368,30 @@ def mean_path_integrals(a0, a1, a2, a3, dt, tau):
     """E[int_0^tau x dt'] and E[int_0^tau x^2 dt'] given the ends of a step.
 
     The first is the integral of the mean path; the second adds the bridge
-    variance of x to its square.
+    variance of x to its square.  They make the tallies of <x> and <x^2>
+    (eq. (xandDeltax)) exact in expectation.
+
+    Parameters
+    ----------
+    a0, a1, a2, a3 : float
+        The mean path (``hermite_cubic``).
+    dt : float
+        The step.
+    tau : float
+        The upper limit, 0 <= tau <= dt (< dt where a collision cuts the step).
+
+    Returns
+    -------
+    int_x, int_x2 : float
+
+    Examples
+    --------
+    At rest at x = 1 over a unit step, the bridge adds int 2 t^3 (1 - t)^3 / 3 dt = 1/210:
+
+    >>> from bouncing_ball.free_flight import mean_path_integrals
+    >>> int_x, int_x2 = mean_path_integrals.py_func(1.0, 0.0, 0.0, 0.0, 1.0, 1.0)
+    >>> print(int_x, round((int_x2 - 1.0) * 210, 12))
+    1.0 1.0
     """
     int_x = tau * (a0 + tau * (0.5 * a1 + tau * ((1.0 / 3.0) * a2 + tau * 0.25 * a3)))
     c0 = a0 * a0
@@ -238,11 +425,30 @@ def mean_path_integrals(a0, a1, a2, a3, dt, tau):
 
 
 def bridge_covariance(dt, t):
-    """(Var x, Cov(x, v), Var v) of the bridge at time t of a step of length dt, given its ends.
+    """The covariance of (x(t), v(t)) on the bridge of a step, given both ends.
 
-    Conditioning the integrated Brownian motion (x, v) at t on its value at dt
+    Conditioning the integrated Brownian motion (x, v) of eq. (eqmo) at t on its value at dt
     (Schur complement of the joint covariance; with w = u (1 - u), u = t / dt):
     Var x = (2/3) dt^3 w^3, Cov = dt^2 w^2 (1 - 2u), Var v = 2 dt w (1 - 3w).
+
+    Parameters
+    ----------
+    dt : float
+        The step's length.
+    t : array_like
+        Times in the step, 0 <= t <= dt.
+
+    Returns
+    -------
+    var_x, cov_xv, var_v : numpy.ndarray
+
+    Examples
+    --------
+    In the middle of a unit step (w = 1/4):
+
+    >>> from bouncing_ball.free_flight import bridge_covariance
+    >>> print([round(float(value), 12) for value in bridge_covariance(1.0, 0.5)])
+    [0.010416666667, 0.0, 0.125]
     """
     u = np.asarray(t, dtype=float) / dt
     w = u * (1.0 - u)
@@ -260,7 +466,22 @@ def bridge_sample(a0, a1, a2, a3, dt, t, normal_1, normal_2):
     The mean is (m(t), m'(t)); with w = u (1 - u), u = t / dt, the covariance
     of ``bridge_covariance`` factors as x = m + (2/3)^(1/2) dt w (dt w)^(1/2) n1 and
     v = m' + (dt w)^(1/2) ((3/2)^(1/2) (1 - 2u) n1 + (1/2)^(1/2) n2): Var v given x
-    is dt w / 2.  ``normal_1``, ``normal_2`` are independent standard normals.
+    is dt w / 2.
+
+    Parameters
+    ----------
+    a0, a1, a2, a3 : float
+        The mean path (``hermite_cubic``).
+    dt : float
+        The step.
+    t : float
+        The time in the step.
+    normal_1, normal_2 : float
+        Independent standard normals.
+
+    Returns
+    -------
+    x, v : float
     """
     u = t * (1.0 / dt)
     w = max(u * (1.0 - u), 0.0)  # u may exceed 1 by a rounding error at t = dt
@@ -279,7 +500,23 @@ def bridge_speed_squared_given_position(a1, a2, a3, dt, t, normal_1):
     In ``bridge_sample``'s factorisation, x(t) fixes normal_1, and v(t) given x(t) is
     Gaussian with mean m'(t) + (3/2)^(1/2) (dt w)^(1/2) (1 - 2u) normal_1 and variance
     dt w / 2 (w = u (1 - u), u = t / dt).  Averaged over normal_1 it is E[v(t)^2 | ends],
-    the integrand of ``speed_squared_coefficients``.
+    the integrand of ``speed_squared_coefficients``.  It makes the <v^2>_x tally
+    (eq. (moment2)) exact in expectation.
+
+    Parameters
+    ----------
+    a1, a2, a3 : float
+        The mean path (``hermite_cubic``).
+    dt : float
+        The step.
+    t : float
+        The time in the step.
+    normal_1 : float
+        The normal ``bridge_sample`` drew x(t) with.
+
+    Returns
+    -------
+    float
     """
     u = t * (1.0 / dt)
     w = max(u * (1.0 - u), 0.0)
@@ -290,10 +527,32 @@ def bridge_speed_squared_given_position(a1, a2, a3, dt, t, normal_1):
 
 @njit(cache=True)
 def speed_squared_coefficients(a1, a2, a3, dt):
-    """S(t) = int_0^t E[v(t')^2 | ends] dt' = t (s1 + t (s2 + t (s3 + t (s4 + t s5)))).
+    """The coefficients of S(t) = int_0^t E[v(t')^2 | ends] dt' on a step.
 
-    The mean slope squared, (a1 + 2 a2 t + 3 a3 t^2)^2, plus Var[v(t) | ends],
+    S(t) = t (s1 + t (s2 + t (s3 + t (s4 + t s5)))): the mean slope squared,
+    (a1 + 2 a2 t + 3 a3 t^2)^2, plus Var[v(t) | ends],
     2 t (dt - t)(dt^2 - 3 t dt + 3 t^2) / dt^3 = 2 t - 8 t^2/dt + 12 t^3/dt^2 - 6 t^4/dt^3.
+
+    Parameters
+    ----------
+    a1, a2, a3 : float
+        The mean path (``hermite_cubic``).
+    dt : float
+        The step.
+
+    Returns
+    -------
+    s1, s2, s3, s4, s5 : float
+
+    Examples
+    --------
+    Over a whole unit step at unit mean velocity, S(1) = 1 + int_0^1 Var v dt = 1 + 2/15:
+
+    >>> from bouncing_ball.free_flight import (
+    ...     quintic_antiderivative_value, speed_squared_coefficients)
+    >>> coefficients = speed_squared_coefficients.py_func(1.0, 0.0, 0.0, 1.0)
+    >>> print(round(quintic_antiderivative_value.py_func(*coefficients, 1.0), 12))
+    1.133333333333
     """
     inv_dt = 1.0 / dt
     s1 = a1 * a1
@@ -306,16 +565,46 @@ def speed_squared_coefficients(a1, a2, a3, dt):
 
 @njit(cache=True)
 def quintic_antiderivative_value(s1, s2, s3, s4, s5, t):
+    """S(t) = t (s1 + t (s2 + t (s3 + t (s4 + t s5)))) (Horner).
+
+    Parameters
+    ----------
+    s1, s2, s3, s4, s5 : float
+        The coefficients of ``speed_squared_coefficients``.
+    t : float
+        The time in the step.
+
+    Returns
+    -------
+    float
+    """
     return t * (s1 + t * (s2 + t * (s3 + t * (s4 + t * s5))))
 
 
 @njit(cache=True, inline="always")
 def piece_inverse(t_lo, t_hi, x_lo, x_hi, d_lo, d_hi):
-    """What ``level_time`` needs of a monotone piece [t_lo, t_hi] of the mean path, from
+    """The inverse of a monotone piece of the mean path, as ``level_time`` needs it.
+
+    What ``level_time`` needs of a monotone piece [t_lo, t_hi] of the mean path, from
     x_lo, x_hi and the slopes d_lo, d_hi at its ends (its divisions, done once a piece):
     (t_lo, width, x_lo, rise, 1 / rise, m0, m1), where m0 and m1 are the end slopes of
     the inverse t(m) on [0, 1] x [0, 1] (0, 0 where an end slope is below 0.1 of the
-    piece's mean slope, next to a zero of m': the start is then linear)."""
+    piece's mean slope, next to a zero of m': the start is then linear).
+
+    Parameters
+    ----------
+    t_lo, t_hi : float
+        The piece's ends.
+    x_lo, x_hi : float
+        The mean path there.
+    d_lo, d_hi : float
+        Its slopes there.
+
+    Returns
+    -------
+    tuple of float
+        (t_lo, width, x_lo, rise, 1 / rise, m0, m1).
+    """
     width = t_hi - t_lo
     rise = x_hi - x_lo
     inv_rise = 1.0 / rise
@@ -328,7 +617,7 @@ def piece_inverse(t_lo, t_hi, x_lo, x_hi, d_lo, d_hi):
 
 
 @njit(cache=True, inline="always")
-def level_time_estimate(level, inverse):
+def _level_time_estimate(level, inverse):
     """The start of ``level_time``: the inverse cubic Hermite interpolant t(m) through the
     ends of the monotone piece (their values and slopes 1/m'), or the linear one next to a
     zero of m' (``inverse``: the piece's ``piece_inverse``).  No iteration: its error is
@@ -343,14 +632,31 @@ def level_time_estimate(level, inverse):
 
 @njit(cache=True, inline="always")
 def level_time_one_step(a0, a1, a2, a3, level, inverse):
-    """``level_time_estimate`` and one Halley step from it, with no test and no iteration
+    """The time the mean path crosses a level, to one Halley step (no test, no iteration).
+
+    ``_level_time_estimate`` and one Halley step from it, with no test and no iteration
     (it may leave the piece, or be NaN where m' vanishes: the caller clips it).  On the
     crossings of simulated steps (r = 1/2, c = 5) its error is below 1e-9 of the piece for
     about 70 % of them and below 3e-3 for 99 %; next to a turning point it can be a few
     tenths of the piece.  The P(x) tally uses it: its errors only move time between
     neighbouring bins of one step's assignment, which the tally's bridge correction
-    undoes in expectation (``simulation``)."""
-    t = level_time_estimate(level, inverse)
+    undoes in expectation (``simulation``).
+
+    Parameters
+    ----------
+    a0, a1, a2, a3 : float
+        The mean path (``hermite_cubic``).
+    level : float
+        The height crossed.
+    inverse : tuple of float
+        The piece's ``piece_inverse``.
+
+    Returns
+    -------
+    float
+        The time of the crossing, unclipped.
+    """
+    t = _level_time_estimate(level, inverse)
     f = cubic_value(a0, a1, a2, a3, t) - level
     d1 = cubic_slope(a1, a2, a3, t)
     d2 = 2.0 * a2 + 6.0 * a3 * t
@@ -359,12 +665,14 @@ def level_time_one_step(a0, a1, a2, a3, level, inverse):
 
 @njit(cache=True, inline="always")
 def level_time(a0, a1, a2, a3, level, inverse):
-    """The t where the mean path m(t) = level on a monotone piece that brackets it
+    """The time the mean path crosses a level on a monotone piece, to about 1e-9 of the piece.
+
+    The t where the mean path m(t) = level on a monotone piece that brackets it
     (``inverse``: the piece's ``piece_inverse``), to about 1e-9 of the piece: where a
     collision cuts a step (``first_crossing_time``), and the P(x) tally's edge crossings
     in such a step; its other crossings use ``level_time_one_step``.
 
-    The start is ``level_time_estimate``: the inverse cubic Hermite interpolant t(m)
+    The start is ``_level_time_estimate``: the inverse cubic Hermite interpolant t(m)
     through the piece's ends (their values and slopes 1/m'), or the linear one next to a
     zero of m'.
     Safeguarded Halley iteration follows: a step that leaves the bracket is
@@ -378,15 +686,29 @@ def level_time(a0, a1, a2, a3, level, inverse):
     Halley steps on average from the Hermite start (2.2 from the linear one).  Next to
     a zero of m' (a piece ends where the path turns) a Halley step is short because m'
     is small, not because the root is near; such a step is replaced by bisection, which
-    stops when the bracket is 1e-10 of the piece.  The crossings of one piece do not depend on each other,
-    so the processor overlaps them.
+    stops when the bracket is 1e-10 of the piece.  The crossings of one piece do not depend
+    on each other, so the processor overlaps them.
+
+    Parameters
+    ----------
+    a0, a1, a2, a3 : float
+        The mean path (``hermite_cubic``).
+    level : float
+        The height crossed, between the piece's ends.
+    inverse : tuple of float
+        The piece's ``piece_inverse``.
+
+    Returns
+    -------
+    float
+        The time of the crossing.
     """
     t_lo, width, x_lo, rise, inv_rise, m0, m1 = inverse
     if (level - x_lo) * inv_rise <= 0.0:
         return t_lo
     rising = rise > 0.0
     lo, hi = t_lo, t_lo + width
-    t = level_time_estimate(level, inverse)
+    t = _level_time_estimate(level, inverse)
     for _ in range(200):
         f = cubic_value(a0, a1, a2, a3, t) - level
         if f == 0.0:
@@ -412,14 +734,55 @@ def level_time(a0, a1, a2, a3, level, inverse):
 
 @njit(cache=True, inline="always")
 def cubic_level_time(a0, a1, a2, a3, level, t_lo, t_hi, x_lo, x_hi, d_lo, d_hi):
-    """The t in [t_lo, t_hi] where m(t) = level, m monotone there from x_lo to x_hi with
-    slopes d_lo, d_hi at the ends, and bracketing (``level_time`` for one crossing)."""
+    """The t in [t_lo, t_hi] where the mean path m(t) = level (``level_time``, one crossing).
+
+    Parameters
+    ----------
+    a0, a1, a2, a3 : float
+        The mean path (``hermite_cubic``), monotone on [t_lo, t_hi].
+    level : float
+        The height crossed, between x_lo and x_hi.
+    t_lo, t_hi : float
+        The piece's ends.
+    x_lo, x_hi : float
+        m there.
+    d_lo, d_hi : float
+        m' there.
+
+    Returns
+    -------
+    float
+    """
     return level_time(a0, a1, a2, a3, level, piece_inverse(t_lo, t_hi, x_lo, x_hi, d_lo, d_hi))
 
 
 @njit(cache=True)
 def slope_zeros(a1, a2, a3, t_end):
-    """The zeros of m'(t) strictly inside (0, t_end), as (count, t1, t2), t1 < t2."""
+    """The zeros of the mean path's slope m'(t) strictly inside (0, t_end).
+
+    Parameters
+    ----------
+    a1, a2, a3 : float
+        The mean path (``hermite_cubic``).
+    t_end : float
+        The step's end.
+
+    Returns
+    -------
+    count : int
+        0, 1 or 2.
+    t1, t2 : float
+        The zeros, t1 < t2 (t_end where there is none).
+
+    Examples
+    --------
+    m'(t) = 1 - 6 t + 3 t^2 vanishes at 1 -+ (2/3)^(1/2):
+
+    >>> from bouncing_ball.free_flight import slope_zeros
+    >>> count, t1, t2 = slope_zeros.py_func(1.0, -3.0, 1.0, 3.0)
+    >>> print(count, round(t1, 10), round(t2, 10))
+    2 0.1835034191 1.8164965809
+    """
     a, b, c = 3.0 * a3, 2.0 * a2, a1
     t1 = t_end
     t2 = t_end
@@ -454,7 +817,23 @@ def slope_zeros(a1, a2, a3, t_end):
 
 @njit(cache=True, inline="always")
 def monotone_piece_end(piece, n_zero, t1, t2, t_end):
-    """End of monotone piece ``piece`` of [0, t_end] split at the slope zeros t1 < t2."""
+    """The end of a monotone piece of [0, t_end], split at the slope zeros t1 < t2.
+
+    Parameters
+    ----------
+    piece : int
+        The piece, 0, 1 or 2.
+    n_zero : int
+        The number of slope zeros (``slope_zeros``).
+    t1, t2 : float
+        The zeros.
+    t_end : float
+        The step's end.
+
+    Returns
+    -------
+    float
+    """
     if piece == 0 and n_zero >= 1:
         return t1
     if piece == 1 and n_zero == 2:
@@ -464,11 +843,23 @@ def monotone_piece_end(piece, n_zero, t1, t2, t_end):
 
 @njit(cache=True)
 def first_crossing_time(a0, a1, a2, a3, t_end, x_end):
-    """First t in (0, t_end] where the mean path reaches 0.
+    """The first t in (0, t_end] where the mean path reaches the floor, x = 0.
 
-    Requires m(0) = a0 > 0 >= m(t_end) = x_end.  The path is split at the
-    zeros of m' into monotone pieces; the first piece that ends at or below 0
-    holds the crossing.
+    Where a collision cuts a step.  The path is split at the zeros of m' into monotone
+    pieces; the first piece that ends at or below 0 holds the crossing.
+
+    Parameters
+    ----------
+    a0, a1, a2, a3 : float
+        The mean path (``hermite_cubic``), m(0) = a0 > 0.
+    t_end : float
+        The step's end.
+    x_end : float
+        m(t_end) <= 0.
+
+    Returns
+    -------
+    float
     """
     n, t1, t2 = slope_zeros(a1, a2, a3, t_end)
     start = 0.0

@@ -36,6 +36,16 @@ from numba.core.caching import FunctionCache
 
 from . import PACKAGE, source_digest
 
+__all__ = [
+    "njit",
+    "COMPILED",
+    "CACHE",
+    "prune_caches",
+    "user_cache_folder",
+    "writable_cache_base",
+    "RecoveringFunctionCache",
+]
+
 KEEP_CACHES = 3
 PRUNE_AFTER_SECONDS = 3600.0
 
@@ -43,10 +53,39 @@ PRUNE_AFTER_SECONDS = 3600.0
 def prune_caches(
     base: Path, current: Path, keep: int = KEEP_CACHES, older_than: float = PRUNE_AFTER_SECONDS
 ):
-    """Remove ``numba-*`` folders under ``base`` other than ``current``, keeping the ``keep`` newest.
+    """Remove the ``numba-*`` folders under ``base`` other than ``current``, but the newest.
 
-    Returns the folders removed.  Failures (a folder removed by another
-    process at the same time, no permission) are ignored: pruning is tidying.
+    Failures (a folder removed by another process at the same time, no permission) are
+    ignored: pruning is tidying.
+
+    Parameters
+    ----------
+    base : pathlib.Path
+        The folder holding the cache folders.
+    current : pathlib.Path
+        The cache folder in use, never removed.
+    keep : int
+        How many of the others are kept, the most recently used.
+    older_than : float
+        Seconds: a folder used more recently than that is kept (a job of another version
+        may still be running).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The folders removed.
+
+    Examples
+    --------
+    >>> import os, tempfile, time
+    >>> from pathlib import Path
+    >>> from bouncing_ball.jit import prune_caches
+    >>> base = Path(tempfile.mkdtemp())
+    >>> for age, name in enumerate(["numba-a", "numba-b", "numba-c"]):
+    ...     (base / name).mkdir()
+    ...     os.utime(base / name, (time.time() - 7200 * (age + 1),) * 2)
+    >>> [path.name for path in prune_caches(base, base / "numba-a", keep=1)]
+    ['numba-c']
     """
     try:
         others = [path for path in base.glob("numba-*") if path.is_dir() and path != current]
@@ -67,13 +106,38 @@ def prune_caches(
 
 
 def user_cache_folder() -> Path:
-    """Where the cache goes when the checkout cannot be written to."""
+    """Where the cache goes when the checkout cannot be written to.
+
+    Returns
+    -------
+    pathlib.Path
+        ``$XDG_CACHE_HOME/bouncing_ball``, else ``~/.cache/bouncing_ball``.
+    """
     root = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
     return Path(root) / "bouncing_ball"
 
 
 def writable_cache_base(preferred: Path, fallback: Path) -> Path:
-    """``preferred`` if a cache folder can be made and written in it, else ``fallback``."""
+    """``preferred`` if a cache folder can be made and written in it, else ``fallback``.
+
+    Parameters
+    ----------
+    preferred, fallback : pathlib.Path
+        The folder wanted, and the one to use where it cannot be written to.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from bouncing_ball.jit import writable_cache_base
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> writable_cache_base(folder / "cache", folder / "other") == folder / "cache"
+    True
+    """
     try:
         preferred.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryFile(dir=preferred):
@@ -84,9 +148,20 @@ def writable_cache_base(preferred: Path, fallback: Path) -> Path:
 
 
 class RecoveringFunctionCache(FunctionCache):
-    """numba's cache of one function, with a damaged cache file taken as a cache miss."""
+    """numba's cache of one function, with a damaged cache file taken as a cache miss.
+
+    ``njit`` gives every cached function this class.  A damaged index (a truncated write, a
+    full disk) is reported with its folder and removed, and the function recompiled, where
+    numba would raise ``UnpicklingError`` in every job.
+
+    Parameters
+    ----------
+    py_func : function
+        The Python function compiled (as for ``numba.core.caching.FunctionCache``).
+    """
 
     def load_overload(self, sig, target_context):
+        """The cached overload of ``sig``, or None (a cache miss) where the cache is damaged."""
         try:
             return super().load_overload(sig, target_context)
         except Exception as error:  # a damaged pickle raises almost anything
@@ -104,9 +179,29 @@ class RecoveringFunctionCache(FunctionCache):
 
 
 def njit(*args, **options):
-    """``numba.njit`` with IEEE division (inf or NaN instead of a Python ZeroDivisionError
-    check on every division: the compiled code tests its own denominators, as the C
-    reference of the loop does) and a cache that survives a damaged file."""
+    """``numba.njit`` with IEEE division and a cache that survives a damaged file.
+
+    IEEE division gives inf or NaN instead of a Python ZeroDivisionError check on every
+    division: the compiled code tests its own denominators, as the C reference of the loop
+    does.  The compiled function keeps the Python function's docstring.
+
+    Parameters
+    ----------
+    *args
+        The function, when used as ``@njit`` without options.
+    **options
+        Options of ``numba.njit`` (e.g. ``cache=True``, ``inline="always"``).
+
+    Returns
+    -------
+    numba dispatcher, or a decorator that makes one
+        Compiled on its first call.
+
+    Raises
+    ------
+    TypeError
+        If options are given other than by keyword.
+    """
 
     def compile_lazily(function):
         dispatcher = numba.njit(error_model="numpy", **options)(function)
@@ -121,13 +216,13 @@ def njit(*args, **options):
     return compile_lazily
 
 
-# what numba compiles: the modules with compiled functions and what those call into or read
-# constants from (the key of numba's cache folder, bouncing_ball.jit); an edit elsewhere does
-# not recompile
+#: What numba compiles: the modules with compiled functions and what those call into or read
+#: constants from (the key of numba's cache folder); an edit elsewhere does not recompile.
 COMPILED = ("distribution", "free_flight", "jit", "kernel", "simulation", "tallies")
 
 _preferred = Path(numba.config.CACHE_DIR) if numba.config.CACHE_DIR else PACKAGE / "__pycache__"
 _base = writable_cache_base(_preferred, user_cache_folder())
+#: numba's cache folder, named after the source of the modules of ``COMPILED``.
 CACHE = _base / f"numba-{source_digest(COMPILED)}"
 numba.config.CACHE_DIR = str(CACHE)
 with contextlib.suppress(OSError):  # not there yet, or not ours to touch (a read-only cache)

@@ -3,6 +3,8 @@
 import re
 from pathlib import Path
 
+import sphinx.ext.autosummary
+
 import bouncing_ball
 
 DOCS = Path(__file__).resolve().parent
@@ -21,7 +23,8 @@ extensions = [
     "sphinx.ext.mathjax",
 ]
 
-source_suffix = {".md": "myst-nb", ".rst": "restructuredtext"}
+# .rst first: autosummary writes its generated pages (reStructuredText) with the first suffix
+source_suffix = {".rst": "restructuredtext", ".md": "myst-nb"}
 exclude_patterns = ["_build", "requirements.txt"]
 root_doc = "index"
 
@@ -36,6 +39,11 @@ nb_execution_raise_on_error = True
 nb_merge_streams = True
 
 autosummary_generate = True
+# a module's page (docs/_templates/autosummary/module_page.rst) lists the names of its __all__
+autosummary_ignore_module_all = False
+templates_path = ["_templates"]
+# a summary line of the API tables ends at its first sentence, and "eq. (label)" does not end one
+sphinx.ext.autosummary.WELL_KNOWN_ABBREVIATIONS += ("eq.", "eqs.", "Eq.", "Eqs.", "Fig.", "Figs.")
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 

@@ -1,12 +1,40 @@
-"""The Examples of the public API's docstrings run as doctests (cheap ones: the exact solutions,
-the solve at r = 1/2, and tiny simulations)."""
+"""The Examples of the public API's and the physics modules' docstrings run as doctests (cheap
+ones: the exact solutions, the solve at r = 1/2, tiny simulations, and pure numpy/scipy
+functions; the physics modules' Examples call a compiled function's ``py_func``, so they
+compile nothing), and every public name of a physics module has a numpydoc docstring."""
 
 import doctest
 import importlib
+import inspect
 
 import pytest
 
-MODULES = ["bouncing_ball.equilibrium", "bouncing_ball.monte_carlo"]
+MODULES = [
+    "bouncing_ball.equilibrium",
+    "bouncing_ball.monte_carlo",
+    "bouncing_ball.asymptotics",
+    "bouncing_ball.bins",
+    "bouncing_ball.comparison",
+    "bouncing_ball.equilibration",
+    "bouncing_ball.fits",
+    "bouncing_ball.flight_time",
+    "bouncing_ball.free_flight",
+    "bouncing_ball.jit",
+    "bouncing_ball.settings",
+]
+
+# the physics modules whose public names (their __all__) are documented in numpydoc style
+DOCUMENTED = [
+    "bouncing_ball.asymptotics",
+    "bouncing_ball.bins",
+    "bouncing_ball.comparison",
+    "bouncing_ball.equilibration",
+    "bouncing_ball.fits",
+    "bouncing_ball.flight_time",
+    "bouncing_ball.free_flight",
+    "bouncing_ball.jit",
+    "bouncing_ball.settings",
+]
 
 
 @pytest.mark.parametrize("name", MODULES)
@@ -18,3 +46,43 @@ def test_examples_run(name, capsys):
     report = capsys.readouterr().out
     assert result.attempted > 0, f"{name} has no Examples"
     assert result.failed == 0, report
+
+
+def _missing_sections(obj) -> list[str]:
+    """The numpydoc sections a public function or class lacks: a one-line summary, Parameters
+    where it takes arguments, Returns (or Yields) for a function (an exception: a summary)."""
+    doc = inspect.getdoc(obj) or ""
+    missing = [] if doc.strip() else ["docstring"]
+    if "\n" in doc.split("\n\n")[0]:
+        missing.append("one-line summary")
+    function = getattr(obj, "py_func", obj)  # a numba dispatcher documents its Python function
+    if inspect.isclass(obj) and issubclass(obj, BaseException):
+        return missing
+    if inspect.isclass(obj):
+        if dataclass_fields := getattr(obj, "__dataclass_fields__", None):
+            takes_arguments = bool(dataclass_fields)
+        else:
+            takes_arguments = len(inspect.signature(obj).parameters) > 0
+    else:
+        takes_arguments = len(inspect.signature(function).parameters) > 0
+        if "Returns\n-------" not in doc and "Yields\n------" not in doc:
+            missing.append("Returns")
+    if takes_arguments and "Parameters\n----------" not in doc:
+        missing.append("Parameters")
+    return missing
+
+
+@pytest.mark.parametrize("name", DOCUMENTED)
+def test_public_names_documented(name):
+    module = importlib.import_module(name)
+    assert module.__all__, f"{name} has an empty __all__"
+    undocumented = {
+        public: missing
+        for public in module.__all__
+        if callable(value := getattr(module, public)) and (missing := _missing_sections(value))
+    }
+    assert not undocumented, f"{name}: numpydoc sections missing: {undocumented}"
+    examples = [
+        public for public in module.__all__ if ">>>" in (getattr(module, public).__doc__ or "")
+    ]
+    assert examples, f"{name}: no public name has Examples"
