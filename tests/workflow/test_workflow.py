@@ -367,7 +367,7 @@ def test_editing_a_plotting_script_reruns_only_figures(finished_run, tmp_path):
         handle.write("\n# an edit\n")
     assert planned_jobs(directory) == {"fig4": 1, "all": 1}
     package, env = _packagecopy_repository(tmp_path)
-    with open(package / "plotting.py", "a") as handle:
+    with open(package / "workflow" / "plotting.py", "a") as handle:
         handle.write("\n# an edit\n")
     assert planned_jobs(finished_run, env) == {f"fig{n}": 1 for n in range(1, 12)} | {"all": 1}
 
