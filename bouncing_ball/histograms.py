@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from . import stages
-from .tallies import CONTROL_VARIATE_SUMS, ShardTallies, merge_shards
+from .tallies import CONTROL_VARIATE_SUMS, MOMENT_CONTROLS, ShardTallies, merge_shards
 
 # the modules whose code decides the merged tables (see ``source_digest``)
 SOURCES = stages.MERGE
@@ -195,11 +195,19 @@ def _delta_x(int_x, int_x2, time):
     return np.sqrt(int_x2 / time - (int_x / time) ** 2)
 
 
+# the moments the summary also gives corrected by MOMENT_CONTROLS (``{name}_controlled``)
+CONTROLLED_MOMENTS = ("mean_x", "delta_x", "mean_flight_time", "flight_time_second_moment")
+
+
 def position_moments_summary(shards: list[ShardTallies], restitution: float) -> pd.DataFrame:
     """One row: <x>, Delta x and the collision rate I, eqs. (collrate), (xandDeltax), and the
-    mean and second moment of the flight time per flight.  I is given twice: the collisions
-    per time, and the same corrected by the control variates (``control_variate_rate``, the
-    same expectation, 3.6-6.7 times less variance; NaN with fewer than 7 shards)."""
+    mean and second moment of the flight time per flight.  Each is given twice: plain (the
+    time averages, collisions per time, the flights' averages) and ``*_controlled``, the same
+    corrected by martingale control variates of mean 0 (the same expectation, less
+    variance): I by ``control_variate_rate`` with the noise sums of CONTROL_VARIATE_SUMS (NaN
+    with fewer than 7 shards), the others by ``control_variate_adjusted`` with those of
+    MOMENT_CONTROLS, which adjusts each sum (int x dt, int x^2 dt, the flights, sum T,
+    sum T^2) before the ratio (NaN with fewer than ``len(MOMENT_CONTROLS) + 3`` shards)."""
     time = np.array([s.time for s in shards])
     int_x = np.array([s.int_x for s in shards])
     int_x2 = np.array([s.int_x2 for s in shards])
@@ -217,6 +225,30 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
     flight_time_squared = np.array([s.flight_time_squared_sum for s in shards])
     mean_t, mean_t_err = jackknife(lambda f, n: f / n, flight_time, flights)
     second_t, second_t_err = jackknife(lambda f, n: f / n, flight_time_squared, flights)
+    controlled_moments = dict.fromkeys(CONTROLLED_MOMENTS, (np.nan, np.nan))
+    if len(shards) >= len(MOMENT_CONTROLS) + 3:
+        moment_controls = np.array([[getattr(s, name) for name in MOMENT_CONTROLS] for s in shards])
+
+        def adjusted(tallies):
+            return control_variate_adjusted(tallies, time, moment_controls)[0]
+
+        x_sum, x2_sum = adjusted(int_x), adjusted(int_x2)
+        flights_sum, t_sum, t2_sum = (
+            adjusted(flights),
+            adjusted(flight_time),
+            adjusted(flight_time_squared),
+        )
+        controlled_moments = {
+            "mean_x": jackknife(_mean_x, x_sum, time),
+            "delta_x": jackknife(_delta_x, x_sum, x2_sum, time),
+            "mean_flight_time": jackknife(lambda f, n: f / n, t_sum, flights_sum),
+            "flight_time_second_moment": jackknife(lambda f, n: f / n, t2_sum, flights_sum),
+        }
+    controlled_columns = {
+        column: [float(value)]
+        for name, pair in controlled_moments.items()
+        for column, value in zip((f"{name}_controlled", f"{name}_controlled_err"), pair)
+    }
     total = merge_shards(shards)
     return pd.DataFrame(
         {
@@ -225,6 +257,7 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
             "mean_x_err": [float(mean_x_err)],
             "delta_x": [float(delta_x)],
             "delta_x_err": [float(delta_x_err)],
+            **controlled_columns,
             "collision_rate": [float(rate)],
             "collision_rate_err": [float(rate_err)],
             "collision_rate_controlled": [float(controlled)],
@@ -270,6 +303,20 @@ def control_variate_rate(tallies, times, controls):
     corrections are made out of sample).  Returns (value, error, beta) with beta the slope
     fitted to all shards (p, or p x bins), for reporting.
     """
+    times = np.asarray(times, dtype=float)
+    adjusted, beta = control_variate_adjusted(tallies, times, controls)
+    value, error = jackknife(lambda a, t: a / t, adjusted, times[:, None])
+    shape = np.shape(tallies)[1:]
+    return value.reshape(shape), error.reshape(shape), beta
+
+
+def control_variate_adjusted(tallies, times, controls):
+    """Each shard's tallies less their cross-fitted share of the control variates: the terms
+    ``tallies_k - beta_{-k} . controls_k`` of ``control_variate_rate`` (shards, or shards x
+    bins), and the slope fitted to all shards (p, or p x bins).  Each adjusted tally has the
+    plain tally's expectation (controls_k has mean 0 and is independent of beta_{-k}), so any
+    function of their sums is estimated as of the plain ones, with its error by ``jackknife``
+    (e.g. Delta x from the adjusted int x dt and int x^2 dt)."""
     tallies = np.asarray(tallies, dtype=float)
     times = np.asarray(times, dtype=float)
     controls = np.asarray(controls, dtype=float)
@@ -293,7 +340,5 @@ def control_variate_rate(tallies, times, controls):
         others = everyone.copy()
         others[k] = False
         adjusted[k] = flat[k] - controls[k] @ slope(others)
-    value, error = jackknife(lambda a, t: a / t, adjusted, times[:, None])
     shape = tallies.shape[1:]
-    beta = slope(everyone)
-    return value.reshape(shape), error.reshape(shape), beta.reshape((p, *shape))
+    return adjusted.reshape(tallies.shape), slope(everyone).reshape((p, *shape))
