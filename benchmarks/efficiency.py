@@ -3,8 +3,8 @@
 For each r of ``RESTITUTIONS`` and each of two estimators,
   * ``paper``: the paper's c = 5 and plain tallies (time averages, counts over time);
   * ``default``: the default config's c and every variance reduction the project uses
-    (each moment's ``*_controlled`` column of ``histograms.position_moments_summary`` where
-    the summary has one),
+    (the ``*_controlled`` estimate of ``histograms`` where a table has one: the summary's
+    moments, P(0, v), P(x), <v^2>_x),
 ``SHARDS`` shards run in two processes and each observable's relative standard error is
 measured from their scatter (the jackknife of ``histograms``), times the CPU seconds of the
 shards: the CPU it takes to reach a relative error of 1 (lower is better).  For P(0, v),
@@ -56,14 +56,20 @@ def moment_relative_squared_errors(shards, r, controlled):
     return values
 
 
-def _median_relative_squared_error(value, error, keep):
-    keep = keep & np.isfinite(value) & np.isfinite(error) & (value > 0)
+def _median_relative_squared_error(table, name, keep, controlled):
+    """The median over the bins ``keep`` of (error / value)^2 of column ``name`` of ``table``,
+    or (``controlled``) of its ``_controlled`` column where the table has one."""
+    if controlled and f"{name}_controlled" in table:
+        name = f"{name}_controlled"
+    value, error = table[name].to_numpy(), table[f"{name}_err"].to_numpy()
+    keep = keep.to_numpy() & np.isfinite(value) & np.isfinite(error) & (value > 0)
     return float(np.median((error[keep] / value[keep]) ** 2))
 
 
-def distribution_relative_squared_errors(shards):
+def distribution_relative_squared_errors(shards, controlled):
     """{observable: median over the bins inside SPEEDS and POSITIONS of (relative standard
-    error)^2} of P(0, v), P(x), <v^2>_x and P(x, v) (v within +-SPEEDS[1] for P(x, v))."""
+    error)^2} of P(0, v), P(x), <v^2>_x and P(x, v) (v within +-SPEEDS[1] for P(x, v)):
+    plain, or (``controlled``) the tables' ``*_controlled`` estimates where they have one."""
     from bouncing_ball.histograms import (
         distribution_histogram,
         outgoing_speed_histogram,
@@ -82,20 +88,12 @@ def distribution_relative_squared_errors(shards):
         & (cells.v_hi <= SPEEDS[1])
     )
     return {
-        "P(0,v)": _median_relative_squared_error(
-            speeds.p0v.to_numpy(), speeds.p0v_err.to_numpy(), in_speeds.to_numpy()
-        ),
-        "P(x)": _median_relative_squared_error(
-            positions.px.to_numpy(), positions.px_err.to_numpy(), in_positions.to_numpy()
-        ),
+        "P(0,v)": _median_relative_squared_error(speeds, "p0v", in_speeds, controlled),
+        "P(x)": _median_relative_squared_error(positions, "px", in_positions, controlled),
         "<v^2>_x": _median_relative_squared_error(
-            positions.v2_given_x.to_numpy(),
-            positions.v2_given_x_err.to_numpy(),
-            in_positions.to_numpy(),
+            positions, "v2_given_x", in_positions, controlled
         ),
-        "P(x,v)": _median_relative_squared_error(
-            cells.pxv.to_numpy(), cells.pxv_err.to_numpy(), in_cells.to_numpy()
-        ),
+        "P(x,v)": _median_relative_squared_error(cells, "pxv", in_cells, controlled),
     }
 
 
@@ -103,7 +101,7 @@ def relative_squared_errors(shards, r, controlled):
     """{observable: (relative standard error)^2} of every observable of ``OBSERVABLES``."""
     return {
         **moment_relative_squared_errors(shards, r, controlled),
-        **distribution_relative_squared_errors(shards),
+        **distribution_relative_squared_errors(shards, controlled),
     }
 
 

@@ -67,8 +67,10 @@ MOMENT_CONTROL_SUMS = (
     "position_noise_v_sum",
     "position_noise_x_sum",
 )
-# every control variate of the moments
+# the control variates of the summary's moments (I, <x>, Delta x, the flights' moments),
+# and the fewer of I with few shards and of the bins of P(0, v), P(x) and <v^2>_x
 MOMENT_CONTROLS = (*CONTROL_VARIATE_SUMS, *MOMENT_CONTROL_SUMS)
+RATE_CONTROLS = (*CONTROL_VARIATE_SUMS, "noise_squared_sum")
 # the same sums over the early part of the recording, the steps that start before
 # EARLY_FRACTION x shard_time: the shard's own evidence of equilibration (``equilibration``)
 EARLY_FRACTION = 0.125
