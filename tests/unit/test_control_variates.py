@@ -96,9 +96,7 @@ def test_adjusted_tallies_give_the_rate_and_any_function_of_their_sums():
 
 def _fake_shards(n):
     rng = np.random.default_rng(n)
-    return [
-        SimpleNamespace(**{name: rng.normal() for name in MOMENT_CONTROLS}) for _ in range(n)
-    ]
+    return [SimpleNamespace(**{name: rng.normal() for name in MOMENT_CONTROLS}) for _ in range(n)]
 
 
 def test_the_moments_use_every_control_the_shards_can_fit():
