@@ -76,9 +76,13 @@ depends on the state):
     (normal_sum), x, v and dt those of the step's start.  dt is fixed before
     the normals are drawn, so each term has mean 0 given the past, and each sum
     has expectation exactly 0 under the simulated process (whole xi also in a
-    step cut short by a collision).  ``histograms.control_variate_rate``
-    subtracts their fitted share from the collision count: the same
-    expectation, 3.5-7 times less variance of I (docs/performance.md).
+    step cut short by a collision).  Fourteen more (``tallies.MOMENT_CONTROL_SUMS``)
+    weigh xi by x, x v, x^2, v^2, v^3, v^4 and x v^2, xi^2 - 2 dt by 1, v, x and
+    v^2, and the position noise dt^(3/2) normal_s of eq. (xstep) by 1, v and x,
+    the same way.  ``histograms.control_variate_adjusted`` subtracts their
+    fitted share from the tallies: the same expectation, less variance of I,
+    the moments of x and of the flights, and the bins of P(0, v), P(x) and
+    <v^2>_x (docs/methods.md).
   * the time, collisions, int x dt and int x^2 dt of the steps that start in the
     early part of the recording (t < EARLY_FRACTION x shard_time, tallies): the
     shard's own evidence of equilibration, that part against the rest compared by
