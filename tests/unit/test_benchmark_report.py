@@ -209,8 +209,15 @@ def test_the_report_has_a_table_per_measurement_with_its_values():
     assert solver[1][-1] == "1.0e-10" and solver[2][-1] == ""  # no exact solution at 3/4
     assert "Target: <= 50 ms per r at <= 1e-08: MISSED (worst 60.0 ms" in page
     efficiency = next(table for table in tables if table[0][0] == "observable")
-    assert efficiency[0] == ["observable", "r", "paper", "default", "gain"]
-    assert efficiency[1] == ["<x>", "0.5", "8.00e-05 +- 2e-05", "2.00e-06 +- 5e-07", "40.0 +- 14.1"]
+    assert efficiency[0] == ["observable", "r", "paper", "default", "gain", "target"]
+    assert efficiency[1] == [
+        "<x>",
+        "0.5",
+        "8.00e-05 +- 2e-05",
+        "2.00e-06 +- 5e-07",
+        "40.0 +- 14.1",
+        ">= 4: met",
+    ]
     workflow = next(table for table in tables if table[0][1:] == ["seconds", "target"])
     assert workflow[1] == ["dry run of 20 r x 16 shards (320 shard jobs)", "4.0", "< 5 s: met"]
     assert workflow[2][2] == "not measured: its results are not complete"
