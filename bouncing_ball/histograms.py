@@ -3,8 +3,10 @@
 Every estimate is a function of the shards' summed tallies; its standard
 error comes from the scatter between shards by the delete-one jackknife
 (for a ratio of sums over shards of equal time it is the standard error of
-the mean of the per-shard estimates).  ``control_variate_rate`` lowers the
-variance of a rate with the shards' martingale control variates.
+the mean of the per-shard estimates).  ``control_variate_adjusted`` lowers the
+variance of any such estimate with the shards' martingale control variates
+(``control_variate_rate``: of a rate); the tables keep both estimates, plain and
+``*_controlled``.
 """
 
 import numpy as np
