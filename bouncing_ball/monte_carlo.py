@@ -238,7 +238,7 @@ class SimulationResult:
     collision_rate_controlled, mean_x_controlled, delta_x_controlled : float
         I, <x>, Delta x corrected by the martingale control variates (the same expectation,
         less variance), each with its ``*_err``; and ``mean_flight_time_controlled``,
-        ``flight_time_second_moment_controlled``.  NaN with fewer than 8 shards.
+        ``flight_time_second_moment_controlled``.  NaN with fewer than 15 shards.
     p0v : pandas.DataFrame
         P(0, v) on the speed bins (v_lo, v_hi, v, p0v, p0v_err, count).
     px, v2_given_x : pandas.DataFrame

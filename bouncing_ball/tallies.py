@@ -71,6 +71,9 @@ MOMENT_CONTROL_SUMS = (
 # and the fewer of I with few shards and of the bins of P(0, v), P(x) and <v^2>_x
 MOMENT_CONTROLS = (*CONTROL_VARIATE_SUMS, *MOMENT_CONTROL_SUMS)
 RATE_CONTROLS = (*CONTROL_VARIATE_SUMS, "noise_squared_sum")
+# the shards per control variate that a correction needs: with fewer, the cross-fitted
+# slopes' noise makes the jackknife error too small (histograms.shard_controls)
+SHARDS_PER_CONTROL = 3
 # the same sums over the early part of the recording, the steps that start before
 # EARLY_FRACTION x shard_time: the shard's own evidence of equilibration (``equilibration``)
 EARLY_FRACTION = 0.125

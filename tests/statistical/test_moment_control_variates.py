@@ -4,7 +4,7 @@ and the corrected <x>, Delta x, I and <T> agree with the exact values of eq. (xa
 (<T> = 1 / I), <T^2> with the solver's, each with a smaller error than the plain estimate.
 
 64 shards, as in the default run: the corrected moments use all of MOMENT_CONTROLS (they
-need 21 shards or more), whose slopes are fitted with the scatter of the default run.  Seed fixed, so the outcome is deterministic.
+need SHARDS_PER_CONTROL x 18 = 54 shards or more), fitted as in the default run.  Seed fixed, so the outcome is deterministic.
 """
 
 from fractions import Fraction
@@ -16,7 +16,7 @@ from shard_statistics import simulate_shards
 
 from bouncing_ball import flight_time, solver
 from bouncing_ball.histograms import position_moments_summary
-from bouncing_ball.tallies import MOMENT_CONTROL_SUMS, MOMENT_CONTROLS
+from bouncing_ball.tallies import MOMENT_CONTROL_SUMS, MOMENT_CONTROLS, SHARDS_PER_CONTROL
 
 R = Fraction(1, 2)
 SHARDS = 64
@@ -43,7 +43,7 @@ def _expected(quantity):
 
 @pytest.fixture(scope="module")
 def shards():
-    assert len(MOMENT_CONTROLS) + 3 <= SHARDS  # all of them, not the fewer RATE_CONTROLS
+    assert SHARDS_PER_CONTROL * len(MOMENT_CONTROLS) <= SHARDS  # all, not RATE_CONTROLS
     return simulate_shards({R: SHARD_TIME}, SHARDS, SEED)[R]
 
 

@@ -13,7 +13,7 @@ from bouncing_ball.histograms import (
     jackknife,
     moment_controls,
 )
-from bouncing_ball.tallies import MOMENT_CONTROLS, RATE_CONTROLS
+from bouncing_ball.tallies import MOMENT_CONTROLS, RATE_CONTROLS, SHARDS_PER_CONTROL
 
 
 def test_a_control_that_explains_everything_leaves_no_error():
@@ -100,14 +100,39 @@ def _fake_shards(n):
 
 
 def test_the_moments_use_every_control_the_shards_can_fit():
-    """All of MOMENT_CONTROLS from len + 3 shards, else RATE_CONTROLS from its len + 3, else
-    none."""
-    enough = len(MOMENT_CONTROLS) + 3
+    """All of MOMENT_CONTROLS from SHARDS_PER_CONTROL shards per control, else RATE_CONTROLS
+    from as many per control, else none."""
+    enough = SHARDS_PER_CONTROL * len(MOMENT_CONTROLS)
     assert moment_controls(_fake_shards(enough)).shape == (enough, len(MOMENT_CONTROLS))
     fewer = moment_controls(_fake_shards(enough - 1))
     assert fewer.shape == (enough - 1, len(RATE_CONTROLS))
-    shards = _fake_shards(len(RATE_CONTROLS) + 3)
+    shards = _fake_shards(SHARDS_PER_CONTROL * len(RATE_CONTROLS))
     assert np.array_equal(
         moment_controls(shards), [[getattr(s, name) for name in RATE_CONTROLS] for s in shards]
     )
-    assert moment_controls(_fake_shards(len(RATE_CONTROLS) + 2)) is None
+    assert moment_controls(_fake_shards(SHARDS_PER_CONTROL * len(RATE_CONTROLS) - 1)) is None
+
+
+def _z_scores(shards, controls, repeats, rng):
+    """z of the corrected rate against the truth over ``repeats`` synthetic runs whose
+    tallies are the rate 1 plus the controls' share (heavy-tailed, Student-t) and noise."""
+    z = []
+    for _ in range(repeats):
+        times = np.ones(shards)
+        sums = rng.standard_t(5, size=(shards, controls))
+        tallies = times + sums @ (0.3 * rng.normal(size=controls)) + 0.2 * rng.normal(size=shards)
+        value, error, _ = control_variate_rate(tallies, times, sums)
+        z.append((value - 1.0) / error)
+    return np.array(z)
+
+
+def test_the_error_is_honest_with_SHARDS_PER_CONTROL_shards_per_control():
+    """With three shards per control the jackknife error holds the slopes' noise: z has a
+    spread near 1; with the least the fit allows (p + 3) it is far too
+    small, which is why shard_controls asks for SHARDS_PER_CONTROL per control."""
+    rng = np.random.default_rng(6)
+    controls = len(RATE_CONTROLS)
+    honest = _z_scores(SHARDS_PER_CONTROL * controls, controls, 400, rng)
+    assert 0.9 < honest.std() < 1.2
+    fewest = _z_scores(controls + 3, controls, 400, rng)
+    assert fewest.std() > 1.5
