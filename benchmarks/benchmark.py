@@ -447,7 +447,8 @@ def main(argv=None):
 
 
 def _full_benchmark(results, scaling):
-    # the solver first: timed in a process that has run nothing else
+    """Every measurement into ``results`` (with ``scaling``, the simulation stage on 1 and 2
+    cores too); the solver first, timed in a process that has run nothing else."""
     results["solver"] = solver_benchmark()
     results.update(
         {
