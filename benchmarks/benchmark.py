@@ -1,12 +1,12 @@
 """Benchmarks on the machine it runs on (from the repository root):
 
-    python -m benchmarks [--json] [--markdown FILE] [--scaling]
+    python -m benchmarks [--json] [--markdown FILE] [--scaling] [--efficiency-only]
 
 prints the tables as Markdown (``report``), or writes them to FILE with the machine and
 the time of the run (e.g. ``--markdown results/benchmarks/benchmark.md``); ``--json``
 prints the results themselves.
 
-Measured here (about 1 minute; ``--scaling`` adds about 2.5 more, outside that budget):
+Measured here (about 3 minutes; ``--scaling`` adds about 2.5 more, outside that budget):
   * simulation throughput on one core at r = 0.25, 0.5, 0.75 with the default
     config's c and delta rule (c = 3, 1/500) and with the paper's c = 5:
     collisions and simulated time per CPU second, steps per collision, ns per
@@ -19,9 +19,11 @@ Measured here (about 1 minute; ``--scaling`` adds about 2.5 more, outside that b
     own ziggurat on the same PCG64 stream, so the tallies must be identical):
     numba's speed over C's at r = 1/2, with the tallies and stepping only
     (target: at least 90%);
-  * statistical efficiency at r = 1/2: (relative standard error of I)^2 x CPU
-    seconds, from 32 short shards (lower is better), for the default c and
-    the paper's c = 5;
+  * statistical efficiency per observable (``efficiency``; about 2 minutes, alone with
+    ``--efficiency-only``): (relative standard error)^2 x CPU seconds at r = 1/4, 1/2, 3/4 of
+    I, <x>, Delta x, <T>, <T^2> and the median bin of P(0, v), P(x), <v^2>_x, P(x, v), for
+    the paper's estimator (c = 5, plain tallies) and the project's default (the default c,
+    every control variate), their gain and the uncertainty of each;
   * numba's compile: the first shard in a fresh cache against a later shard
     (a new process that loads the cache), and the peak memory of a shard;
   * the solver of eq. (inteq): time per r (median of repeats after a warm-up
@@ -50,6 +52,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from .breakdown import breakdown
+from .efficiency import efficiency_benchmark
 from .report import REFERENCE_TARGET, SOLVER_TARGET_MS, machine_info, markdown_report
 
 SINGLE_THREAD = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
@@ -162,47 +165,6 @@ def reference_benchmark(r=0.5, recorded_time=2.0e6, repeats=3):
         "rows": rows,
         "worst_speed_ratio": ratio,
         "target_met": ratio >= REFERENCE_TARGET,
-    }
-
-
-def _efficiency_shard(arguments):
-    r, recorded_time, shard, changes = arguments
-    started = time.process_time()
-    tallies = _shard(r, recorded_time, shard=shard, seed=7, **changes)
-    return (
-        tallies.collisions / tallies.time,
-        time.process_time() - started,
-        tallies.steps,
-        tallies.collisions,
-    )
-
-
-def efficiency_benchmark(settings=None, shards=32, recorded_time=1.0e5, r=0.5):
-    """(relative standard error of I)^2 x CPU seconds at r = 1/2 from ``shards`` shards in two processes."""
-    from concurrent.futures import ProcessPoolExecutor
-
-    import numpy as np
-
-    settings = settings or {}
-    with ProcessPoolExecutor(2) as pool:
-        results = list(
-            pool.map(_efficiency_shard, [(r, recorded_time, k, settings) for k in range(shards)])
-        )
-    rates = np.array([rate for rate, *_ in results])
-    cpu = sum(seconds for _, seconds, *_ in results)
-    relative_error = rates.std(ddof=1) / np.sqrt(shards) / rates.mean()
-    return {
-        "r": r,
-        "criterion_c": SHARD_SETTINGS.criterion_c,
-        "min_step_divisor": SHARD_SETTINGS.min_step_divisor,
-        **settings,
-        "shards": shards,
-        "shard_time": recorded_time,
-        "collision_rate": float(rates.mean()),
-        "relative_error": float(relative_error),
-        "cpu_seconds": cpu,
-        "variance_times_cpu": float(relative_error**2 * cpu),
-        "steps_per_collision": sum(s for *_, s, _ in results) / sum(c for *_, c in results),
     }
 
 
@@ -457,28 +419,21 @@ def main(argv=None):
     parser.add_argument(
         "--scaling", action="store_true", help="also time the simulation stage with 1 and 2 cores"
     )
+    parser.add_argument(
+        "--efficiency-only",
+        action="store_true",
+        help="measure only the statistical efficiency per observable (``efficiency``)",
+    )
     args = parser.parse_args(argv)
     started = time.perf_counter()
     results = {
         "started_utc": datetime.now(UTC).strftime("%Y-%m-%d %H:%M:%S"),
         "machine": machine_info(),
-        # first: timed in a process that has run nothing else
-        "solver": solver_benchmark(),
     }
-    results.update(
-        {
-            "simulation": simulation_benchmark(),
-            "breakdown": breakdown(SHARD_SETTINGS),
-            "reference": reference_benchmark(),
-            "efficiency": efficiency_benchmark(),
-            "efficiency_paper_c": efficiency_benchmark({"criterion_c": PAPER_CRITERION_C}),
-            "compile": compile_benchmark(),
-            "distribution": distribution_benchmark(),
-            "workflow": workflow_benchmark(),
-        }
-    )
-    if args.scaling:
-        results["scaling"] = scaling_benchmark()
+    if args.efficiency_only:
+        results["efficiency"] = efficiency_benchmark()
+    else:
+        _full_benchmark(results, args.scaling)
     results["seconds"] = time.perf_counter() - started
     if args.json:
         print(json.dumps(results, indent=2))
@@ -489,6 +444,25 @@ def main(argv=None):
     elif not args.json:
         print(report)
     return 0
+
+
+def _full_benchmark(results, scaling):
+    """Every measurement into ``results`` (with ``scaling``, the simulation stage on 1 and 2
+    cores too); the solver first, timed in a process that has run nothing else."""
+    results["solver"] = solver_benchmark()
+    results.update(
+        {
+            "simulation": simulation_benchmark(),
+            "breakdown": breakdown(SHARD_SETTINGS),
+            "reference": reference_benchmark(),
+            "efficiency": efficiency_benchmark(),
+            "compile": compile_benchmark(),
+            "distribution": distribution_benchmark(),
+            "workflow": workflow_benchmark(),
+        }
+    )
+    if scaling:
+        results["scaling"] = scaling_benchmark()
 
 
 def write_markdown(report: str, path) -> None:

@@ -54,16 +54,31 @@ MOMENT_COLUMNS = (
     "solver",
     "simulation",
     "simulation_err",
+    "estimator",
     "reference",
     "z",
 )
 
 
+def smaller_error_estimate(summary, quantity):
+    """(value, error, estimator) of ``quantity`` in a simulation summary: the plain estimate
+    or the one corrected by control variates (``{quantity}_controlled``, the same
+    expectation), whichever has the smaller error; estimator is "plain" or "controlled"."""
+    value, error = float(summary[quantity]), float(summary[f"{quantity}_err"])
+    controlled = f"{quantity}_controlled"
+    if controlled in summary:
+        other, other_error = float(summary[controlled]), float(summary[f"{controlled}_err"])
+        if np.isfinite(other) and other_error > 0 and not other_error >= error:
+            return other, other_error, "controlled"
+    return value, error, "plain"
+
+
 def moment_rows(label, restitution, simulation, solver, exact=None):
     """The time averages <x>, Delta x and I of eq. (xandDeltax) of one r, with their z.
 
-    z = (simulation - reference) / simulation_err, the reference being the exact value where
-    there is one and the solver's otherwise.
+    The simulation's value is that of ``smaller_error_estimate``, plain or controlled
+    (``estimator`` says which). z = (simulation - reference) / simulation_err, the reference
+    being the exact value where there is one and the solver's otherwise.
 
     Parameters
     ----------
@@ -99,8 +114,7 @@ def moment_rows(label, restitution, simulation, solver, exact=None):
     for quantity in QUANTITIES:
         reference_name = "exact" if exact is not None else "solver"
         reference = float((exact if exact is not None else solver)[quantity])
-        value = float(simulation[quantity])
-        error = float(simulation[f"{quantity}_err"])
+        value, error, estimator = smaller_error_estimate(simulation, quantity)
         z = (value - reference) / error if np.isfinite(reference) and error > 0 else np.nan
         rows.append(
             {
@@ -112,6 +126,7 @@ def moment_rows(label, restitution, simulation, solver, exact=None):
                 "solver": float(solver[quantity]),
                 "simulation": value,
                 "simulation_err": error,
+                "estimator": estimator,
                 "reference": reference_name,
                 "z": z,
             }
@@ -192,6 +207,7 @@ def moments_markdown(table: pd.DataFrame) -> str:
                 value_with_error(value, error)
                 for value, error in zip(table.simulation, table.simulation_err)
             ],
+            "estimator": table.estimator,
             "z": [
                 f"{z:+.2f} (vs {reference})" if np.isfinite(z) else ""
                 for z, reference in zip(table.z, table.reference)

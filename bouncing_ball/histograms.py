@@ -3,14 +3,22 @@
 Every estimate is a function of the shards' summed tallies; its standard
 error comes from the scatter between shards by the delete-one jackknife
 (for a ratio of sums over shards of equal time it is the standard error of
-the mean of the per-shard estimates).  ``control_variate_rate`` lowers the
-variance of a rate with the shards' martingale control variates.
+the mean of the per-shard estimates).  ``control_variate_adjusted`` lowers the
+variance of any such estimate with the shards' martingale control variates
+(``control_variate_rate``: of a rate); the tables keep both estimates, plain and
+``*_controlled``.
 """
 
 import numpy as np
 import pandas as pd
 
-from .tallies import CONTROL_VARIATE_SUMS, ShardTallies, merge_shards
+from .tallies import (
+    MOMENT_CONTROLS,
+    RATE_CONTROLS,
+    SHARDS_PER_CONTROL,
+    ShardTallies,
+    merge_shards,
+)
 
 
 def jackknife(estimator, *per_shard):
@@ -33,6 +41,42 @@ def jackknife(estimator, *per_shard):
     return value, np.sqrt((n - 1) / n * (spread**2).sum(axis=0))
 
 
+def shard_controls(shards, names):
+    """The control sums ``names`` of each shard (shards x p), or None with fewer than
+    SHARDS_PER_CONTROL x p shards: with p controls fitted to n shards the jackknife error of
+    the corrected estimate is too small by a factor that grows with p / n (about 1.05 at
+    p / n = 1/3, 1.3 at 3/4, on shards with Student-t controls)."""
+    if len(shards) < SHARDS_PER_CONTROL * len(names):
+        return None
+    return np.array([[getattr(s, name) for name in names] for s in shards], dtype=float)
+
+
+def moment_controls(shards):
+    """The control sums of the summary's moments: those of MOMENT_CONTROLS where the shards
+    are enough to fit their slopes, else the fewer of RATE_CONTROLS, else None."""
+    controls = shard_controls(shards, MOMENT_CONTROLS)
+    return controls if controls is not None else shard_controls(shards, RATE_CONTROLS)
+
+
+def _controlled(estimator, controls, times, adjusted, fixed=()):
+    """Value and jackknife error of ``estimator`` of the sums over shards of ``adjusted``, each
+    first adjusted by the control variates (``control_variate_adjusted``; ``times`` are the
+    shards' times), and of ``fixed`` as they are; NaN where ``controls`` is None."""
+    if controls is None:
+        sums = [np.asarray(a, dtype=float).sum(axis=0) for a in (*adjusted, *fixed)]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            shape = np.shape(estimator(*sums))
+        return np.full(shape, np.nan), np.full(shape, np.nan)
+    arrays = [np.asarray(a, dtype=float) for a in adjusted]
+    n = len(times)
+    # one fit for all: the columns of every array side by side, split again after
+    stacked = np.concatenate([a.reshape(n, -1) for a in arrays], axis=1)
+    corrected = control_variate_adjusted(stacked, times, controls)[0]
+    ends = np.cumsum([a[0].size for a in arrays])[:-1]
+    parts = [c.reshape(a.shape) for c, a in zip(np.split(corrected, ends, axis=1), arrays)]
+    return jackknife(estimator, *parts, *fixed)
+
+
 def outgoing_speed_density(counts, time, lower, upper):
     """eq. (collrate): the rate of collisions in a bin is int v P(0,v) dv."""
     return counts / (time * 0.5 * (upper**2 - lower**2))
@@ -42,18 +86,28 @@ def outgoing_speed_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
     """P(0, v) on the outgoing side, bin averages weighted by v.
 
     Columns v_lo, v_hi, v (the geometric centre; the arithmetic one for the
-    underflow bin), p0v, p0v_err, count.  Bin averages mean
-    p0v = int_bin v P(0,v) dv / int_bin v dv.  The overflow bin has p0v = NaN;
-    an empty bin has p0v = 0 and p0v_err = NaN (no scatter to measure).
+    underflow bin), p0v, p0v_err, count, p0v_controlled, p0v_controlled_err.  Bin averages
+    mean p0v = int_bin v P(0,v) dv / int_bin v dv.  The overflow bin has p0v = NaN;
+    an empty bin has p0v = 0 and p0v_err = NaN (no scatter to measure).  p0v_controlled is
+    the same with each bin's counts corrected by the control variates of RATE_CONTROLS
+    (``control_variate_adjusted``: the same expectation, less variance; NaN with fewer than
+    SHARDS_PER_CONTROL x ``len(RATE_CONTROLS)`` shards).
     """
     bins = shards[0].speed_bins
     lower, upper = bins.lower, bins.upper
     counts = np.stack([s.speed_counts for s in shards])
     times = np.array([s.time for s in shards])[:, None]
-    p0v, err = jackknife(lambda c, t: outgoing_speed_density(c, t, lower, upper), counts, times)
+
+    def density(c, t):
+        return outgoing_speed_density(c, t, lower, upper)
+
+    p0v, err = jackknife(density, counts, times)
+    controls = shard_controls(shards, RATE_CONTROLS)
+    controlled, controlled_err = _controlled(density, controls, times[:, 0], [counts], [times])
     total = counts.sum(axis=0)
-    p0v[~np.isfinite(upper)] = np.nan
-    err[~np.isfinite(upper) | (total == 0)] = np.nan
+    for value, error in ((p0v, err), (controlled, controlled_err)):
+        value[~np.isfinite(upper)] = np.nan
+        error[~np.isfinite(upper) | (total == 0)] = np.nan
     return pd.DataFrame(
         {
             "v_lo": lower,
@@ -62,6 +116,8 @@ def outgoing_speed_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
             "p0v": p0v,
             "p0v_err": err,
             "count": total.astype(np.int64),
+            "p0v_controlled": controlled,
+            "p0v_controlled_err": controlled_err,
         }
     )
 
@@ -75,17 +131,32 @@ def position_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
     bridge point a step), so a bin's
     total can come out slightly negative where the particle hardly goes; the underflow
     bin (x below the first edge) also holds the bridge points below x = 0.
+    ``px_controlled`` and ``v2_given_x_controlled`` (with their ``_err``) are the same with
+    each bin's time and int v^2 dt corrected by the control variates of RATE_CONTROLS
+    (``control_variate_adjusted``: the same expectation, less variance; NaN with fewer than
+    SHARDS_PER_CONTROL x ``len(RATE_CONTROLS)`` shards).
     """
     bins = shards[0].position_bins
     lower, upper = bins.lower, bins.upper
     in_bin = np.stack([s.position_time for s in shards])
     v2 = np.stack([s.position_v2_time for s in shards])
     times = np.array([s.time for s in shards])[:, None]
-    px, px_err = jackknife(lambda b, t: b / (t * (upper - lower)), in_bin, times)
-    v2x, v2x_err = jackknife(lambda w, b: w / b, v2, in_bin)
+
+    def density(b, t):
+        return b / (t * (upper - lower))
+
+    def given_x(w, b):
+        return w / b
+
+    px, px_err = jackknife(density, in_bin, times)
+    v2x, v2x_err = jackknife(given_x, v2, in_bin)
+    controls = shard_controls(shards, RATE_CONTROLS)
+    px_c, px_c_err = _controlled(density, controls, times[:, 0], [in_bin], [times])
+    v2x_c, v2x_c_err = _controlled(given_x, controls, times[:, 0], [v2, in_bin])
     empty = in_bin.sum(axis=0) == 0
-    px[~np.isfinite(upper)] = np.nan
-    px_err[~np.isfinite(upper) | empty] = np.nan
+    for value, error in ((px, px_err), (px_c, px_c_err)):
+        value[~np.isfinite(upper)] = np.nan
+        error[~np.isfinite(upper) | empty] = np.nan
     return pd.DataFrame(
         {
             "x_lo": lower,
@@ -95,6 +166,10 @@ def position_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
             "px_err": px_err,
             "v2_given_x": v2x,
             "v2_given_x_err": v2x_err,
+            "px_controlled": px_c,
+            "px_controlled_err": px_c_err,
+            "v2_given_x_controlled": v2x_c,
+            "v2_given_x_controlled_err": v2x_c_err,
         }
     )
 
@@ -191,11 +266,19 @@ def _delta_x(int_x, int_x2, time):
     return np.sqrt(int_x2 / time - (int_x / time) ** 2)
 
 
+# the moments the summary also gives corrected by MOMENT_CONTROLS (``{name}_controlled``)
+CONTROLLED_MOMENTS = ("mean_x", "delta_x", "mean_flight_time", "flight_time_second_moment")
+
+
 def position_moments_summary(shards: list[ShardTallies], restitution: float) -> pd.DataFrame:
     """One row: <x>, Delta x and the collision rate I, eqs. (collrate), (xandDeltax), and the
-    mean and second moment of the flight time per flight.  I is given twice: the collisions
-    per time, and the same corrected by the control variates (``control_variate_rate``, the
-    same expectation, 3.6-6.7 times less variance; NaN with fewer than 7 shards)."""
+    mean and second moment of the flight time per flight.  Each is given twice: plain (the
+    time averages, collisions per time, the flights' averages) and ``*_controlled``, the same
+    with each sum (the collisions, int x dt, int x^2 dt, the flights, sum T, sum T^2)
+    corrected by martingale control variates of mean 0 before the ratio
+    (``control_variate_adjusted``: the same expectation, less variance), those of
+    ``moment_controls``: MOMENT_CONTROLS or the fewer RATE_CONTROLS, as many as the shards
+    can fit (``shard_controls``), none (NaN) with too few shards."""
     time = np.array([s.time for s in shards])
     int_x = np.array([s.int_x for s in shards])
     int_x2 = np.array([s.int_x2 for s in shards])
@@ -203,16 +286,32 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
     mean_x, mean_x_err = jackknife(_mean_x, int_x, time)
     delta_x, delta_x_err = jackknife(_delta_x, int_x, int_x2, time)
     rate, rate_err = jackknife(lambda c, t: c / t, collisions, time)
-    controls = np.array([[getattr(s, name) for name in CONTROL_VARIATE_SUMS] for s in shards])
-    if len(shards) >= len(CONTROL_VARIATE_SUMS) + 3:  # enough shards to fit the slopes
-        controlled, controlled_err, _ = control_variate_rate(collisions, time, controls)
-    else:
-        controlled = controlled_err = np.nan
+    controls = moment_controls(shards)
+    controlled, controlled_err = _controlled(
+        lambda c, t: c / t, controls, time, [collisions], [time]
+    )
     flights = np.array([s.flights for s in shards], dtype=float)
     flight_time = np.array([s.flight_time_sum for s in shards])
     flight_time_squared = np.array([s.flight_time_squared_sum for s in shards])
     mean_t, mean_t_err = jackknife(lambda f, n: f / n, flight_time, flights)
     second_t, second_t_err = jackknife(lambda f, n: f / n, flight_time_squared, flights)
+    adjusted = (int_x, int_x2, flights, flight_time, flight_time_squared)
+    # each estimator takes the adjusted sums of int x dt, int x^2 dt, the flights, sum T and
+    # sum T^2, and the times
+    controlled_moments = {
+        name: _controlled(estimator, controls, time, adjusted, [time])
+        for name, estimator in (
+            ("mean_x", lambda ix, ix2, n, f, f2, t: _mean_x(ix, t)),
+            ("delta_x", lambda ix, ix2, n, f, f2, t: _delta_x(ix, ix2, t)),
+            ("mean_flight_time", lambda ix, ix2, n, f, f2, t: f / n),
+            ("flight_time_second_moment", lambda ix, ix2, n, f, f2, t: f2 / n),
+        )
+    }
+    controlled_columns = {
+        column: [float(value)]
+        for name, pair in controlled_moments.items()
+        for column, value in zip((f"{name}_controlled", f"{name}_controlled_err"), pair)
+    }
     total = merge_shards(shards)
     return pd.DataFrame(
         {
@@ -229,6 +328,7 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
             "mean_flight_time_err": [float(mean_t_err)],
             "flight_time_second_moment": [float(second_t)],
             "flight_time_second_moment_err": [float(second_t_err)],
+            **controlled_columns,
             "flights": [int(total.flights)],
             "total_time": [float(total.time)],
             "collisions": [int(total.collisions)],
@@ -266,6 +366,20 @@ def control_variate_rate(tallies, times, controls):
     corrections are made out of sample).  Returns (value, error, beta) with beta the slope
     fitted to all shards (p, or p x bins), for reporting.
     """
+    times = np.asarray(times, dtype=float)
+    adjusted, beta = control_variate_adjusted(tallies, times, controls)
+    value, error = jackknife(lambda a, t: a / t, adjusted, times[:, None])
+    shape = np.shape(tallies)[1:]
+    return value.reshape(shape), error.reshape(shape), beta
+
+
+def control_variate_adjusted(tallies, times, controls):
+    """Each shard's tallies less their cross-fitted share of the control variates: the terms
+    ``tallies_k - beta_{-k} . controls_k`` of ``control_variate_rate`` (shards, or shards x
+    bins), and the slope fitted to all shards (p, or p x bins).  Each adjusted tally has the
+    plain tally's expectation (controls_k has mean 0 and is independent of beta_{-k}), so any
+    function of their sums is estimated as of the plain ones, with its error by ``jackknife``
+    (e.g. Delta x from the adjusted int x dt and int x^2 dt)."""
     tallies = np.asarray(tallies, dtype=float)
     times = np.asarray(times, dtype=float)
     controls = np.asarray(controls, dtype=float)
@@ -289,7 +403,5 @@ def control_variate_rate(tallies, times, controls):
         others = everyone.copy()
         others[k] = False
         adjusted[k] = flat[k] - controls[k] @ slope(others)
-    value, error = jackknife(lambda a, t: a / t, adjusted, times[:, None])
     shape = tallies.shape[1:]
-    beta = slope(everyone)
-    return value.reshape(shape), error.reshape(shape), beta.reshape((p, *shape))
+    return adjusted.reshape(tallies.shape), slope(everyone).reshape((p, *shape))

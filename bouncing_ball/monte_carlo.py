@@ -235,8 +235,10 @@ class SimulationResult:
     collision_rate, mean_x, delta_x, mean_flight_time, flight_time_second_moment : float
         I (eq. (collrate)), <x>, Delta x (eq. (xandDeltax)), and <T>, <T^2> per flight; each
         with its jackknife error ``*_err``.
-    collision_rate_controlled, collision_rate_controlled_err : float
-        I corrected by the martingale control variates (NaN with fewer than 7 shards).
+    collision_rate_controlled, mean_x_controlled, delta_x_controlled : float
+        I, <x>, Delta x corrected by the martingale control variates (the same expectation,
+        less variance), each with its ``*_err``; and ``mean_flight_time_controlled``,
+        ``flight_time_second_moment_controlled``.  NaN with fewer than 15 shards.
     p0v : pandas.DataFrame
         P(0, v) on the speed bins (v_lo, v_hi, v, p0v, p0v_err, count).
     px, v2_given_x : pandas.DataFrame
@@ -301,6 +303,20 @@ class SimulationResult:
     collision_rate_controlled = property(lambda self: self._scalar("collision_rate_controlled"))
     collision_rate_controlled_err = property(
         lambda self: self._scalar("collision_rate_controlled_err")
+    )
+    mean_x_controlled = property(lambda self: self._scalar("mean_x_controlled"))
+    mean_x_controlled_err = property(lambda self: self._scalar("mean_x_controlled_err"))
+    delta_x_controlled = property(lambda self: self._scalar("delta_x_controlled"))
+    delta_x_controlled_err = property(lambda self: self._scalar("delta_x_controlled_err"))
+    mean_flight_time_controlled = property(lambda self: self._scalar("mean_flight_time_controlled"))
+    mean_flight_time_controlled_err = property(
+        lambda self: self._scalar("mean_flight_time_controlled_err")
+    )
+    flight_time_second_moment_controlled = property(
+        lambda self: self._scalar("flight_time_second_moment_controlled")
+    )
+    flight_time_second_moment_controlled_err = property(
+        lambda self: self._scalar("flight_time_second_moment_controlled_err")
     )
     mean_x = property(lambda self: self._scalar("mean_x"))
     mean_x_err = property(lambda self: self._scalar("mean_x_err"))

@@ -76,9 +76,13 @@ depends on the state):
     (normal_sum), x, v and dt those of the step's start.  dt is fixed before
     the normals are drawn, so each term has mean 0 given the past, and each sum
     has expectation exactly 0 under the simulated process (whole xi also in a
-    step cut short by a collision).  ``histograms.control_variate_rate``
-    subtracts their fitted share from the collision count: the same
-    expectation, 3.5-7 times less variance of I (docs/performance.md).
+    step cut short by a collision).  Fourteen more (``tallies.MOMENT_CONTROL_SUMS``)
+    weigh xi by x, x v, x^2, v^2, v^3, v^4 and x v^2, xi^2 - 2 dt by 1, v, x and
+    v^2, and the position noise dt^(3/2) normal_s of eq. (xstep) by 1, v and x,
+    the same way.  ``histograms.control_variate_adjusted`` subtracts their
+    fitted share from the tallies: the same expectation, less variance of I,
+    the moments of x and of the flights, and the bins of P(0, v), P(x) and
+    <v^2>_x (docs/methods.md).
   * the time, collisions, int x dt and int x^2 dt of the steps that start in the
     early part of the recording (t < EARLY_FRACTION x shard_time, tallies): the
     shard's own evidence of equilibration, that part against the rest compared by
@@ -152,6 +156,20 @@ _EARLY_TIME = SCALAR_INDEX["early_time"]
 _EARLY_COLLISIONS = SCALAR_INDEX["early_collisions"]
 _EARLY_INT_X = SCALAR_INDEX["early_int_x"]
 _EARLY_INT_X2 = SCALAR_INDEX["early_int_x2"]
+_NOISE_X_SUM = SCALAR_INDEX["noise_x_sum"]
+_NOISE_XV_SUM = SCALAR_INDEX["noise_xv_sum"]
+_NOISE_X2_SUM = SCALAR_INDEX["noise_x2_sum"]
+_NOISE_V2_SUM = SCALAR_INDEX["noise_v2_sum"]
+_NOISE_V3_SUM = SCALAR_INDEX["noise_v3_sum"]
+_NOISE_V4_SUM = SCALAR_INDEX["noise_v4_sum"]
+_NOISE_XV2_SUM = SCALAR_INDEX["noise_xv2_sum"]
+_NOISE_SQUARED_SUM = SCALAR_INDEX["noise_squared_sum"]
+_NOISE_SQUARED_V_SUM = SCALAR_INDEX["noise_squared_v_sum"]
+_NOISE_SQUARED_X_SUM = SCALAR_INDEX["noise_squared_x_sum"]
+_NOISE_SQUARED_V2_SUM = SCALAR_INDEX["noise_squared_v2_sum"]
+_POSITION_NOISE_SUM = SCALAR_INDEX["position_noise_sum"]
+_POSITION_NOISE_V_SUM = SCALAR_INDEX["position_noise_v_sum"]
+_POSITION_NOISE_X_SUM = SCALAR_INDEX["position_noise_x_sum"]
 
 
 def shard_seed_sequence(seed: int, label: str, shard: int) -> np.random.SeedSequence:
@@ -534,6 +552,20 @@ def _run(
     noise_v_sum = 0.0
     noise_scaled_sum = 0.0
     normal_sum = 0.0
+    noise_x_sum = 0.0
+    noise_xv_sum = 0.0
+    noise_x2_sum = 0.0
+    noise_v2_sum = 0.0
+    noise_v3_sum = 0.0
+    noise_v4_sum = 0.0
+    noise_xv2_sum = 0.0
+    noise_squared_sum = 0.0
+    noise_squared_v_sum = 0.0
+    noise_squared_x_sum = 0.0
+    noise_squared_v2_sum = 0.0
+    position_noise_sum = 0.0
+    position_noise_v_sum = 0.0
+    position_noise_x_sum = 0.0
     # the early part of the recording: the running sums when a step first starts past t_early
     t_early = EARLY_FRACTION * recorded_time if recording else math.inf
     early_time = 0.0
@@ -591,6 +623,26 @@ def _run(
                 noise_v_sum += v * xi
                 noise_scaled_sum += v / (x + 0.5 * v * v + 4.0 * dt) * xi
                 normal_sum += normal_r
+                # the moments' control variates: weights polynomial in the start state times
+                # xi, q = xi^2 - 2 dt (mean 0 given the past) and eta = dt^(3/2) normal_s
+                x2 = x * x
+                v2 = v * v
+                noise_x_sum += x * xi
+                noise_xv_sum += x * v * xi
+                noise_x2_sum += x2 * xi
+                noise_v2_sum += v2 * xi
+                noise_v3_sum += v2 * v * xi
+                noise_v4_sum += v2 * v2 * xi
+                noise_xv2_sum += x * v2 * xi
+                q = xi * xi - 2.0 * dt
+                noise_squared_sum += q
+                noise_squared_v_sum += v * q
+                noise_squared_x_sum += x * q
+                noise_squared_v2_sum += v2 * q
+                eta = dt * math.sqrt(dt) * normal_s
+                position_noise_sum += eta
+                position_noise_v_sum += v * eta
+                position_noise_x_sum += x * eta
             if parts & MEAN_PATH_INTEGRALS:
                 ix, ix2 = mean_path_integrals(a0, a1, a2, a3, dt, tau)
                 int_x += ix
@@ -731,6 +783,20 @@ def _run(
     scalars[_EARLY_COLLISIONS] = early_collisions
     scalars[_EARLY_INT_X] = early_int_x
     scalars[_EARLY_INT_X2] = early_int_x2
+    scalars[_NOISE_X_SUM] = noise_x_sum
+    scalars[_NOISE_XV_SUM] = noise_xv_sum
+    scalars[_NOISE_X2_SUM] = noise_x2_sum
+    scalars[_NOISE_V2_SUM] = noise_v2_sum
+    scalars[_NOISE_V3_SUM] = noise_v3_sum
+    scalars[_NOISE_V4_SUM] = noise_v4_sum
+    scalars[_NOISE_XV2_SUM] = noise_xv2_sum
+    scalars[_NOISE_SQUARED_SUM] = noise_squared_sum
+    scalars[_NOISE_SQUARED_V_SUM] = noise_squared_v_sum
+    scalars[_NOISE_SQUARED_X_SUM] = noise_squared_x_sum
+    scalars[_NOISE_SQUARED_V2_SUM] = noise_squared_v2_sum
+    scalars[_POSITION_NOISE_SUM] = position_noise_sum
+    scalars[_POSITION_NOISE_V_SUM] = position_noise_v_sum
+    scalars[_POSITION_NOISE_X_SUM] = position_noise_x_sum
 
 
 def simulate_shard(

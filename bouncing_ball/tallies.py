@@ -13,7 +13,8 @@ A shard is stored as one long table, a row per tally entry:
     time, collisions, steps, int_x, int_x2, budget_exhausted,
     flights, flight_time_sum, flight_time_squared_sum,
     noise_sum, noise_v_sum, noise_scaled_sum, normal_sum,
-    early_time, early_collisions, early_int_x, early_int_x2
+    early_time, early_collisions, early_int_x, early_int_x2,
+    noise_x_sum, ..., position_noise_x_sum (MOMENT_CONTROL_SUMS)
                             NaN    NaN    NaN    NaN    the scalar
 
 A 2-D tally's rows run over its second variable fastest (row-major, the first
@@ -47,6 +48,32 @@ HISTOGRAMS_2D = {
 }
 # the martingale sums of mean 0 that correct I (``histograms.control_variate_rate``)
 CONTROL_VARIATE_SUMS = ("noise_sum", "noise_v_sum", "noise_scaled_sum", "normal_sum")
+# more such sums, with weights polynomial in the step's start state, that correct the moments
+# of x and the flights (``histograms.position_moments_summary``); xi_n = sqrt(2 dt_n) normal_r,
+# q_n = xi_n^2 - 2 dt_n and eta_n = dt_n^(3/2) normal_s, the noises of eqs. (xstep), (vstep)
+MOMENT_CONTROL_SUMS = (
+    "noise_x_sum",
+    "noise_xv_sum",
+    "noise_x2_sum",
+    "noise_v2_sum",
+    "noise_v3_sum",
+    "noise_v4_sum",
+    "noise_xv2_sum",
+    "noise_squared_sum",
+    "noise_squared_v_sum",
+    "noise_squared_x_sum",
+    "noise_squared_v2_sum",
+    "position_noise_sum",
+    "position_noise_v_sum",
+    "position_noise_x_sum",
+)
+# the control variates of the summary's moments (I, <x>, Delta x, the flights' moments),
+# and the fewer of I with few shards and of the bins of P(0, v), P(x) and <v^2>_x
+MOMENT_CONTROLS = (*CONTROL_VARIATE_SUMS, *MOMENT_CONTROL_SUMS)
+RATE_CONTROLS = (*CONTROL_VARIATE_SUMS, "noise_squared_sum")
+# the shards per control variate that a correction needs: with fewer, the cross-fitted
+# slopes' noise makes the jackknife error too small (histograms.shard_controls)
+SHARDS_PER_CONTROL = 3
 # the same sums over the early part of the recording, the steps that start before
 # EARLY_FRACTION x shard_time: the shard's own evidence of equilibration (``equilibration``)
 EARLY_FRACTION = 0.125
@@ -63,6 +90,7 @@ SCALARS = (
     "flight_time_squared_sum",
     *CONTROL_VARIATE_SUMS,
     *EARLY_SUMS,
+    *MOMENT_CONTROL_SUMS,
 )
 # where each scalar sits in the array a compiled shard loop fills
 SCALAR_INDEX = {name: index for index, name in enumerate(SCALARS)}
@@ -114,6 +142,21 @@ class ShardTallies:
     early_collisions: int
     early_int_x: float
     early_int_x2: float
+    # sums over the recorded steps of mean 0 (MOMENT_CONTROL_SUMS)
+    noise_x_sum: float  # sum x xi
+    noise_xv_sum: float  # sum x v xi
+    noise_x2_sum: float  # sum x^2 xi
+    noise_v2_sum: float  # sum v^2 xi
+    noise_v3_sum: float  # sum v^3 xi
+    noise_v4_sum: float  # sum v^4 xi
+    noise_xv2_sum: float  # sum x v^2 xi
+    noise_squared_sum: float  # sum q
+    noise_squared_v_sum: float  # sum v q
+    noise_squared_x_sum: float  # sum x q
+    noise_squared_v2_sum: float  # sum v^2 q
+    position_noise_sum: float  # sum eta
+    position_noise_v_sum: float  # sum v eta
+    position_noise_x_sum: float  # sum x eta
 
     @staticmethod
     def loop_arrays(settings) -> dict:

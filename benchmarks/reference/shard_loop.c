@@ -690,6 +690,20 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
     double noise_v_sum = 0.0;
     double noise_scaled_sum = 0.0;
     double normal_sum = 0.0;
+    double noise_x_sum = 0.0;
+    double noise_xv_sum = 0.0;
+    double noise_x2_sum = 0.0;
+    double noise_v2_sum = 0.0;
+    double noise_v3_sum = 0.0;
+    double noise_v4_sum = 0.0;
+    double noise_xv2_sum = 0.0;
+    double noise_squared_sum = 0.0;
+    double noise_squared_v_sum = 0.0;
+    double noise_squared_x_sum = 0.0;
+    double noise_squared_v2_sum = 0.0;
+    double position_noise_sum = 0.0;
+    double position_noise_v_sum = 0.0;
+    double position_noise_x_sum = 0.0;
     /* the early part of the recording: the running sums when a step first starts past t_early */
     double t_early = recording ? EARLY_FRACTION * recorded_time : INFINITY;
     double early_time = 0.0;
@@ -758,6 +772,26 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
             noise_v_sum += v * xi;
             noise_scaled_sum += v / (x + 0.5 * v * v + 4.0 * dt) * xi;
             normal_sum += normal_r;
+            /* the moments' control variates: weights polynomial in the start state times xi,
+               q = xi^2 - 2 dt (mean 0 given the past) and eta = dt^(3/2) normal_s */
+            double x2 = x * x;
+            double v2 = v * v;
+            noise_x_sum += x * xi;
+            noise_xv_sum += x * v * xi;
+            noise_x2_sum += x2 * xi;
+            noise_v2_sum += v2 * xi;
+            noise_v3_sum += v2 * v * xi;
+            noise_v4_sum += v2 * v2 * xi;
+            noise_xv2_sum += x * v2 * xi;
+            double q = xi * xi - 2.0 * dt;
+            noise_squared_sum += q;
+            noise_squared_v_sum += v * q;
+            noise_squared_x_sum += x * q;
+            noise_squared_v2_sum += v2 * q;
+            double eta = dt * sqrt(dt) * normal_s;
+            position_noise_sum += eta;
+            position_noise_v_sum += v * eta;
+            position_noise_x_sum += x * eta;
             double ix, ix2;
             mean_path_integrals(a0, a1, a2, a3, dt, tau, &ix, &ix2);
             int_x += ix;
@@ -857,6 +891,20 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
     scalars[SCALAR_EARLY_COLLISIONS] = (double)early_collisions;
     scalars[SCALAR_EARLY_INT_X] = early_int_x;
     scalars[SCALAR_EARLY_INT_X2] = early_int_x2;
+    scalars[SCALAR_NOISE_X_SUM] = noise_x_sum;
+    scalars[SCALAR_NOISE_XV_SUM] = noise_xv_sum;
+    scalars[SCALAR_NOISE_X2_SUM] = noise_x2_sum;
+    scalars[SCALAR_NOISE_V2_SUM] = noise_v2_sum;
+    scalars[SCALAR_NOISE_V3_SUM] = noise_v3_sum;
+    scalars[SCALAR_NOISE_V4_SUM] = noise_v4_sum;
+    scalars[SCALAR_NOISE_XV2_SUM] = noise_xv2_sum;
+    scalars[SCALAR_NOISE_SQUARED_SUM] = noise_squared_sum;
+    scalars[SCALAR_NOISE_SQUARED_V_SUM] = noise_squared_v_sum;
+    scalars[SCALAR_NOISE_SQUARED_X_SUM] = noise_squared_x_sum;
+    scalars[SCALAR_NOISE_SQUARED_V2_SUM] = noise_squared_v2_sum;
+    scalars[SCALAR_POSITION_NOISE_SUM] = position_noise_sum;
+    scalars[SCALAR_POSITION_NOISE_V_SUM] = position_noise_v_sum;
+    scalars[SCALAR_POSITION_NOISE_X_SUM] = position_noise_x_sum;
     free(x_bin_lower);
     free(x_bin_upper);
     return 0;

@@ -40,14 +40,24 @@ def fake_results(hand_tuned=True, scaling=False):
     else:
         breakdown["hand_tuned_skipped"] = "the C compiler 'gcc' was not found on PATH"
     efficiency = {
-        "criterion_c": 3.0,
-        "shards": 32,
-        "shard_time": 1.0e5,
-        "collision_rate": 1.23456,
-        "relative_error": 0.001,
-        "steps_per_collision": 12.0,
-        "cpu_seconds": 10.0,
-        "variance_times_cpu": 1.0e-5,
+        "shards": 64,
+        "shard_times": {"0.5": 1.0e5},
+        "criterion_c": {"paper": 5.0, "default": 3.0},
+        "speeds": [0.01, 5.0],
+        "positions": [1.0e-3, 50.0],
+        "cpu_seconds": {"paper r=0.5": 6.0, "default r=0.5": 5.0},
+        "rows": [
+            {
+                "observable": "<x>",
+                "r": 0.5,
+                "paper": 8.0e-5,
+                "paper_err": 2.0e-5,
+                "default": 2.0e-6,
+                "default_err": 5.0e-7,
+                "gain": 40.0,
+                "gain_err": 14.1,
+            }
+        ],
     }
     results = {
         "started_utc": "2000-01-01 12:00:00",
@@ -89,7 +99,6 @@ def fake_results(hand_tuned=True, scaling=False):
             "target_met": True,
         },
         "efficiency": efficiency,
-        "efficiency_paper_c": {**efficiency, "criterion_c": 5.0},
         "compile": {
             "first_shard_compile_seconds": 30.0,
             "later_shard_load_seconds": 0.3,
@@ -199,9 +208,16 @@ def test_the_report_has_a_table_per_measurement_with_its_values():
     solver = next(table for table in tables if table[0][:2] == ["r", "nodes"])
     assert solver[1][-1] == "1.0e-10" and solver[2][-1] == ""  # no exact solution at 3/4
     assert "Target: <= 50 ms per r at <= 1e-08: MISSED (worst 60.0 ms" in page
-    efficiency = next(table for table in tables if "I" in table[0])
-    assert [row[0] for row in efficiency[1:]] == ["3", "5"]
-    assert efficiency[1][efficiency[0].index("relative error of I")] == "0.10%"
+    efficiency = next(table for table in tables if table[0][0] == "observable")
+    assert efficiency[0] == ["observable", "r", "paper", "default", "gain", "target"]
+    assert efficiency[1] == [
+        "<x>",
+        "0.5",
+        "8.00e-05 +- 2e-05",
+        "2.00e-06 +- 5e-07",
+        "40.0 +- 14.1",
+        ">= 4: met",
+    ]
     workflow = next(table for table in tables if table[0][1:] == ["seconds", "target"])
     assert workflow[1] == ["dry run of 20 r x 16 shards (320 shard jobs)", "4.0", "< 5 s: met"]
     assert workflow[2][2] == "not measured: its results are not complete"
@@ -233,3 +249,10 @@ def test_machine_info_names_the_cpu_and_the_versions():
     machine = machine_info()
     assert machine["cpu_model"] and machine["cores"] >= 1
     assert machine["python"].count(".") == 2 and machine["numba"][0].isdigit()
+
+
+def test_the_efficiency_only_report_has_the_header_and_the_efficiency_table():
+    everything = fake_results()
+    results = {key: everything[key] for key in ("started_utc", "seconds", "machine", "efficiency")}
+    page = markdown_report(results)
+    assert [table[0][0] for table in _tables(page)] == ["", "observable"]

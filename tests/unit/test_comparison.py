@@ -28,6 +28,7 @@ from bouncing_ball.comparison import (
     value_with_error,
 )
 from bouncing_ball.histograms import outgoing_speed_histogram, position_histogram
+from bouncing_ball.tallies import RATE_CONTROLS
 
 
 @pytest.mark.parametrize("restitution", exact.EXACT_RESTITUTIONS)
@@ -77,6 +78,45 @@ def test_z_is_against_the_exact_value_where_there_is_one_and_the_solver_otherwis
         moments_table(moment_rows("0.5", Fraction(1, 2), simulated, solved, exact_row))
     )
     assert "6.020 ± 0.010" in markdown and "+2.00 (vs exact)" in markdown
+    assert (rows.estimator == "plain").all()  # the summary has no controlled estimate
+
+
+def test_the_table_shows_the_estimate_with_the_smaller_error():
+    """The plain estimate or the one corrected by control variates, whichever has the smaller
+    error, and says which; a NaN controlled estimate (too few shards) is passed over."""
+    simulated = _summary(
+        {
+            "mean_x": 6.02,
+            "mean_x_controlled": 6.001,
+            "delta_x": 10.3,
+            "delta_x_controlled": 10.2,
+            "collision_rate": 0.3330,
+            "collision_rate_controlled": np.nan,
+        },
+        {
+            "mean_x": 0.01,
+            "mean_x_controlled": 0.002,
+            "delta_x": 0.05,
+            "delta_x_controlled": 0.06,
+            "collision_rate": 0.0002,
+            "collision_rate_controlled": np.nan,
+        },
+    )
+    solved = pd.Series({"mean_x": 6.0, "delta_x": 6 * 3**0.5, "collision_rate": 1 / 3})
+    rows = moments_table(moment_rows("0.6", Fraction(3, 5), simulated, solved))
+    rows = rows.set_index("quantity")
+    assert rows.loc["mean_x", ["simulation", "simulation_err", "estimator"]].tolist() == [
+        6.001,
+        0.002,
+        "controlled",
+    ]
+    assert rows.loc["mean_x", "z"] == pytest.approx(0.5)
+    assert rows.loc["delta_x", "estimator"] == "plain" and rows.loc["delta_x", "simulation"] == 10.3
+    assert rows.loc["collision_rate", "estimator"] == "plain"
+    markdown = moments_markdown(
+        moments_table(moment_rows("0.6", Fraction(3, 5), simulated, solved))
+    )
+    assert "| controlled " in markdown
 
 
 @pytest.mark.parametrize(
@@ -457,6 +497,7 @@ def _synthetic_shards(restitution, shards, rng, relative_noise=0.04, bias=0.0):
                 speed_counts=padded(noisy(time * p0v * 0.5 * (v_hi**2 - v_lo**2))),
                 position_time=padded(in_bin),
                 position_v2_time=padded(noisy(in_bin * v2)),
+                **dict.fromkeys(RATE_CONTROLS, 0.0),  # control sums that explain nothing
             )
         )
     return made

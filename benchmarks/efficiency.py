@@ -1,0 +1,190 @@
+"""Statistical efficiency per observable: (relative standard error)^2 x CPU seconds.
+
+For each r of ``RESTITUTIONS`` and each of two estimators,
+  * ``paper``: the paper's c = 5 and plain tallies (time averages, counts over time);
+  * ``default``: the default config's c and every variance reduction the project uses
+    (the ``*_controlled`` estimate of ``histograms`` where a table has one: the summary's
+    moments, P(0, v), P(x), <v^2>_x),
+``SHARDS`` shards run in two processes and each observable's relative standard error is
+measured from their scatter (the jackknife of ``histograms``), times the CPU seconds of the
+shards: the CPU it takes to reach a relative error of 1 (lower is better).  For P(0, v),
+P(x), <v^2>_x and P(x, v) it is the median over the bins inside ``SPEEDS`` and
+``POSITIONS``.  The gain is paper / default.
+
+A jackknife error from n shards is itself uncertain (about sqrt(2 / (n - 1)) for Gaussian
+shards, more with heavy tails): each efficiency's uncertainty is the delete-one jackknife of
+its relative squared error (the error of the error), the whole estimate (cross-fitting
+included) repeated without each shard; the gain's adds the two in quadrature.
+"""
+
+import time
+
+import numpy as np
+
+RESTITUTIONS = (0.25, 0.5, 0.75)
+ESTIMATORS = ("paper", "default")
+# shards per (r, estimator): as many as the default run's, so the cross-fitted slopes are as
+# noisy as there; the simulated time per shard gives about 0.1-0.4 CPU s each at c = 3
+SHARDS = 64
+SHARD_TIMES = {0.25: 4.0e4, 0.5: 1.0e5, 0.75: 4.0e5}
+# the bins over which the median is taken
+SPEEDS = (0.01, 5.0)
+POSITIONS = (1.0e-3, 50.0)
+MOMENTS = {
+    "I": "collision_rate",
+    "<x>": "mean_x",
+    "Delta x": "delta_x",
+    "<T>": "mean_flight_time",
+    "<T^2>": "flight_time_second_moment",
+}
+DISTRIBUTIONS = ("P(0,v)", "P(x)", "<v^2>_x", "P(x,v)")
+OBSERVABLES = (*MOMENTS, *DISTRIBUTIONS)
+
+
+def moment_relative_squared_errors(shards, r, controlled):
+    """{observable: (relative standard error)^2} of the moments of ``MOMENTS`` from ``shards``:
+    plain, or (``controlled``) the summary's ``*_controlled`` estimate where it has one."""
+    from bouncing_ball.histograms import position_moments_summary
+
+    summary = position_moments_summary(shards, r).iloc[0]
+    values = {}
+    for observable, name in MOMENTS.items():
+        column = f"{name}_controlled" if controlled else name
+        if column not in summary or not np.isfinite(summary[column]):
+            column = name
+        values[observable] = (summary[f"{column}_err"] / summary[column]) ** 2
+    return values
+
+
+def _median_relative_squared_error(table, name, keep, controlled):
+    """The median over the bins ``keep`` of (error / value)^2 of column ``name`` of ``table``,
+    or (``controlled``) of its ``_controlled`` column where the table has one."""
+    if controlled and f"{name}_controlled" in table:
+        name = f"{name}_controlled"
+    value, error = table[name].to_numpy(), table[f"{name}_err"].to_numpy()
+    keep = keep.to_numpy() & np.isfinite(value) & np.isfinite(error) & (value > 0)
+    return float(np.median((error[keep] / value[keep]) ** 2))
+
+
+def distribution_relative_squared_errors(shards, controlled):
+    """{observable: median over the bins inside SPEEDS and POSITIONS of (relative standard
+    error)^2} of P(0, v), P(x), <v^2>_x and P(x, v) (v within +-SPEEDS[1] for P(x, v)):
+    plain, or (``controlled``) the tables' ``*_controlled`` estimates where they have one."""
+    from bouncing_ball.histograms import (
+        distribution_histogram,
+        outgoing_speed_histogram,
+        position_histogram,
+    )
+
+    speeds = outgoing_speed_histogram(shards)
+    positions = position_histogram(shards)
+    cells = distribution_histogram(shards)
+    in_speeds = (speeds.v_lo >= SPEEDS[0]) & (speeds.v_hi <= SPEEDS[1])
+    in_positions = (positions.x_lo >= POSITIONS[0]) & (positions.x_hi <= POSITIONS[1])
+    in_cells = (
+        (cells.x_lo >= POSITIONS[0])
+        & (cells.x_hi <= POSITIONS[1])
+        & (cells.v_lo >= -SPEEDS[1])
+        & (cells.v_hi <= SPEEDS[1])
+    )
+    return {
+        "P(0,v)": _median_relative_squared_error(speeds, "p0v", in_speeds, controlled),
+        "P(x)": _median_relative_squared_error(positions, "px", in_positions, controlled),
+        "<v^2>_x": _median_relative_squared_error(
+            positions, "v2_given_x", in_positions, controlled
+        ),
+        "P(x,v)": _median_relative_squared_error(cells, "pxv", in_cells, controlled),
+    }
+
+
+def relative_squared_errors(shards, r, controlled):
+    """{observable: (relative standard error)^2} of every observable of ``OBSERVABLES``."""
+    return {
+        **moment_relative_squared_errors(shards, r, controlled),
+        **distribution_relative_squared_errors(shards, controlled),
+    }
+
+
+def with_error_of_error(shards, r, controlled):
+    """{observable: (relative squared error, its delete-one jackknife standard error)}: the
+    estimate of ``relative_squared_errors`` from all shards, and repeated without each."""
+    full = relative_squared_errors(shards, r, controlled)
+    n = len(shards)
+    leave_one_out = [
+        relative_squared_errors(shards[:k] + shards[k + 1 :], r, controlled) for k in range(n)
+    ]
+    result = {}
+    for observable, value in full.items():
+        others = np.array([values[observable] for values in leave_one_out])
+        spread = np.sqrt((n - 1) / n * ((others - others.mean()) ** 2).sum())
+        result[observable] = (float(value), float(spread))
+    return result
+
+
+def efficiency_rows(measurements):
+    """The rows of the efficiency table from ``measurements``: {(estimator, r): {"cpu_seconds":
+    CPU s of its shards, "relative_squared_errors": {observable: (value, error)}}} for both
+    estimators of ``ESTIMATORS`` at each r.  Each row: observable, r, paper and default
+    ((relative squared error) x CPU s), gain (paper / default), and the uncertainty of each
+    (``*_err``; the gain's from the two relative uncertainties in quadrature)."""
+    rows = []
+    restitutions = sorted({r for _, r in measurements})
+    for observable in OBSERVABLES:
+        for r in restitutions:
+            row = {"observable": observable, "r": r}
+            relative = {}
+            for estimator in ESTIMATORS:
+                measured = measurements[(estimator, r)]
+                value, error = measured["relative_squared_errors"][observable]
+                row[estimator] = value * measured["cpu_seconds"]
+                row[f"{estimator}_err"] = error * measured["cpu_seconds"]
+                relative[estimator] = error / value
+            row["gain"] = row["paper"] / row["default"]
+            row["gain_err"] = row["gain"] * float(np.hypot(relative["paper"], relative["default"]))
+            rows.append(row)
+    return rows
+
+
+def _timed_shard(arguments):
+    from .benchmark import _shard
+
+    r, recorded_time, shard, criterion_c = arguments
+    started = time.process_time()
+    tallies = _shard(r, recorded_time, shard=shard, seed=7, criterion_c=criterion_c)
+    return tallies, time.process_time() - started
+
+
+def efficiency_benchmark(shards=SHARDS, shard_times=None):
+    """Run the shards of every (estimator, r) in two processes and return the efficiency table
+    (``efficiency_rows``) with what was run."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    from .benchmark import PAPER_CRITERION_C, SHARD_SETTINGS, _shard
+
+    shard_times = shard_times or SHARD_TIMES
+    criteria = {"paper": PAPER_CRITERION_C, "default": SHARD_SETTINGS.criterion_c}
+    _shard(0.5, 10.0)  # compile or load the cache here before the pool forks
+    measurements = {}
+    with ProcessPoolExecutor(2) as pool:
+        for r, recorded_time in shard_times.items():
+            for estimator, criterion_c in criteria.items():
+                jobs = [(r, recorded_time, k, criterion_c) for k in range(shards)]
+                results = list(pool.map(_timed_shard, jobs))
+                tallies = [t for t, _ in results]
+                measurements[(estimator, r)] = {
+                    "cpu_seconds": sum(seconds for _, seconds in results),
+                    "relative_squared_errors": with_error_of_error(
+                        tallies, r, controlled=estimator == "default"
+                    ),
+                }
+    return {
+        "shards": shards,
+        "shard_times": {str(r): t for r, t in shard_times.items()},
+        "criterion_c": criteria,
+        "speeds": list(SPEEDS),
+        "positions": list(POSITIONS),
+        "cpu_seconds": {
+            f"{estimator} r={r:g}": m["cpu_seconds"] for (estimator, r), m in measurements.items()
+        },
+        "rows": efficiency_rows(measurements),
+    }
