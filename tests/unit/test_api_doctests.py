@@ -21,6 +21,7 @@ MODULES = [
     "bouncing_ball.flight_time",
     "bouncing_ball.free_flight",
     "bouncing_ball.jit",
+    "bouncing_ball.restitution",
     "bouncing_ball.settings",
 ]
 
@@ -35,6 +36,7 @@ DOCUMENTED = [
     "bouncing_ball.flight_time",
     "bouncing_ball.free_flight",
     "bouncing_ball.jit",
+    "bouncing_ball.restitution",
     "bouncing_ball.settings",
 ]
 
