@@ -23,6 +23,7 @@ MODULES = [
     "bouncing_ball.jit",
     "bouncing_ball.restitution",
     "bouncing_ball.settings",
+    "bouncing_ball.tallies",
 ]
 
 # the physics modules whose public names (their __all__) are documented in numpydoc style
@@ -38,6 +39,7 @@ DOCUMENTED = [
     "bouncing_ball.jit",
     "bouncing_ball.restitution",
     "bouncing_ball.settings",
+    "bouncing_ball.tallies",
 ]
 
 
