@@ -433,7 +433,7 @@ def _distribution_integrand(log_force, x, v, weight):
 
 
 def distribution_by_force_integral(x, v, restitution):
-    """P(x, v) of eqs. (fpsol), (psi), (weightfunc2) by integration over F, and quad's error estimate.
+    """P(x, v) of eqs. (fpsol), (psi), (weightfunc2) by integration over F, and its error.
 
     Converges absolutely for x > 0, and for x = 0 on the incoming side v < 0
     (there the Airy function decays); at x = 0, v > 0 only conditionally.

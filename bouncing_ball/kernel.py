@@ -62,8 +62,9 @@ __all__ = [
     "kernel_small_u_limit",
 ]
 
-#: Gauss-Legendre order of the tau integral: 2e-13 of a 64-node rule (``tests/unit/test_kernel.py``);
-#: the continuation to complex v (bouncing_ball.distribution) uses the same rule.
+#: Gauss-Legendre order of the tau integral: 2e-13 of a 64-node rule
+#: (``tests/unit/test_kernel.py``); the continuation to complex v (bouncing_ball.distribution)
+#: uses the same rule.
 TAU_NODES = 20
 #: The same tau integral weighted by powers of the flight time, eq. (timemoments) (k up to 3:
 #: bouncing_ball.flight_time), takes a few more nodes.

@@ -24,6 +24,7 @@ MODULES = [
     "bouncing_ball.kernel",
     "bouncing_ball.restitution",
     "bouncing_ball.settings",
+    "bouncing_ball.solver",
     "bouncing_ball.tallies",
 ]
 
@@ -41,6 +42,7 @@ DOCUMENTED = [
     "bouncing_ball.kernel",
     "bouncing_ball.restitution",
     "bouncing_ball.settings",
+    "bouncing_ball.solver",
     "bouncing_ball.tallies",
 ]
 
