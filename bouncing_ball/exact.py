@@ -95,7 +95,7 @@ def outgoing_speed_density(v, restitution):
     Raises
     ------
     ValueError
-        If a v is negative or NaN (the incoming side is r^2 P(0, r |v|), eq. (bc)), or r is not
+        If a v is negative or NaN (the incoming side is r^2 P(0, -r v), eq. (bc)), or r is not
         1/2 or 1/3.
 
     Examples
@@ -462,7 +462,7 @@ def distribution_by_force_integral(x, v, restitution):
 
     Examples
     --------
-    At x = 0 on the incoming side the integral gives eq. (bc), r^2 P(0, r |v|) = e^(-1/2) / 6
+    At x = 0 on the incoming side the integral gives eq. (bc), r^2 P(0, -r v) = e^(-1/2) / 6
     at r = 1/2, v = -1:
 
     >>> import math

@@ -11,7 +11,7 @@ trapezoidal rule, uniform in
     s = ln u + b u^(1/2):
 
 ln u where the kernel is scale-free (u << 1: there G_g(v, u) du u is a
-function of ln(v / u), analytic in the strip |Im ln(v/u)| < pi / 3, so the
+function of ln(v / u), analytic in the strip abs(Im ln(v/u)) < pi / 3, so the
 rule converges like exp(-2 pi^2 / (3 h))), and u^(1/2) where a fast
 particle comes back with its speed spread by ~ 2 u^(1/2), so the spacing
 keeps pace with the kernel's width.  Below the lowest node u_0 the power
@@ -330,7 +330,7 @@ class OutgoingSpeedSolution:
         Raises
         ------
         ValueError
-            If a v is negative or NaN (the incoming side is r^2 P(0, r |v|), eq. (bc)).
+            If a v is negative or NaN (the incoming side is r^2 P(0, -r v), eq. (bc)).
         """
         v = np.asarray(v, dtype=float)
         if np.any(~(v >= 0.0)):
@@ -584,7 +584,7 @@ def accuracy_estimate(solution) -> float:
     Returns
     -------
     float
-        max |P(0, v) / P_finer(0, v) - 1| over the speeds of ``CHECKED_SPEEDS`` where P_finer
+        max abs(P(0, v) / P_finer(0, v) - 1) over the speeds of ``CHECKED_SPEEDS`` where P_finer
         is positive; compare with ``ACCURACY_TARGET``.
 
     Examples

@@ -1,6 +1,6 @@
 """What one simulation shard records, and merging shards (a sum).
 
-A shard is stored as one long table, a row per tally entry:
+A shard is stored as one long table, a row per tally entry::
 
     tally                   lo     hi     lo2    hi2    value
     outgoing_speed          v_lo   v_hi   NaN    NaN    collisions with v_out in [v_lo, v_hi)
