@@ -154,8 +154,7 @@ def tally_seed_sequence(seed_sequence: np.random.SeedSequence) -> np.random.Seed
 class ShardTallies:
     """The tallies of one shard, or of several merged (``+``, ``merge_shards``).
 
-    Every field but the bins is additive over shards.  Each field's comment in the source
-    says what it records.
+    Every field but the bins is additive over shards.
 
     Parameters
     ----------
