@@ -33,6 +33,18 @@ there (the part beyond is below exp(-TAIL^2) = 1e-18 of the whole), so a
 fixed Gauss-Legendre rule resolves it for every v, u.  tau1^2 is evaluated as
 3 v u / ((v + u + z0) z0), which keeps its digits when u << v or v << u, and
 z0^2 as (v - u)^2 + v u.
+
+The kernel is numba-compiled: ``return_speed_kernel`` and ``return_speed_kernel_matrix``
+compile on their first call (seconds), so their Examples are not run as doctests; the unit
+tests (``tests/unit/test_kernel.py``) check the same values.
+
+Examples
+--------
+For u << v the kernel approaches ``kernel_small_u_limit``:
+
+>>> from bouncing_ball.kernel import kernel_small_u_limit
+>>> print(kernel_small_u_limit([1.0, 2.0], 1e-4).round(8))
+[0.00579194 0.00093152]
 """
 
 import math
@@ -41,13 +53,23 @@ import numpy as np
 
 from .jit import njit, prange
 
-# Gauss-Legendre order of the tau integral: 2e-13 of a 64-node rule (``tests/unit/test_kernel.py``);
-# the continuation to complex v (bouncing_ball.distribution) uses the same rule
+__all__ = [
+    "TAU_NODES",
+    "TIME_MOMENT_TAU_NODES",
+    "TAIL",
+    "return_speed_kernel",
+    "return_speed_kernel_matrix",
+    "kernel_small_u_limit",
+]
+
+#: Gauss-Legendre order of the tau integral: 2e-13 of a 64-node rule
+#: (``tests/unit/test_kernel.py``); the continuation to complex v (bouncing_ball.distribution)
+#: uses the same rule.
 TAU_NODES = 20
-# the same tau integral weighted by powers of the flight time, eq. (timemoments) (k up to 3:
-# bouncing_ball.flight_time), takes a few more nodes
+#: The same tau integral weighted by powers of the flight time, eq. (timemoments) (k up to 3:
+#: bouncing_ball.flight_time), takes a few more nodes.
 TIME_MOMENT_TAU_NODES = 24
-# exp(-TAIL^2) ~ 1e-18: the cut of the tau integral for large z0
+#: exp(-TAIL^2) ~ 1e-18: the cut of the tau integral for large z0.
 TAIL = 6.4
 
 _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(TAU_NODES)
@@ -94,7 +116,32 @@ def _kernel_pairs(v, u, nodes, weights):
 
 
 def return_speed_kernel(v, u):
-    """G_g(v, u) of eq. (kernel3) for arrays v, u (broadcast), in the stable form above."""
+    """G_g(v, u) of eq. (kernel3) for arrays v, u (broadcast), in the stable form above.
+
+    v G_g(v, u) dv is the probability that a particle leaving the floor with speed u first
+    returns with speed in [v, v + dv]; int_0^inf v G_g(v, u) dv = 1, eq. (normG).
+
+    Parameters
+    ----------
+    v : array_like
+        Return speeds (0 where v <= 0).
+    u : array_like
+        Outgoing speeds (0 where u <= 0); broadcast against ``v``.
+
+    Returns
+    -------
+    numpy.ndarray
+        G_g(v, u), the broadcast shape.
+
+    Examples
+    --------
+    Compiles on its first call (so not run as a doctest):
+
+    >>> from bouncing_ball.kernel import return_speed_kernel
+    >>> print(return_speed_kernel([1.0, 2.0], [[0.5], [1.0]]).round(8))  # doctest: +SKIP
+    [[0.46453837 0.08424588]
+     [0.42936793 0.13643782]]
+    """
     v, u = np.broadcast_arrays(np.asarray(v, dtype=float), np.asarray(u, dtype=float))
     flat = _kernel_pairs(
         np.ascontiguousarray(v.ravel()), np.ascontiguousarray(u.ravel()), _NODES, _WEIGHTS
@@ -103,7 +150,31 @@ def return_speed_kernel(v, u):
 
 
 def return_speed_kernel_matrix(v, u):
-    """The matrix G_g(v_i, u_j) for 1-d arrays v, u."""
+    """The matrix G_g(v_i, u_j) of eq. (kernel3) for 1-d arrays v, u.
+
+    The kernel of the integral equation eq. (inteq) on a grid of speeds.
+
+    Parameters
+    ----------
+    v : array_like
+        Return speeds v_i, 1-d.
+    u : array_like
+        Outgoing speeds u_j, 1-d.
+
+    Returns
+    -------
+    numpy.ndarray
+        G_g(v_i, u_j), shape (v.size, u.size).
+
+    Examples
+    --------
+    Compiles on its first call (so not run as a doctest):
+
+    >>> from bouncing_ball.kernel import return_speed_kernel_matrix
+    >>> print(return_speed_kernel_matrix([1.0, 2.0], [0.5, 1.0]).round(8))  # doctest: +SKIP
+    [[0.46453837 0.42936793]
+     [0.08424588 0.13643782]]
+    """
     return _kernel_matrix(
         np.ascontiguousarray(v, dtype=float), np.ascontiguousarray(u, dtype=float), _NODES, _WEIGHTS
     )
@@ -114,6 +185,24 @@ def kernel_small_u_limit(v, u):
 
     From eq. (kernel3) at u -> 0 (z -> v for every y).  The relative
     correction is O(u max(1, 1 / v)) (the exponent (v + u) / 2 - z moves by O(u)).
+
+    Parameters
+    ----------
+    v : array_like
+        Return speeds, v > 0.
+    u : array_like
+        Outgoing speeds, 0 < u << v; broadcast against ``v``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The leading form of G_g(v, u), the broadcast shape.
+
+    Examples
+    --------
+    >>> from bouncing_ball.kernel import kernel_small_u_limit
+    >>> print(kernel_small_u_limit([1.0, 2.0], 1e-4).round(8))
+    [0.00579194 0.00093152]
     """
     v = np.asarray(v, dtype=float)
     return 1.5 / np.pi * np.sqrt(u) * v**-2.5 * (1.0 + v) * np.exp(-0.5 * v)

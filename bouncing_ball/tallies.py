@@ -1,6 +1,6 @@
 """What one simulation shard records, and merging shards (a sum).
 
-A shard is stored as one long table, a row per tally entry:
+A shard is stored as one long table, a row per tally entry::
 
     tally                   lo     hi     lo2    hi2    value
     outgoing_speed          v_lo   v_hi   NaN    NaN    collisions with v_out in [v_lo, v_hi)
@@ -24,7 +24,34 @@ overflow bins.  Every entry is additive over shards, so merging is a sum.
 ``SCALARS`` is the one definition of the scalars' layout: their order in the table, in
 the array a compiled shard loop fills (``SCALAR_INDEX``: the numba loop's indices, and
 the C reference's, which ``benchmarks/reference_loop.py`` passes to the compiler, with
-``EARLY_FRACTION``).
+``EARLY_FRACTION``).  ``HISTOGRAMS`` and ``HISTOGRAMS_2D`` name the histograms and their
+bins, ``BINS`` the four bins a shard is recorded on, ``CONTROL_VARIATE_SUMS`` the martingale
+sums of mean 0 that correct the collision rate I, and ``EARLY_SUMS`` the sums over the first
+``EARLY_FRACTION`` of the recording (the shard's own evidence of equilibration).
+
+Examples
+--------
+A shard's tallies round-trip through its table; two shards merge to their sum:
+
+>>> from bouncing_ball.bins import LinearBins, LogBins
+>>> from bouncing_ball.settings import ShardSettings
+>>> from bouncing_ball.tallies import ShardTallies, merge_shards, SCALAR_INDEX
+>>> from bouncing_ball.tallies import tallies_from_frame, tallies_to_frame
+>>> settings = ShardSettings(
+...     shard_time=1.0, equilibration_time=0.0, criterion_c=5, min_step_divisor=10,
+...     max_steps=100, speed_bins=LogBins(0.1, 10.0, 1), position_bins=LogBins(0.1, 10.0, 1),
+...     velocity_bins=LinearBins(-1.0, 1.0, 1.0), flight_time_bins=LogBins(0.1, 10.0, 1),
+... )
+>>> arrays = ShardTallies.loop_arrays(settings)
+>>> arrays["speed_counts"][1] = 3
+>>> arrays["scalars"][SCALAR_INDEX["collisions"]] = 3
+>>> shard = ShardTallies.from_loop(settings, arrays)
+>>> total = merge_shards([shard, shard])
+>>> print(total.collisions, total.speed_counts)
+6 [0 6 0 0]
+>>> back = tallies_from_frame(tallies_to_frame(total), settings)
+>>> print(back.collisions, back.speed_counts)
+6 [0 6 0 0]
 """
 
 from dataclasses import dataclass, fields, replace
@@ -34,14 +61,32 @@ import pandas as pd
 
 from .bins import LinearBins, LogBins
 
-# name in the table: (the bins' attribute, the values' attribute, integer counts?)
+__all__ = [
+    "HISTOGRAMS",
+    "HISTOGRAMS_2D",
+    "CONTROL_VARIATE_SUMS",
+    "EARLY_FRACTION",
+    "EARLY_SUMS",
+    "SCALARS",
+    "SCALAR_INDEX",
+    "BINS",
+    "tally_seed_sequence",
+    "ShardTallies",
+    "merge_shards",
+    "tallies_to_frame",
+    "tallies_from_frame",
+]
+
+#: The 1-D histograms, name in the table: (the bins' attribute, the values' attribute,
+#: integer counts?).
 HISTOGRAMS = {
     "outgoing_speed": ("speed_bins", "speed_counts", True),
     "position_time": ("position_bins", "position_time", False),
     "position_v2_time": ("position_bins", "position_v2_time", False),
     "flight_time": ("flight_time_bins", "flight_time_counts", True),
 }
-# name in the table: ((the bins of the first and of the second variable), values, integer?)
+#: The 2-D histograms, name in the table: ((the bins of the first and of the second variable),
+#: values, integer?).
 HISTOGRAMS_2D = {
     "position_velocity_time": (("position_bins", "velocity_bins"), "position_velocity_time", False),
     "return_speed": (("speed_bins", "speed_bins"), "return_speed_counts", True),
@@ -92,16 +137,40 @@ SCALARS = (
     *EARLY_SUMS,
     *MOMENT_CONTROL_SUMS,
 )
-# where each scalar sits in the array a compiled shard loop fills
+#: Where each scalar of ``SCALARS`` sits in the array a compiled shard loop fills.
 SCALAR_INDEX = {name: index for index, name in enumerate(SCALARS)}
 _INTEGER = ("collisions", "steps", "budget_exhausted", "flights", "early_collisions")
 BINS = ("speed_bins", "position_bins", "velocity_bins", "flight_time_bins")
 
 
 def tally_seed_sequence(seed_sequence: np.random.SeedSequence) -> np.random.SeedSequence:
-    """The stream of a shard's bridge points (``simulation.simulate_shard``: P(x, v) and the
-    correction of P(x) and <v^2>_x): the first child of its stream, made without ``spawn``
-    (which would change the parent's state)."""
+    """The stream of a shard's bridge points, the first child of the shard's stream.
+
+    The bridge points (``simulation.simulate_shard``) sample P(x, v) and correct P(x) and
+    <v^2>_x.  The child is made without ``spawn`` (which would change the parent's state).
+
+    Parameters
+    ----------
+    seed_sequence : numpy.random.SeedSequence
+        The shard's stream.
+
+    Returns
+    -------
+    numpy.random.SeedSequence
+        Its child with spawn key ``(*seed_sequence.spawn_key, 0)``, as ``spawn`` would make
+        first.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bouncing_ball.tallies import tally_seed_sequence
+    >>> shard = np.random.SeedSequence(12345, spawn_key=(7,))
+    >>> child = tally_seed_sequence(shard)
+    >>> child.spawn_key, child.entropy
+    ((7, 0), 12345)
+    >>> bool((child.generate_state(2) == shard.spawn(1)[0].generate_state(2)).all())
+    True
+    """
     return np.random.SeedSequence(
         entropy=seed_sequence.entropy,
         spawn_key=(*seed_sequence.spawn_key, 0),
@@ -111,6 +180,47 @@ def tally_seed_sequence(seed_sequence: np.random.SeedSequence) -> np.random.Seed
 
 @dataclass(frozen=True)
 class ShardTallies:
+    """The tallies of one shard, or of several merged (``+``, ``merge_shards``).
+
+    Every field but the bins is additive over shards.
+
+    Parameters
+    ----------
+    speed_bins, position_bins, flight_time_bins : LogBins
+        The bins of outgoing speeds, heights and flight times (``BINS``).
+    velocity_bins : LinearBins
+        The velocity bins of P(x, v).
+    speed_counts, flight_time_counts : numpy.ndarray of int64
+        Collisions by outgoing speed (P(0, v)), flights by duration; each with its under- and
+        overflow bins.
+    position_time, position_v2_time : numpy.ndarray
+        Time spent in each height bin (P(x)) and int v^2 dt over it (<v^2>_x, eq. (moment2)).
+    position_velocity_time : numpy.ndarray
+        Time spent in each (x, v) cell, shape (x bins, v bins): P(x, v).
+    return_speed_counts : numpy.ndarray of int64
+        Flights by outgoing speed u and return speed v, shape (u bins, v bins).
+    time, collisions, steps, int_x, int_x2 : float or int
+        Scalars of ``SCALARS``: recorded time, collisions, steps, int x dt and int x^2 dt.
+    budget_exhausted, flights, flight_time_sum, flight_time_squared_sum : int or float
+        Scalars of ``SCALARS``: shards that ran out of their step budget, flights recorded (one
+        per recorded collision with an earlier collision) and the sums of their T and T^2.
+    noise_sum, noise_v_sum, noise_scaled_sum, normal_sum : float
+        The control variates of ``CONTROL_VARIATE_SUMS``, sums of mean 0 over the recorded
+        steps (velocity noise of eq. (vstep)).
+    early_time, early_collisions, early_int_x, early_int_x2 : float or int
+        ``EARLY_SUMS``: time, collisions, int x dt and int x^2 dt over the first
+        ``EARLY_FRACTION`` of the recording.
+
+    Raises
+    ------
+    ValueError
+        On ``+`` of shards recorded on different bins.
+
+    Examples
+    --------
+    See the module's example.
+    """
+
     speed_bins: LogBins
     position_bins: LogBins
     velocity_bins: LinearBins
@@ -160,9 +270,19 @@ class ShardTallies:
 
     @staticmethod
     def loop_arrays(settings) -> dict:
-        """Zeroed arrays a compiled shard loop fills, by field name, each histogram with under-
-        and overflow bins, and ``scalars`` in the order of ``SCALARS``.  ``settings``: anything
-        with the four bins of ``BINS`` (a ``settings.ShardSettings``)."""
+        """Zeroed arrays a compiled shard loop fills.
+
+        Parameters
+        ----------
+        settings : settings.ShardSettings
+            Anything with the four bins of ``BINS``.
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            By field name, each histogram with under- and overflow bins, and ``scalars`` in
+            the order of ``SCALARS``.
+        """
         arrays = {}
         for bins_attr, values_attr, integer in HISTOGRAMS.values():
             arrays[values_attr] = np.zeros(
@@ -176,8 +296,20 @@ class ShardTallies:
 
     @classmethod
     def from_loop(cls, settings, arrays: dict) -> "ShardTallies":
-        """The tallies of a compiled shard loop: the arrays of ``loop_arrays`` after the loop
-        (the numba loop and its C reference both fill them so)."""
+        """The tallies of a compiled shard loop.
+
+        Parameters
+        ----------
+        settings : settings.ShardSettings
+            Anything with the four bins of ``BINS``: the bins the loop recorded on.
+        arrays : dict of str to numpy.ndarray
+            The arrays of ``loop_arrays`` after the loop (the numba loop and its C reference
+            both fill them so).
+
+        Returns
+        -------
+        ShardTallies
+        """
         values = {
             name: int(value) if name in _INTEGER else float(value)
             for name, value in zip(SCALARS, arrays["scalars"])
@@ -201,7 +333,27 @@ class ShardTallies:
 
 
 def merge_shards(shards) -> ShardTallies:
-    """Sum the tallies of several shards (order does not matter)."""
+    """Sum the tallies of several shards (order does not matter).
+
+    Parameters
+    ----------
+    shards : iterable of ShardTallies
+        At least one, all recorded on the same bins.
+
+    Returns
+    -------
+    ShardTallies
+        Their sum.
+
+    Raises
+    ------
+    ValueError
+        If there are no shards, or their bins differ.
+
+    Examples
+    --------
+    See the module's example.
+    """
     shards = list(shards)
     if not shards:
         raise ValueError("no shards to merge")
@@ -212,6 +364,23 @@ def merge_shards(shards) -> ShardTallies:
 
 
 def tallies_to_frame(tallies: ShardTallies) -> pd.DataFrame:
+    """A shard's tallies as its long table, the layout of the module's docstring.
+
+    Parameters
+    ----------
+    tallies : ShardTallies
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``tally``, ``lo``, ``hi``, ``lo2``, ``hi2``, ``value``: a row per bin of each
+        histogram (a 2-D one's second variable fastest), then a row per scalar of
+        ``SCALARS``.
+
+    Examples
+    --------
+    See the module's example.
+    """
     parts = []
     for name, (bins_attr, values_attr, _) in HISTOGRAMS.items():
         bins = getattr(tallies, bins_attr)
@@ -263,8 +432,31 @@ def _on_bins(rows, column, expected):
 
 
 def tallies_from_frame(frame: pd.DataFrame, settings, source: str = "shard") -> ShardTallies:
-    """Inverse of ``tallies_to_frame``; checks that the bins are those of ``settings``
-    (anything with the four bins of ``BINS``, e.g. a ``settings.ShardSettings``)."""
+    """A shard's tallies from its table: the inverse of ``tallies_to_frame``.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        The table of ``tallies_to_frame``.
+    settings : settings.ShardSettings
+        Anything with the four bins of ``BINS``; the table's bins must be these.
+    source : str, optional
+        Where the table comes from (a file), named in errors.
+
+    Returns
+    -------
+    ShardTallies
+
+    Raises
+    ------
+    ValueError
+        Naming ``source``, if a column is missing, a tally is not on the bins of ``settings``,
+        or a scalar is missing or repeated.
+
+    Examples
+    --------
+    See the module's example.
+    """
     missing = {"tally", "lo", "hi", "lo2", "hi2", "value"} - set(frame.columns)
     if missing:
         raise ValueError(f"{source}: missing columns {sorted(missing)}")

@@ -16,11 +16,16 @@ MODULES = [
     "bouncing_ball.bins",
     "bouncing_ball.comparison",
     "bouncing_ball.equilibration",
+    "bouncing_ball.exact",
     "bouncing_ball.fits",
     "bouncing_ball.flight_time",
     "bouncing_ball.free_flight",
     "bouncing_ball.jit",
+    "bouncing_ball.kernel",
+    "bouncing_ball.restitution",
     "bouncing_ball.settings",
+    "bouncing_ball.solver",
+    "bouncing_ball.tallies",
 ]
 
 # the physics modules whose public names (their __all__) are documented in numpydoc style
@@ -29,11 +34,16 @@ DOCUMENTED = [
     "bouncing_ball.bins",
     "bouncing_ball.comparison",
     "bouncing_ball.equilibration",
+    "bouncing_ball.exact",
     "bouncing_ball.fits",
     "bouncing_ball.flight_time",
     "bouncing_ball.free_flight",
     "bouncing_ball.jit",
+    "bouncing_ball.kernel",
+    "bouncing_ball.restitution",
     "bouncing_ball.settings",
+    "bouncing_ball.solver",
+    "bouncing_ball.tallies",
 ]
 
 
