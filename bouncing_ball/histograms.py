@@ -1,12 +1,51 @@
 """From summed shard tallies to P(0,v), P(x), <v^2>_x, P(x,v), the flights and the moments.
 
-Every estimate is a function of the shards' summed tallies; its standard
-error comes from the scatter between shards by the delete-one jackknife
-(for a ratio of sums over shards of equal time it is the standard error of
-the mean of the per-shard estimates).  ``control_variate_adjusted`` lowers the
-variance of any such estimate with the shards' martingale control variates
-(``control_variate_rate``: of a rate); the tables keep both estimates, plain and
-``*_controlled``.
+Every estimate is a function of the shards' summed tallies (``tallies.ShardTallies``); its
+standard error comes from the scatter between shards by the delete-one jackknife
+(``jackknife``: for a ratio of sums over shards of equal time it is the standard error of the
+mean of the per-shard estimates).  ``control_variate_adjusted`` lowers the variance of any such
+estimate with the shards' martingale control variates (``control_variate_rate``: of a rate);
+the tables keep both estimates, plain and ``*_controlled``.
+
+Examples
+--------
+Two shards of time 2 on one speed bin per decade, built by hand (``tallies``): 4 and 2
+collisions, so I = 6 / 4 = 1.5 collisions per unit time, and the jackknife error is the
+standard error of the mean of the shards' rates 2 and 1:
+
+>>> from bouncing_ball.bins import LinearBins, LogBins
+>>> from bouncing_ball.settings import ShardSettings
+>>> from bouncing_ball.tallies import SCALAR_INDEX, ShardTallies
+>>> from bouncing_ball.histograms import outgoing_speed_histogram, position_moments_summary
+>>> settings = ShardSettings(
+...     shard_time=2.0, equilibration_time=0.0, criterion_c=5, min_step_divisor=10,
+...     max_steps=100, speed_bins=LogBins(0.1, 10.0, 1), position_bins=LogBins(0.1, 10.0, 1),
+...     velocity_bins=LinearBins(-1.0, 1.0, 1.0), flight_time_bins=LogBins(0.1, 10.0, 1),
+... )
+>>> def shard(speed_counts, int_x, int_x2):
+...     arrays = ShardTallies.loop_arrays(settings)
+...     arrays["speed_counts"][:] = speed_counts
+...     for name, value in (("time", 2.0), ("collisions", sum(speed_counts)),
+...                         ("int_x", int_x), ("int_x2", int_x2)):
+...         arrays["scalars"][SCALAR_INDEX[name]] = value
+...     return ShardTallies.from_loop(settings, arrays)
+>>> shards = [shard([0, 1, 3, 0], 1.0, 1.0), shard([0, 1, 1, 0], 2.0, 3.0)]
+>>> summary = position_moments_summary(shards, restitution=0.5)
+>>> print(summary[["collision_rate", "collision_rate_err", "mean_x", "mean_x_err"]].to_string())
+   collision_rate  collision_rate_err  mean_x  mean_x_err
+0             1.5                 0.5    0.75        0.25
+
+Two shards are too few for the control variates: the ``*_controlled`` columns are NaN.
+
+>>> print(summary["collision_rate_controlled"].isna().all())
+True
+>>> p0v = outgoing_speed_histogram(shards)
+>>> print(p0v[["v_lo", "v_hi", "p0v", "count"]].round(6).to_string())
+   v_lo  v_hi       p0v  count
+0   0.0   0.1  0.000000      0
+1   0.1   1.0  1.010101      2
+2   1.0  10.0  0.020202      4
+3  10.0   inf       NaN      0
 """
 
 import numpy as np
@@ -20,12 +59,54 @@ from .tallies import (
     merge_shards,
 )
 
+__all__ = [
+    "CONTROLLED_MOMENTS",
+    "jackknife",
+    "shard_controls",
+    "moment_controls",
+    "outgoing_speed_density",
+    "outgoing_speed_histogram",
+    "position_histogram",
+    "distribution_histogram",
+    "flight_time_histogram",
+    "return_speed_table",
+    "position_moments_summary",
+    "control_variate_rate",
+    "control_variate_adjusted",
+]
+
 
 def jackknife(estimator, *per_shard):
-    """Value and jackknife standard error of ``estimator`` of summed tallies.
+    """Value and delete-one jackknife standard error of a function of summed tallies.
 
-    Each argument of ``per_shard`` has the shard index as its first axis; the
-    estimator receives the sums over shards.  With one shard the error is NaN.
+    The estimator is evaluated on the sums over all shards and on the sums leaving out each
+    shard k in turn; the error is sqrt((n - 1) / n * sum_k (estimate_{-k} - mean)^2) over the
+    n shards.
+
+    Parameters
+    ----------
+    estimator : callable
+        A function of the sums over shards, one argument per array of ``per_shard``,
+        vectorised over their remaining axes.
+    *per_shard : array_like
+        The shards' tallies, each with the shard index as its first axis.
+
+    Returns
+    -------
+    value : numpy.ndarray or float
+        ``estimator`` of the sums over all shards.
+    error : numpy.ndarray or float
+        Its jackknife standard error, of the shape of ``value``; NaN with one shard.
+
+    Examples
+    --------
+    For a ratio of sums over shards of equal time, the error is the standard error of the
+    mean of the per-shard ratios (here 2 and 1):
+
+    >>> from bouncing_ball.histograms import jackknife
+    >>> value, error = jackknife(lambda c, t: c / t, [4.0, 2.0], [2.0, 2.0])
+    >>> print(value, error)
+    1.5 0.5
     """
     per_shard = [np.asarray(a, dtype=float) for a in per_shard]
     totals = [a.sum(axis=0) for a in per_shard]
@@ -42,18 +123,53 @@ def jackknife(estimator, *per_shard):
 
 
 def shard_controls(shards, names):
-    """The control sums ``names`` of each shard (shards x p), or None with fewer than
-    SHARDS_PER_CONTROL x p shards: with p controls fitted to n shards the jackknife error of
-    the corrected estimate is too small by a factor that grows with p / n (about 1.05 at
-    p / n = 1/3, 1.3 at 3/4, on shards with Student-t controls)."""
+    """The control sums ``names`` of each shard, if the shards are enough to fit their slopes.
+
+    With p controls fitted to n shards the jackknife error of the corrected estimate is too
+    small by a factor that grows with p / n (about 1.05 at p / n = 1/3, 1.3 at 3/4, on shards
+    with Student-t controls), so at least ``tallies.SHARDS_PER_CONTROL`` shards per control
+    are asked for.
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards.
+    names : sequence of str
+        The control sums, fields of ``ShardTallies`` (e.g. ``tallies.RATE_CONTROLS``).
+
+    Returns
+    -------
+    numpy.ndarray or None
+        The sums, shape (shards, p) with p = ``len(names)``; None with fewer than
+        ``SHARDS_PER_CONTROL * p`` shards.
+
+    Examples
+    --------
+    See the module's example: two shards are too few for any control.
+    """
     if len(shards) < SHARDS_PER_CONTROL * len(names):
         return None
     return np.array([[getattr(s, name) for name in names] for s in shards], dtype=float)
 
 
 def moment_controls(shards):
-    """The control sums of the summary's moments: those of MOMENT_CONTROLS where the shards
-    are enough to fit their slopes, else the fewer of RATE_CONTROLS, else None."""
+    """The control sums of the summary's moments, as many as the shards can fit.
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards.
+
+    Returns
+    -------
+    numpy.ndarray or None
+        ``shard_controls`` of ``tallies.MOMENT_CONTROLS`` where the shards are enough to fit
+        their slopes, else of the fewer ``tallies.RATE_CONTROLS``, else None.
+
+    Examples
+    --------
+    See the module's example: two shards are too few for any control.
+    """
     controls = shard_controls(shards, MOMENT_CONTROLS)
     return controls if controls is not None else shard_controls(shards, RATE_CONTROLS)
 
@@ -78,20 +194,60 @@ def _controlled(estimator, controls, times, adjusted, fixed=()):
 
 
 def outgoing_speed_density(counts, time, lower, upper):
-    """eq. (collrate): the rate of collisions in a bin is int v P(0,v) dv."""
+    """P(0, v) averaged over a bin of outgoing speed, from the rate of collisions in it.
+
+    The rate of collisions with outgoing speed in [lower, upper) is int v P(0, v) dv over the
+    bin, eq. (collrate); the bin average weighted by v is that rate over int v dv.
+
+    Parameters
+    ----------
+    counts : array_like
+        Collisions in each bin.
+    time : float or array_like
+        The time over which they were counted.
+    lower, upper : array_like
+        The bins' edges.
+
+    Returns
+    -------
+    numpy.ndarray or float
+        counts / (time (upper^2 - lower^2) / 2), the bin average of P(0, v) weighted by v.
+
+    Examples
+    --------
+    >>> from bouncing_ball.histograms import outgoing_speed_density
+    >>> print(outgoing_speed_density(6.0, 4.0, 1.0, 2.0))
+    1.0
+    """
     return counts / (time * 0.5 * (upper**2 - lower**2))
 
 
 def outgoing_speed_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
     """P(0, v) on the outgoing side, bin averages weighted by v.
 
-    Columns v_lo, v_hi, v (the geometric centre; the arithmetic one for the
-    underflow bin), p0v, p0v_err, count, p0v_controlled, p0v_controlled_err.  Bin averages
-    mean p0v = int_bin v P(0,v) dv / int_bin v dv.  The overflow bin has p0v = NaN;
-    an empty bin has p0v = 0 and p0v_err = NaN (no scatter to measure).  p0v_controlled is
-    the same with each bin's counts corrected by the control variates of RATE_CONTROLS
-    (``control_variate_adjusted``: the same expectation, less variance; NaN with fewer than
-    SHARDS_PER_CONTROL x ``len(RATE_CONTROLS)`` shards).
+    Bin averages mean p0v = int_bin v P(0,v) dv / int_bin v dv (``outgoing_speed_density``,
+    eq. (collrate)).
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards, all on the same speed bins.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per speed bin, under- and overflow included, columns ``v_lo``, ``v_hi``,
+        ``v`` (the geometric centre; the arithmetic one for the underflow bin), ``p0v``,
+        ``p0v_err``, ``count``, ``p0v_controlled``, ``p0v_controlled_err``.  The overflow bin
+        has p0v = NaN; an empty bin has p0v = 0 and p0v_err = NaN (no scatter to measure).
+        ``p0v_controlled`` is the same with each bin's counts corrected by the control
+        variates of ``tallies.RATE_CONTROLS`` (``control_variate_adjusted``: the same
+        expectation, less variance; NaN with fewer than ``SHARDS_PER_CONTROL`` x
+        ``len(RATE_CONTROLS)`` shards).
+
+    Examples
+    --------
+    See the module's example.
     """
     bins = shards[0].speed_bins
     lower, upper = bins.lower, bins.upper
@@ -125,16 +281,32 @@ def outgoing_speed_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
 def position_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
     """P(x) (bin averages) and <v^2>_x, eq. (moment2), per bin of x.
 
-    NaN where a value is undefined: P(x) in the overflow bin, errors and
-    <v^2>_x in bins the particle never visited.  The tally is exact in expectation
-    but in the steps cut by a collision (``simulation``: the mean path corrected by one
-    bridge point a step), so a bin's
-    total can come out slightly negative where the particle hardly goes; the underflow
-    bin (x below the first edge) also holds the bridge points below x = 0.
-    ``px_controlled`` and ``v2_given_x_controlled`` (with their ``_err``) are the same with
-    each bin's time and int v^2 dt corrected by the control variates of RATE_CONTROLS
-    (``control_variate_adjusted``: the same expectation, less variance; NaN with fewer than
-    SHARDS_PER_CONTROL x ``len(RATE_CONTROLS)`` shards).
+    The tally is exact in expectation but in the steps cut by a collision (``simulation``:
+    the mean path corrected by one bridge point a step), so a bin's total can come out
+    slightly negative where the particle hardly goes; the underflow bin (x below the first
+    edge) also holds the bridge points below x = 0.
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards, all on the same position bins.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per position bin, under- and overflow included, columns ``x_lo``, ``x_hi``,
+        ``x`` (as ``v`` of ``outgoing_speed_histogram``), ``px``, ``px_err``,
+        ``v2_given_x``, ``v2_given_x_err``, ``px_controlled``, ``px_controlled_err``,
+        ``v2_given_x_controlled``, ``v2_given_x_controlled_err``.  NaN where a value is
+        undefined: P(x) in the overflow bin, errors and <v^2>_x in bins the particle never
+        visited.  The ``*_controlled`` columns are the same with each bin's time and
+        int v^2 dt corrected by the control variates of ``tallies.RATE_CONTROLS``
+        (``control_variate_adjusted``: the same expectation, less variance; NaN with fewer
+        than ``SHARDS_PER_CONTROL`` x ``len(RATE_CONTROLS)`` shards).
+
+    Examples
+    --------
+    See the module's example.
     """
     bins = shards[0].position_bins
     lower, upper = bins.lower, bins.upper
@@ -175,13 +347,26 @@ def position_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
 
 
 def distribution_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
-    """P(x, v) as cell averages: the time in each cell of (x, v) over the total time and the
-    cell's area (x on the position bins, v on the velocity bins).
+    """P(x, v) as cell averages: the time in each cell of (x, v) over the total time and its area.
 
-    Columns x_lo, x_hi, v_lo, v_hi, pxv, pxv_err, one row per cell, v fastest.  pxv is NaN
-    in cells of infinite area (x overflow, v under- and overflow); pxv_err also in cells the
-    particle never visited.  The x underflow cell [0, x_lo) also holds the rare bridge draws
-    below x = 0 (see ``simulation``).
+    x is on the position bins, v on the velocity bins.  The x underflow cell [0, x_lo) also
+    holds the rare bridge draws below x = 0 (see ``simulation``).
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards, all on the same position and velocity bins.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per cell, v fastest, columns ``x_lo``, ``x_hi``, ``v_lo``, ``v_hi``,
+        ``pxv``, ``pxv_err``.  pxv is NaN in cells of infinite area (x overflow, v under- and
+        overflow); pxv_err also in cells the particle never visited.
+
+    Examples
+    --------
+    See the module's example.
     """
     first = shards[0]
     x_lower, x_upper = first.position_bins.lower, first.position_bins.upper
@@ -207,11 +392,26 @@ def distribution_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
 
 
 def flight_time_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
-    """The density of the flight time T between consecutive collisions, per unit T and per
-    flight (bin averages): counts / (flights x bin width).
+    """The density of the flight time T between consecutive collisions, per unit T and per flight.
 
-    Columns t_lo, t_hi, t (geometric centre; the arithmetic one for the underflow bin
-    [0, t_lo)), density, density_err.  NaN in the overflow bin; density_err NaN in empty bins.
+    Bin averages: counts / (flights x bin width).
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards, all on the same flight-time bins.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per flight-time bin, under- and overflow included, columns ``t_lo``,
+        ``t_hi``, ``t`` (geometric centre; the arithmetic one for the underflow bin
+        [0, t_lo)), ``density``, ``density_err``.  NaN in the overflow bin; density_err NaN
+        in empty bins.
+
+    Examples
+    --------
+    See the module's example.
     """
     bins = shards[0].flight_time_bins
     lower, upper = bins.lower, bins.upper
@@ -232,12 +432,25 @@ def flight_time_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
 
 
 def return_speed_table(shards: list[ShardTallies]) -> pd.DataFrame:
-    """The return speed v at the next collision given the outgoing speed u of a bounce: the
-    probability of each v bin given the u bin, counts over the counts of that u row.
+    """The return speed v at the next collision given the outgoing speed u of a bounce.
 
-    Columns u_lo, u_hi, v_lo, v_hi, probability, probability_err, one row per (u, v) bin
-    pair of the speed bins, v fastest.  NaN (both) in rows of u with no flight;
-    probability_err NaN where the pair was never seen.
+    The probability of each v bin given the u bin: counts over the counts of that u row.
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards, all on the same speed bins.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per (u, v) pair of the speed bins, v fastest, columns ``u_lo``, ``u_hi``,
+        ``v_lo``, ``v_hi``, ``probability``, ``probability_err``.  NaN (both) in rows of u
+        with no flight; probability_err NaN where the pair was never seen.
+
+    Examples
+    --------
+    See the module's example.
     """
     bins = shards[0].speed_bins
     lower, upper = bins.lower, bins.upper
@@ -266,19 +479,43 @@ def _delta_x(int_x, int_x2, time):
     return np.sqrt(int_x2 / time - (int_x / time) ** 2)
 
 
-# the moments the summary also gives corrected by MOMENT_CONTROLS (``{name}_controlled``)
+#: The moments ``position_moments_summary`` also gives corrected by the control variates of
+#: ``moment_controls`` (its columns ``{name}_controlled``).
 CONTROLLED_MOMENTS = ("mean_x", "delta_x", "mean_flight_time", "flight_time_second_moment")
 
 
 def position_moments_summary(shards: list[ShardTallies], restitution: float) -> pd.DataFrame:
-    """One row: <x>, Delta x and the collision rate I, eqs. (collrate), (xandDeltax), and the
-    mean and second moment of the flight time per flight.  Each is given twice: plain (the
-    time averages, collisions per time, the flights' averages) and ``*_controlled``, the same
-    with each sum (the collisions, int x dt, int x^2 dt, the flights, sum T, sum T^2)
-    corrected by martingale control variates of mean 0 before the ratio
-    (``control_variate_adjusted``: the same expectation, less variance), those of
-    ``moment_controls``: MOMENT_CONTROLS or the fewer RATE_CONTROLS, as many as the shards
-    can fit (``shard_controls``), none (NaN) with too few shards."""
+    """One row of moments: <x>, Delta x, the collision rate I and the flight time's moments.
+
+    <x> and Delta x are eq. (xandDeltax), I eq. (collrate); the flight time T has its mean and
+    second moment per flight.  Each is given twice: plain (the time averages, collisions per
+    time, the flights' averages) and ``*_controlled`` (the moments of
+    ``CONTROLLED_MOMENTS`` and I), the same with each sum (the collisions, int x dt,
+    int x^2 dt, the flights, sum T, sum T^2) corrected by martingale control variates of mean
+    0 before the ratio (``control_variate_adjusted``: the same expectation, less variance),
+    those of ``moment_controls``: ``tallies.MOMENT_CONTROLS`` or the fewer
+    ``tallies.RATE_CONTROLS``, as many as the shards can fit (``shard_controls``), none (NaN)
+    with too few shards.
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards.
+    restitution : float
+        The restitution coefficient r of the shards, written in column ``r``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row: ``r``; ``mean_x``, ``delta_x``, ``collision_rate``, ``mean_flight_time``,
+        ``flight_time_second_moment``, each with ``_err`` and ``_controlled`` and
+        ``_controlled_err``; the totals ``flights``, ``total_time``, ``collisions``,
+        ``steps``, ``shards`` and ``shards_out_of_budget``.
+
+    Examples
+    --------
+    See the module's example.
+    """
     time = np.array([s.time for s in shards])
     int_x = np.array([s.int_x for s in shards])
     int_x2 = np.array([s.int_x2 for s in shards])
@@ -349,22 +586,56 @@ def _bin_centres(lower, upper):
 def control_variate_rate(tallies, times, controls):
     """A rate per unit time corrected by martingale control variates, and its standard error.
 
-    ``tallies`` (shards, or shards x bins) are what each shard counted (e.g. its collisions),
-    ``times`` (shards) its recorded time and ``controls`` (shards x p) sums over the shard's
-    steps of noise terms whose expectation is exactly 0 under the simulated process
-    (``ShardTallies.noise_sum``, the sum of the velocity noise sqrt(2 dt) normal_r of
-    eq. (vstep), ``noise_v_sum``, ``noise_scaled_sum``, ``normal_sum``).  The estimate is
+    The controls are sums over the shard's steps of noise terms whose expectation is exactly
+    0 under the simulated process (``tallies.ShardTallies``: e.g. ``noise_sum``, the sum of
+    the velocity noise sqrt(2 dt) normal_r of eq. (vstep)).  The estimate is::
 
         sum_k (tallies_k - beta_{-k} . controls_k) / sum_k times_k
 
     with beta_{-k} the weighted least-squares slope (with intercept, weights times_j) of
-    tallies_j / times_j on controls_j / times_j over the other shards j != k (cross-fitting).
-    As controls_k has mean 0 and is independent of beta_{-k}, each correction has mean 0: the
-    estimate has the plain estimator's expectation, with no O(1 / shards) bias from the
-    fitted slope.  The standard error is the delete-one jackknife of the corrected per-shard
-    tallies over the times (``jackknife``), which holds the slope's own scatter (the
-    corrections are made out of sample).  Returns (value, error, beta) with beta the slope
-    fitted to all shards (p, or p x bins), for reporting.
+    tallies_j / times_j on controls_j / times_j over the other shards j != k (cross-fitting,
+    ``control_variate_adjusted``).  As controls_k has mean 0 and is independent of
+    beta_{-k}, each correction has mean 0: the estimate has the plain estimator's
+    expectation, with no O(1 / shards) bias from the fitted slope.  The standard error is
+    the delete-one jackknife of the corrected per-shard tallies over the times
+    (``jackknife``), which holds the slope's own scatter (the corrections are made out of
+    sample).
+
+    Parameters
+    ----------
+    tallies : array_like
+        What each shard counted (e.g. its collisions), shape (shards,) or (shards, bins).
+    times : array_like
+        Each shard's recorded time, shape (shards,).
+    controls : array_like
+        Each shard's control sums, shape (shards, p) or (shards,) for p = 1.
+
+    Returns
+    -------
+    value : numpy.ndarray
+        The corrected rate, of the shape of a shard's tallies.
+    error : numpy.ndarray
+        Its jackknife standard error.
+    beta : numpy.ndarray
+        The slope fitted to all shards, (p,) or (p, bins), for reporting.
+
+    Raises
+    ------
+    ValueError
+        With fewer than p + 3 shards.
+
+    Examples
+    --------
+    Tallies that are a rate of 5 plus 3 times a control: the control explains all the
+    scatter, so the corrected rate is 5 with no error.
+
+    >>> import numpy as np
+    >>> from bouncing_ball.histograms import control_variate_rate
+    >>> controls = np.array([1.0, -1.0, 2.0, -2.0, 0.5, -0.5])
+    >>> times = np.full(6, 2.0)
+    >>> value, error, beta = control_variate_rate(5.0 * times + 3.0 * controls, times, controls)
+    >>> print(np.round(value, 12), np.round(error, 12), np.round(beta, 12))
+    5.0 0.0 [3.]
     """
     times = np.asarray(times, dtype=float)
     adjusted, beta = control_variate_adjusted(tallies, times, controls)
@@ -374,12 +645,48 @@ def control_variate_rate(tallies, times, controls):
 
 
 def control_variate_adjusted(tallies, times, controls):
-    """Each shard's tallies less their cross-fitted share of the control variates: the terms
-    ``tallies_k - beta_{-k} . controls_k`` of ``control_variate_rate`` (shards, or shards x
-    bins), and the slope fitted to all shards (p, or p x bins).  Each adjusted tally has the
-    plain tally's expectation (controls_k has mean 0 and is independent of beta_{-k}), so any
-    function of their sums is estimated as of the plain ones, with its error by ``jackknife``
-    (e.g. Delta x from the adjusted int x dt and int x^2 dt)."""
+    """Each shard's tallies less their cross-fitted share of the control variates.
+
+    These are the terms ``tallies_k - beta_{-k} . controls_k`` of ``control_variate_rate``.
+    Each adjusted tally has the plain tally's expectation (controls_k has mean 0 and is
+    independent of beta_{-k}), so any function of their sums is estimated as of the plain
+    ones, with its error by ``jackknife`` (e.g. Delta x from the adjusted int x dt and
+    int x^2 dt).
+
+    Parameters
+    ----------
+    tallies : array_like
+        Each shard's tallies, shape (shards,) or (shards, ...).
+    times : array_like
+        Each shard's recorded time, shape (shards,): the weights of the fit.
+    controls : array_like
+        Each shard's control sums, shape (shards, p) or (shards,) for p = 1.
+
+    Returns
+    -------
+    adjusted : numpy.ndarray
+        The adjusted tallies, of the shape of ``tallies``.
+    beta : numpy.ndarray
+        The slope fitted to all shards, shape (p, ...).
+
+    Raises
+    ------
+    ValueError
+        With fewer than p + 3 shards.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bouncing_ball.histograms import control_variate_adjusted
+    >>> controls = np.array([1.0, -1.0, 2.0, -2.0])
+    >>> adjusted, beta = control_variate_adjusted(10.0 + 3.0 * controls, np.ones(4), controls)
+    >>> print(np.round(adjusted, 12), np.round(beta, 12))
+    [10. 10. 10. 10.] [3.]
+    >>> control_variate_adjusted(np.ones(3), np.ones(3), np.ones(3))
+    Traceback (most recent call last):
+    ...
+    ValueError: 3 shards are too few for 1 control variates (need 4)
+    """
     tallies = np.asarray(tallies, dtype=float)
     times = np.asarray(times, dtype=float)
     controls = np.asarray(controls, dtype=float)

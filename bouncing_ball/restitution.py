@@ -30,10 +30,10 @@ EXACT_RESTITUTIONS = (Fraction(1, 2), Fraction(1, 3))
 #: matter (the answer is wrong by 2% at 0.015, by 50% at 0.01); above 0.9999 the dense grid,
 #: ~ (1 - r)^(-1/2) nodes, outgrows a job.  The bounds are exact decimals: 0.02 is 1/50.
 SOLVER_RESTITUTION_RANGE = (0.02, 0.9999)
-# the r for which the whole distribution from P(0, v) (bouncing_ball.distribution: w(F), P(x),
-# P(x, v)) meets the same target, and so every table of rule solve: the r of a run.  Above, int
-# P dx drifts from 1 (by 5e-8 at r = 0.93, 3e-6 at 0.95, 1e-4 at 0.99): the weight of P(x)
-# moves to forces F where w(F) is not computed accurately
+#: The r for which the whole distribution from P(0, v) (bouncing_ball.distribution: w(F), P(x),
+#: P(x, v)) meets the same target, and so every table of rule solve: the r of a run.  Above, int
+#: P dx drifts from 1 (by 5e-8 at r = 0.93, 3e-6 at 0.95, 1e-4 at 0.99): the weight of P(x)
+#: moves to forces F where w(F) is not computed accurately.
 DISTRIBUTION_RESTITUTION_RANGE = (0.02, 0.9)
 
 

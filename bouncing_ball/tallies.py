@@ -65,6 +65,10 @@ __all__ = [
     "HISTOGRAMS",
     "HISTOGRAMS_2D",
     "CONTROL_VARIATE_SUMS",
+    "MOMENT_CONTROL_SUMS",
+    "MOMENT_CONTROLS",
+    "RATE_CONTROLS",
+    "SHARDS_PER_CONTROL",
     "EARLY_FRACTION",
     "EARLY_SUMS",
     "SCALARS",
@@ -91,11 +95,13 @@ HISTOGRAMS_2D = {
     "position_velocity_time": (("position_bins", "velocity_bins"), "position_velocity_time", False),
     "return_speed": (("speed_bins", "speed_bins"), "return_speed_counts", True),
 }
-# the martingale sums of mean 0 that correct I (``histograms.control_variate_rate``)
+#: The martingale sums of mean 0 in the velocity noise xi_n = sqrt(2 dt_n) normal_r of
+#: eq. (vstep): of xi_n, v_n xi_n, v_n xi_n / (x_n + v_n^2 / 2 + 4 dt_n) and normal_r, at the
+#: step's start state; in every set of control variates (``RATE_CONTROLS``, ``MOMENT_CONTROLS``).
 CONTROL_VARIATE_SUMS = ("noise_sum", "noise_v_sum", "noise_scaled_sum", "normal_sum")
-# more such sums, with weights polynomial in the step's start state, that correct the moments
-# of x and the flights (``histograms.position_moments_summary``); xi_n = sqrt(2 dt_n) normal_r,
-# q_n = xi_n^2 - 2 dt_n and eta_n = dt_n^(3/2) normal_s, the noises of eqs. (xstep), (vstep)
+#: More such sums, with weights polynomial in the step's start state, that correct the moments
+#: of x and the flights (``histograms.position_moments_summary``); xi_n = sqrt(2 dt_n) normal_r,
+#: q_n = xi_n^2 - 2 dt_n and eta_n = dt_n^(3/2) normal_s, the noises of eqs. (xstep), (vstep).
 MOMENT_CONTROL_SUMS = (
     "noise_x_sum",
     "noise_xv_sum",
@@ -112,17 +118,23 @@ MOMENT_CONTROL_SUMS = (
     "position_noise_v_sum",
     "position_noise_x_sum",
 )
-# the control variates of the summary's moments (I, <x>, Delta x, the flights' moments),
-# and the fewer of I with few shards and of the bins of P(0, v), P(x) and <v^2>_x
+#: The control variates of the summary's moments (I, <x>, Delta x, the flights' moments):
+#: all the sums of mean 0 (``histograms.moment_controls``).
 MOMENT_CONTROLS = (*CONTROL_VARIATE_SUMS, *MOMENT_CONTROL_SUMS)
+#: The fewer control variates of the summary's moments with few shards, and those of the bins
+#: of P(0, v), P(x) and <v^2>_x.
 RATE_CONTROLS = (*CONTROL_VARIATE_SUMS, "noise_squared_sum")
-# the shards per control variate that a correction needs: with fewer, the cross-fitted
-# slopes' noise makes the jackknife error too small (histograms.shard_controls)
+#: The shards per control variate that a correction needs: with fewer, the cross-fitted
+#: slopes' noise makes the jackknife error too small (``histograms.shard_controls``).
 SHARDS_PER_CONTROL = 3
-# the same sums over the early part of the recording, the steps that start before
-# EARLY_FRACTION x shard_time: the shard's own evidence of equilibration (``equilibration``)
+#: The fraction of the recording whose steps ``EARLY_SUMS`` sum over: those that start before
+#: ``EARLY_FRACTION`` x shard_time.
 EARLY_FRACTION = 0.125
+#: The time, collisions, int x dt and int x^2 dt over the early part of the recording
+#: (``EARLY_FRACTION``): the shard's own evidence of equilibration (``equilibration``).
 EARLY_SUMS = ("early_time", "early_collisions", "early_int_x", "early_int_x2")
+#: The scalars of a shard, in their order in its table and in the array a compiled shard loop
+#: fills: the totals, then ``CONTROL_VARIATE_SUMS``, ``EARLY_SUMS`` and ``MOMENT_CONTROL_SUMS``.
 SCALARS = (
     "time",
     "collisions",
@@ -140,6 +152,8 @@ SCALARS = (
 #: Where each scalar of ``SCALARS`` sits in the array a compiled shard loop fills.
 SCALAR_INDEX = {name: index for index, name in enumerate(SCALARS)}
 _INTEGER = ("collisions", "steps", "budget_exhausted", "flights", "early_collisions")
+#: The four bins a shard is recorded on, fields of ``ShardTallies`` and of
+#: ``settings.ShardSettings``.
 BINS = ("speed_bins", "position_bins", "velocity_bins", "flight_time_bins")
 
 
@@ -204,9 +218,12 @@ class ShardTallies:
     budget_exhausted, flights, flight_time_sum, flight_time_squared_sum : int or float
         Scalars of ``SCALARS``: shards that ran out of their step budget, flights recorded (one
         per recorded collision with an earlier collision) and the sums of their T and T^2.
-    noise_sum, noise_v_sum, noise_scaled_sum, normal_sum : float
-        The control variates of ``CONTROL_VARIATE_SUMS``, sums of mean 0 over the recorded
-        steps (velocity noise of eq. (vstep)).
+    **control_variates : float
+        One field per name of ``CONTROL_VARIATE_SUMS`` (the velocity noise of eq. (vstep))
+        and of ``MOMENT_CONTROL_SUMS`` (the noises of eqs. (xstep), (vstep) with weights
+        polynomial in the step's start state): sums of mean 0 over the recorded steps, the
+        martingale control variates, all of them ``MOMENT_CONTROLS``, the fewer
+        ``RATE_CONTROLS``.
     early_time, early_collisions, early_int_x, early_int_x2 : float or int
         ``EARLY_SUMS``: time, collisions, int x dt and int x^2 dt over the first
         ``EARLY_FRACTION`` of the recording.
