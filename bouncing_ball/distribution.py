@@ -65,7 +65,7 @@ import bisect
 import cmath
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -100,12 +100,34 @@ SMALL_PANEL_WIDTH = 1.2  # (F < 1, r > 1/2)
 PANEL_CHEBYSHEV_NODES = 12
 SMALL_FORCE_DEGREE = 5  # of the polynomial in F continuing ln w below F_min
 PANEL_NODES = 10  # Gauss-Legendre nodes per panel of the real-axis v integrals
+# P(0, v) e^(q v) in the wedge 0 <= arg v <= THETA_MAX, |v| >= WEDGE_SMALLEST_SPEED, is
+# interpolated from Nystrom sums at the nodes of cells WEDGE_SPEED_WIDTH wide in s = ln |v| +
+# |v|^(1/2) and WEDGE_ANGLE_WIDTH wide in arg v (tensor Chebyshev, ~1e-13 relative: the contour
+# integrals of w(F) need ~1e4 values per r, the cells ~1e3 sums)
+WEDGE_SMALLEST_SPEED = 5e-4
+WEDGE_SPEED_WIDTH = 2.0
+WEDGE_SPEED_NODES = 14
+WEDGE_ANGLE_PANELS = 2
+WEDGE_ANGLE_WIDTH = THETA_MAX / WEDGE_ANGLE_PANELS
+WEDGE_ANGLE_NODES = 8
+# a cell whose Nystrom sums cancel by more (magnitude / |value|) is not interpolated (its nodes'
+# rounding errors would spread over it)
+WEDGE_CLEAN = 1e6
 ACCURATE_RANGE = 0.4  # P(0, v) of a solution is used up to this fraction of its highest node
 NEGLIGIBLE_EFOLDS = 60.0
 
 _TAU_X, _TAU_W = np.polynomial.legendre.leggauss(TAU_NODES)
 _TAU_X, _TAU_W = 0.5 * (_TAU_X + 1.0), 0.5 * _TAU_W
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(PANEL_NODES)
+
+
+def _chebyshev_nodes_and_inverse(count):
+    x = np.cos(np.pi * (np.arange(count) + 0.5) / count)
+    return x, np.linalg.inv(np.polynomial.chebyshev.chebvander(x, count - 1))
+
+
+_WEDGE_SPEED_X, _WEDGE_INVERSE_SPEED = _chebyshev_nodes_and_inverse(WEDGE_SPEED_NODES)
+_WEDGE_ANGLE_X, _WEDGE_INVERSE_ANGLE = _chebyshev_nodes_and_inverse(WEDGE_ANGLE_NODES)
 
 
 # On the outgoing side v > 0 the Airy factor of the F integral of eq. (fpsol) oscillates; up to
@@ -214,6 +236,8 @@ class _OutgoingDensity:
     nodes: np.ndarray  # u grid of the complex Nystrom sum
     log_weights: np.ndarray  # ln(weight u P(0, u))
     remainder: float  # closed-form part of the lower tail, times P(0, u_0)
+    # cells of the interpolant of P(0, v) e^(q v) in the wedge (``_wedge_cell``), built on use
+    cells: dict = field(default_factory=dict, compare=False, repr=False)
 
     def log_density(self, v):
         """ln P(0, v), real v in (0, largest]."""
@@ -233,8 +257,72 @@ class _OutgoingDensity:
         return np.where(below, power, smooth - self.beta * np.log(v) - self.q * v)
 
     def scaled_complex(self, v):
-        """P(0, v) e^(q v) at complex v, |arg v| < pi/3, and the sum of the magnitudes of the
-        terms of the Nystrom sum (rounding errors are ~1e-16 of it: at complex v the terms
+        """P(0, v) e^(q v) at complex v, |arg v| < pi/3, and a bound on its rounding error in
+        units of EPSILON: from the wedge interpolant (``_wedge_cell``) where v lies in a clean
+        cell of it, else from the Nystrom sum (``scaled_complex_direct``)."""
+        v = np.asarray(v, dtype=complex)
+        shape = v.shape
+        v = v.ravel()
+        value, magnitude = np.empty(v.size, dtype=complex), np.empty(v.size)
+        rho, theta = np.abs(v), np.angle(v)
+        inside = (
+            (rho >= WEDGE_SMALLEST_SPEED)
+            & (rho <= self.largest)
+            & (theta >= -1e-12)
+            & (theta <= THETA_MAX + 1e-12)
+        )
+        sigma = coordinate_of_speed(np.where(inside, rho, 1.0))
+        row = np.floor((sigma - self._wedge_origin) / WEDGE_SPEED_WIDTH).astype(int)
+        column = np.clip(np.floor(theta / WEDGE_ANGLE_WIDTH), 0, WEDGE_ANGLE_PANELS - 1).astype(int)
+        direct = ~inside
+        for key in set(zip(row[inside].tolist(), column[inside].tolist())):
+            members = inside & (row == key[0]) & (column == key[1])
+            cell = self._wedge_cell(*key)
+            if cell is None:
+                direct |= members
+                continue
+            value[members], magnitude[members] = _evaluate_wedge_cell(
+                cell, key, self._wedge_origin, sigma[members], theta[members], v[members], self.beta
+            )
+        if direct.any():
+            value[direct], magnitude[direct] = self.scaled_complex_direct(v[direct])
+        return value.reshape(shape), magnitude.reshape(shape)
+
+    @functools.cached_property
+    def _wedge_origin(self):
+        return float(coordinate_of_speed(WEDGE_SMALLEST_SPEED))
+
+    def _wedge_cell(self, row, column):
+        """One cell of the interpolant of P(0, v) e^(q v) in the wedge 0 <= arg v <= THETA_MAX:
+        the Chebyshev coefficients (in s = ln |v| + |v|^(1/2) and arg v) of
+        ln(P(0, v) e^(q v)) + beta ln v, and magnitude / |value| of the Nystrom sums at its
+        nodes; None for a cell in which that ratio exceeds WEDGE_CLEAN somewhere (such v are
+        summed directly)."""
+        key = (row, column)
+        if key not in self.cells:
+            self.cells[key] = self._build_wedge_cell(row, column)
+        return self.cells[key]
+
+    def _build_wedge_cell(self, row, column):
+        sigma = self._wedge_origin + WEDGE_SPEED_WIDTH * (row + 0.5 * (_WEDGE_SPEED_X + 1.0))
+        theta = WEDGE_ANGLE_WIDTH * (column + 0.5 * (_WEDGE_ANGLE_X + 1.0))
+        # the noisiest node first (largest |v| and arg v): a dirty cell costs one sum
+        corner = speed_of_coordinate(sigma.max()) * np.exp(1j * theta.max())
+        value, magnitude = self.scaled_complex_direct(np.array([corner]))
+        if not magnitude[0] <= WEDGE_CLEAN * abs(value[0]):
+            return None
+        rho = speed_of_coordinate(sigma)
+        v = rho[:, None] * np.exp(1j * theta[None, :])
+        value, magnitude = (part.reshape(v.shape) for part in self.scaled_complex_direct(v))
+        noise = magnitude / np.abs(value)
+        if not np.all(noise <= WEDGE_CLEAN):
+            return None
+        log_value = np.log(value) + self.beta * np.log(v)
+        return _WEDGE_INVERSE_SPEED @ log_value @ _WEDGE_INVERSE_ANGLE.T, noise
+
+    def scaled_complex_direct(self, v):
+        """P(0, v) e^(q v) at complex v, |arg v| < pi/3, by the Nystrom sum, and the sum of the
+        magnitudes of its terms (rounding errors are ~1e-16 of it: at complex v the terms
         cancel, increasingly so as Im(v)^2 / Re(v) grows)."""
         v = np.ascontiguousarray(np.asarray(v, dtype=complex).ravel())
         r = self.restitution
@@ -256,6 +344,22 @@ class _OutgoingDensity:
         return (out + tail / (r * r)).reshape(shape), (magnitude + np.abs(tail) / (r * r)).reshape(
             shape
         )
+
+
+def _evaluate_wedge_cell(cell, key, origin, sigma, theta, v, beta):
+    """P(0, v) e^(q v) from a wedge cell, and the sum of the rounding errors of its nodes'
+    Nystrom sums weighted by |Lagrange basis| at v (in the units of ``scaled_complex_direct``'s
+    magnitude: the interpolant carries the rounding errors of all its nodes)."""
+    coefficients, noise = cell
+    t_speed = 2.0 * (sigma - origin) / WEDGE_SPEED_WIDTH - 2.0 * key[0] - 1.0
+    t_angle = 2.0 * theta / WEDGE_ANGLE_WIDTH - 2.0 * key[1] - 1.0
+    speed = np.polynomial.chebyshev.chebvander(t_speed, WEDGE_SPEED_NODES - 1)
+    angle = np.polynomial.chebyshev.chebvander(t_angle, WEDGE_ANGLE_NODES - 1)
+    value = np.exp(np.einsum("pi,ij,pj->p", speed, coefficients, angle) - beta * np.log(v))
+    lagrange_speed = np.abs(speed @ _WEDGE_INVERSE_SPEED)
+    lagrange_angle = np.abs(angle @ _WEDGE_INVERSE_ANGLE)
+    spread = np.einsum("pi,ij,pj->p", lagrange_speed, noise, lagrange_angle)
+    return value, np.abs(value) * spread
 
 
 @njit(cache=True)
@@ -515,7 +619,11 @@ def _compute_kernel_transform_table(density):
     log_vh = np.log(ws * _jacobian(v) * v) + 0.5 * v + density.log_density(v)
     transforms = np.empty(g.size)
     for k, gk in enumerate(g):
-        body = np.sum(np.exp(log_vh + _log_psi(gk, v)))
+        # psi_G(v) <= G^(-1/6) exp(-(2/3) (G^(1/3) v)^(3/2)): the terms beyond e^-NEGLIGIBLE_EFOLDS
+        # of the largest such bound are dropped before the Airy function is evaluated
+        bound = log_vh - np.log(gk) / 6.0 - (2.0 / 3.0) * (gk ** (1.0 / 3.0) * v) ** 1.5
+        kept = bound > np.max(bound) - 2.0 * NEGLIGIBLE_EFOLDS
+        body = np.sum(np.exp(log_vh[kept] + _log_psi(gk, v[kept])))
         small = (
             np.exp(density.log_amplitude + _log_psi(gk, 0.0))
             * SMALLEST_SPEED ** (2.0 - beta)
@@ -565,15 +673,16 @@ def _log_contour_part(density, force):
     v, wv = _contour(force, v1, q)
     # drop the nodes where the Airy factor times e^((1/2 - q) Re v) (|h| up to powers of v)
     # is below e^-50 of the largest term
-    estimate = np.log(np.abs(wv * v)) + (0.5 - q) * v.real + _log_psi_omega(force, v).real
+    log_airy = _log_psi_omega(force, v)
+    estimate = np.log(np.abs(wv * v)) + (0.5 - q) * v.real + log_airy.real
     keep = estimate > max(np.max(estimate), np.max(all_terms)) - 50.0
-    v, wv = v[keep], wv[keep]
+    v, wv, log_airy = v[keep], wv[keep], log_airy[keep]
     if np.max(np.abs(v)) > density.largest:
         raise ValueError(
             f"w({force}) needs P(0, v) at |v| = {np.max(np.abs(v)):.4g} > {density.largest:.4g}"
         )
     scaled, magnitude = density.scaled_complex(v)
-    log_rest = np.log(wv * v) + (0.5 - q) * v + _log_psi_omega(force, v)
+    log_rest = np.log(wv * v) + (0.5 - q) * v + log_airy
     log_terms_c = np.log(scaled) + log_rest  # complex logs
     top = max(np.max(log_terms_c.real), np.max(all_terms))
     contour = 2.0 * np.sum(np.exp(log_terms_c - top)).real
