@@ -761,9 +761,9 @@ class WeightFunction:
     def _smooth(self, y):
         index = np.clip(np.searchsorted(self.edges, y) - 1, 0, len(self.series) - 1)
         out = np.empty_like(y)
-        for k, piece in enumerate(self.series):
+        for k in np.unique(index):
             chosen = index == k
-            out[chosen] = piece(y[chosen])
+            out[chosen] = self.series[k](y[chosen])
         return out
 
     def log(self, force):
@@ -772,31 +772,43 @@ class WeightFunction:
         y = np.atleast_1d(np.log(force)).astype(float)
         lo, hi = self.edges[0], self.edges[-1]
         smooth = self._smooth(np.clip(y, lo, hi))
-        last = self.series[-1]
         below = y < lo
         f_below = np.exp(y[below])
         smooth[below] = self.small_force_power * y[below] + self.small_force_series(f_below)
         above = y > hi
         if above.any():
-            decay = self.small_force_decay
-            value = last(hi) - decay * np.exp(-hi)  # ln w at F_max
-            slope = last.deriv()(hi) + decay * np.exp(-hi)  # d ln w / d ln F
-            alpha = (2.0 * self.small_speed_exponent - 5.0) / 6.0
-            kappa = 3.0 * (alpha - slope)
+            value, alpha, kappa = self._large_force_law
             t = y[above] - hi
             smooth[above] = (
                 value
                 + alpha * t
                 + np.log((1.0 - kappa) + kappa * np.exp(-t / 3.0))
-                + decay * np.exp(-y[above])
+                + self.small_force_decay * np.exp(-y[above])
             )
         return (smooth - self.small_force_decay * np.exp(-y)).reshape(np.shape(force))
+
+    @functools.cached_property
+    def _large_force_law(self):
+        """ln w(F_max), alpha and kappa of the continuation above F_max."""
+        hi, last, decay = self.edges[-1], self.series[-1], self.small_force_decay
+        value = last(hi) - decay * np.exp(-hi)  # ln w at F_max
+        slope = last.deriv()(hi) + decay * np.exp(-hi)  # d ln w / d ln F
+        alpha = (2.0 * self.small_speed_exponent - 5.0) / 6.0
+        return float(value), alpha, float(3.0 * (alpha - slope))
 
     def log_scalar(self, force: float) -> float:
         """ln w(F) for one F (a fast path for scalar integrands: Clenshaw on the panel's series)."""
         y = math.log(force)
-        if not self.edges[0] <= y <= self.edges[-1]:
-            return float(self.log(force))
+        if y > self._edge_list[-1]:
+            value, alpha, kappa = self._large_force_law
+            t = y - self._edge_list[-1]
+            return value + alpha * t + math.log((1.0 - kappa) + kappa * math.exp(-t / 3.0))
+        if y < self._edge_list[0]:
+            return float(
+                self.small_force_power * y
+                + self.small_force_series(force)
+                - self.small_force_decay / force
+            )
         index = min(bisect.bisect_right(self._edge_list, y) - 1, len(self.series) - 1)
         a, b = self._edge_list[index], self._edge_list[index + 1]
         t = (2.0 * y - a - b) / (b - a)
