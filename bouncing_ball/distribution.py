@@ -605,13 +605,10 @@ def _kernel_transform_table(density):
     return table
 
 
-def _compute_kernel_transform_table(density):
-    """ln T(G) at Gauss-Legendre nodes in ln G, with the weights of int dG/(2 pi) e^(-1/(12G)) ...,
-    and the closed-form remainder above LARGEST_KERNEL_FORCE (returned as a coefficient of
-    int_{G_c}^inf G^alpha / (F + G) dG)."""
+def _kernel_transforms(density, g):
+    """T(G) = int_0^inf dv v h(v) psi_G(v) at the forces ``g`` (Gauss-Legendre panels in s, and
+    the closed form C psi_G(0) eps^(2-beta) / (2-beta) below eps = SMALLEST_SPEED)."""
     beta = density.beta
-    log_g, wg = _panels(np.log(2e-3), np.log(LARGEST_KERNEL_FORCE), 1.0)
-    g = np.exp(log_g)
     # v grid: Gauss-Legendre panels in s up to where P(0, v) has fallen by e^-60 from its peak
     top = min(density.largest, 20.0 + NEGLIGIBLE_EFOLDS / density.q)
     s, ws = _panels(coordinate_of_speed(SMALLEST_SPEED), coordinate_of_speed(top), 0.5)
@@ -619,8 +616,8 @@ def _compute_kernel_transform_table(density):
     log_vh = np.log(ws * _jacobian(v) * v) + 0.5 * v + density.log_density(v)
     transforms = np.empty(g.size)
     for k, gk in enumerate(g):
-        # psi_G(v) <= G^(-1/6) exp(-(2/3) (G^(1/3) v)^(3/2)): the terms beyond e^-NEGLIGIBLE_EFOLDS
-        # of the largest such bound are dropped before the Airy function is evaluated
+        # psi_G(v) <= G^(-1/6) exp(-(2/3) (G^(1/3) v)^(3/2)): the terms beyond e^-120 of the
+        # largest such bound are dropped before the Airy function is evaluated
         bound = log_vh - np.log(gk) / 6.0 - (2.0 / 3.0) * (gk ** (1.0 / 3.0) * v) ** 1.5
         kept = bound > np.max(bound) - 2.0 * NEGLIGIBLE_EFOLDS
         body = np.sum(np.exp(log_vh[kept] + _log_psi(gk, v[kept])))
@@ -631,8 +628,38 @@ def _compute_kernel_transform_table(density):
             * (1.0 + _small_speed_slope(gk, beta))
         )
         transforms[k] = body + small
-    weights = wg * g * np.exp(-1.0 / (12.0 * g)) / (2.0 * np.pi)
+    return transforms
+
+
+# T(G) G^-alpha e^(1/(12G)) (smooth in ln G, alpha = (2 beta - 5)/6) is computed at
+# KERNEL_TRANSFORM_NODES Chebyshev nodes on panels KERNEL_TRANSFORM_WIDTH wide in ln G and
+# interpolated to the quadrature nodes of B(F)
+KERNEL_TRANSFORM_WIDTH = 3.0
+KERNEL_TRANSFORM_NODES = 16
+
+
+def _compute_kernel_transform_table(density):
+    """T(G) at Gauss-Legendre nodes in ln G, with the weights of int dG/(2 pi) e^(-1/(12G)) ...,
+    and the closed-form remainder above LARGEST_KERNEL_FORCE (returned as a coefficient of
+    int_{G_c}^inf G^alpha / (F + G) dG)."""
+    beta = density.beta
     alpha = (2.0 * beta - 5.0) / 6.0
+    lo, hi = np.log(2e-3), np.log(LARGEST_KERNEL_FORCE)
+    log_g, wg = _panels(lo, hi, 1.0)
+    g = np.exp(log_g)
+    count = int(np.ceil((hi - lo) / KERNEL_TRANSFORM_WIDTH))
+    edges = np.linspace(lo, hi, count + 1)
+    x = np.cos(np.pi * (np.arange(KERNEL_TRANSFORM_NODES) + 0.5) / KERNEL_TRANSFORM_NODES)
+    nodes = 0.5 * (edges[:-1, None] + edges[1:, None]) + 0.5 * np.diff(edges)[:, None] * x
+    at_nodes = np.exp(nodes)
+    smooth = _kernel_transforms(density, at_nodes.ravel()).reshape(nodes.shape)
+    smooth *= np.exp(1.0 / (12.0 * at_nodes) - alpha * nodes)
+    index = np.clip(np.searchsorted(edges, log_g) - 1, 0, count - 1)
+    t = (2.0 * log_g - edges[index] - edges[index + 1]) / (edges[index + 1] - edges[index])
+    coefficients = np.array([np.polynomial.chebyshev.chebfit(x, row, x.size - 1) for row in smooth])
+    interpolated = np.polynomial.chebyshev.chebval(t, coefficients[index].T, tensor=False)
+    transforms = interpolated * np.exp(alpha * log_g - 1.0 / (12.0 * g))
+    weights = wg * g * np.exp(-1.0 / (12.0 * g)) / (2.0 * np.pi)
     tail_coefficient = np.exp(density.log_amplitude) * _airy_mellin(2.0 - beta) / (2.0 * np.pi)
     tail = tail_coefficient * LARGEST_KERNEL_FORCE**alpha / -alpha  # F << G_c
     return g, weights, transforms, tail
