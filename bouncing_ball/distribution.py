@@ -1067,10 +1067,11 @@ def _distribution_integrand(log_force, x, v, weight, width=0.0):
     log_rest = log_w + log_force - f * x - 0.5 * v - log_force / 6.0
     if width > 0.0:
         log_rest += math.log(-math.expm1(-f * width) / (f * width))
-    if argument > 0.0:
-        airy = special.airye(argument)[0] if argument < 1e6 else float(_airy_scaled(argument))
-        return airy * math.exp(log_rest - (2.0 / 3.0) * argument**1.5)
-    return special.airy(argument)[0] * math.exp(log_rest)
+    if argument <= 0.0 or (argument < 30.0 and abs(log_rest) < 600.0):
+        # (Ai alone: scipy's airy is half the cost of airye; Ai(30) ~ 1e-48 is still a double)
+        return special.airy(argument)[0] * math.exp(log_rest)
+    airy = special.airye(argument)[0] if argument < 1e6 else float(_airy_scaled(argument))
+    return airy * math.exp(log_rest - (2.0 / 3.0) * argument**1.5)
 
 
 def check_force_integral_point(x: float, v: float) -> None:
