@@ -40,7 +40,9 @@ exp(-c F^(1/2) |v|^(3/2)), faster than any exponential.  h is analytic for
 Nystrom formula of the solver, P(0, v) = r^-2 int du u G_g(v/r, u) P(0, u),
 with G_g continued to complex v (``_complex_kernel_sums``) and the u integral
 on a grid REFINE times finer than the solver's (the trapezoidal rule in
-ln u loses accuracy as exp(-2 pi (pi/3 - arg v) / step)).  The split point
+ln u loses accuracy as exp(-2 pi (pi/3 - arg v) / step)), summed at the nodes of Chebyshev
+cells of the wedge 0 <= arg v <= THETA_MAX and interpolated in between
+(``_OutgoingDensity.scaled_complex``; directly where the sums cancel).  The split point
 is v1 = 1/(4F) where q >= 1/2 and the saddle of the continued integrand,
 v1 = q (1 - q) / F, where q < 1/2: there the real-axis part is exponentially
 smaller than the result and nothing cancels.  At small F,
