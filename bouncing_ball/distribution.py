@@ -112,10 +112,10 @@ WEDGE_SPEED_NODES = 14
 WEDGE_ANGLE_PANELS = 2
 WEDGE_ANGLE_WIDTH = THETA_MAX / WEDGE_ANGLE_PANELS
 WEDGE_ANGLE_NODES = 8
-# a cell whose Nystrom sums cancel by more (magnitude / |value|) is not interpolated (its nodes'
-# rounding errors would spread over it; below 1e10 they are at most ~1e-6 of each value, so its
-# logarithm, which is interpolated, carries them linearly)
-WEDGE_CLEAN = 1e10
+# a cell whose Nystrom sums cancel by more (magnitude / |value|) is not interpolated: its nodes'
+# rounding errors would spread over it (the bound of the spread, in the noise estimate of w,
+# would raise F_min where r > 0.9)
+WEDGE_CLEAN = 1e6
 ACCURATE_RANGE = 0.4  # P(0, v) of a solution is used up to this fraction of its highest node
 NEGLIGIBLE_EFOLDS = 60.0
 
