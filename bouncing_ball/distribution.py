@@ -372,26 +372,30 @@ def _complex_kernel_sums(v, r, q, u, log_weights, tau_x, tau_w, out, magnitude):
     along the straight segment from 0 to tau1).  Terms below e^-SKIP_EFOLDS of the largest
     are skipped (at large |v| the kernel confines u to a window of width ~ |v|^(1/2))."""
     root3_pi = math.sqrt(3.0) / math.pi
+    # per u: z0, the exponent and its real part with the u^(1/2) bound (first pass, reused)
+    z0s = np.empty(u.size, dtype=np.complex128)
+    exponents = np.empty(u.size, dtype=np.complex128)
+    levels = np.empty(u.size)
     for i in range(v.size):
         big_v = v[i] / r
+        size_v = abs(big_v)
         best = -1e300
         for j in range(u.size):
             d = big_v - u[j]
             z0 = cmath.sqrt(d * d + big_v * u[j])
-            e = (-0.75 * d * d / (0.5 * (big_v + u[j]) + z0)).real + log_weights[j]
-            e += 0.5 * math.log(min(u[j] / abs(big_v), 1.0))  # G ~ u^(1/2) for u << |v|
-            if e > best:
-                best = e
+            exponent = -0.75 * d * d / (0.5 * (big_v + u[j]) + z0) + log_weights[j]
+            z0s[j] = z0
+            exponents[j] = exponent
+            # G ~ u^(1/2) for u << |v|
+            levels[j] = exponent.real + 0.5 * math.log(min(u[j] / size_v, 1.0))
+            if levels[j] > best:
+                best = levels[j]
         total = 0.0 + 0.0j
         size = 0.0
         for j in range(u.size):
-            d = big_v - u[j]
-            z0_squared = d * d + big_v * u[j]
-            z0 = cmath.sqrt(z0_squared)
-            exponent = -0.75 * d * d / (0.5 * (big_v + u[j]) + z0) + log_weights[j]
-            if exponent.real + 0.5 * math.log(min(u[j] / abs(big_v), 1.0)) < best - 46.0:
+            if levels[j] < best - 46.0:
                 continue
-            if u[j] < 1e-13 * abs(big_v):
+            if u[j] < 1e-13 * size_v:
                 # kernel.kernel_small_u_limit: relative error O(u / |v|)
                 term = (
                     1.5
@@ -404,6 +408,7 @@ def _complex_kernel_sums(v, r, q, u, log_weights, tau_x, tau_w, out, magnitude):
                 total += term
                 size += abs(term)
                 continue
+            z0 = z0s[j]
             tau1 = cmath.sqrt(3.0 * big_v * u[j] / ((big_v + u[j] + z0) * z0))
             decay = (z0 * tau1 * tau1).real
             upper = tau1
@@ -419,7 +424,7 @@ def _complex_kernel_sums(v, r, q, u, log_weights, tau_x, tau_w, out, magnitude):
                     * (1.0 + z0 * one_t2)
                     / (one_t2 * one_t2 * cmath.sqrt(2.0 + t2))
                 )
-            term = cmath.exp(exponent + q * v[i]) * root3_pi * upper * acc / z0_squared
+            term = cmath.exp(exponents[j] + q * v[i]) * root3_pi * upper * acc / (z0 * z0)
             total += term
             size += abs(term)
         out[i] = total / (r * r)
