@@ -40,7 +40,9 @@ exp(-c F^(1/2) |v|^(3/2)), faster than any exponential.  h is analytic for
 Nystrom formula of the solver, P(0, v) = r^-2 int du u G_g(v/r, u) P(0, u),
 with G_g continued to complex v (``_complex_kernel_sums``) and the u integral
 on a grid REFINE times finer than the solver's (the trapezoidal rule in
-ln u loses accuracy as exp(-2 pi (pi/3 - arg v) / step)).  The split point
+ln u loses accuracy as exp(-2 pi (pi/3 - arg v) / step)), summed at the nodes of Chebyshev
+cells of the wedge 0 <= arg v <= THETA_MAX and interpolated in between
+(``_OutgoingDensity.scaled_complex``; directly where the sums cancel).  The split point
 is v1 = 1/(4F) where q >= 1/2 and the saddle of the continued integrand,
 v1 = q (1 - q) / F, where q < 1/2: there the real-axis part is exponentially
 smaller than the result and nothing cancels.  At small F,
@@ -65,7 +67,7 @@ import bisect
 import cmath
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -100,12 +102,35 @@ SMALL_PANEL_WIDTH = 1.2  # (F < 1, r > 1/2)
 PANEL_CHEBYSHEV_NODES = 12
 SMALL_FORCE_DEGREE = 5  # of the polynomial in F continuing ln w below F_min
 PANEL_NODES = 10  # Gauss-Legendre nodes per panel of the real-axis v integrals
+# P(0, v) e^(q v) in the wedge 0 <= arg v <= THETA_MAX, |v| >= WEDGE_SMALLEST_SPEED, is
+# interpolated from Nystrom sums at the nodes of cells WEDGE_SPEED_WIDTH wide in s = ln |v| +
+# |v|^(1/2) and WEDGE_ANGLE_WIDTH wide in arg v (tensor Chebyshev, ~1e-13 relative: the contour
+# integrals of w(F) need ~1e4 values per r, the cells ~1e3 sums)
+WEDGE_SMALLEST_SPEED = 5e-4
+WEDGE_SPEED_WIDTH = 2.0
+WEDGE_SPEED_NODES = 14
+WEDGE_ANGLE_PANELS = 2
+WEDGE_ANGLE_WIDTH = THETA_MAX / WEDGE_ANGLE_PANELS
+WEDGE_ANGLE_NODES = 8
+# a cell whose Nystrom sums cancel by more (magnitude / |value|) is not interpolated: its nodes'
+# rounding errors would spread over it (the bound of the spread, in the noise estimate of w,
+# would raise F_min where r > 0.9)
+WEDGE_CLEAN = 1e6
 ACCURATE_RANGE = 0.4  # P(0, v) of a solution is used up to this fraction of its highest node
 NEGLIGIBLE_EFOLDS = 60.0
 
 _TAU_X, _TAU_W = np.polynomial.legendre.leggauss(TAU_NODES)
 _TAU_X, _TAU_W = 0.5 * (_TAU_X + 1.0), 0.5 * _TAU_W
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(PANEL_NODES)
+
+
+def _chebyshev_nodes_and_inverse(count):
+    x = np.cos(np.pi * (np.arange(count) + 0.5) / count)
+    return x, np.linalg.inv(np.polynomial.chebyshev.chebvander(x, count - 1))
+
+
+_WEDGE_SPEED_X, _WEDGE_INVERSE_SPEED = _chebyshev_nodes_and_inverse(WEDGE_SPEED_NODES)
+_WEDGE_ANGLE_X, _WEDGE_INVERSE_ANGLE = _chebyshev_nodes_and_inverse(WEDGE_ANGLE_NODES)
 
 
 # On the outgoing side v > 0 the Airy factor of the F integral of eq. (fpsol) oscillates; up to
@@ -214,6 +239,8 @@ class _OutgoingDensity:
     nodes: np.ndarray  # u grid of the complex Nystrom sum
     log_weights: np.ndarray  # ln(weight u P(0, u))
     remainder: float  # closed-form part of the lower tail, times P(0, u_0)
+    # cells of the interpolant of P(0, v) e^(q v) in the wedge (``_wedge_cell``), built on use
+    cells: dict = field(default_factory=dict, compare=False, repr=False)
 
     def log_density(self, v):
         """ln P(0, v), real v in (0, largest]."""
@@ -233,8 +260,72 @@ class _OutgoingDensity:
         return np.where(below, power, smooth - self.beta * np.log(v) - self.q * v)
 
     def scaled_complex(self, v):
-        """P(0, v) e^(q v) at complex v, |arg v| < pi/3, and the sum of the magnitudes of the
-        terms of the Nystrom sum (rounding errors are ~1e-16 of it: at complex v the terms
+        """P(0, v) e^(q v) at complex v, |arg v| < pi/3, and a bound on its rounding error in
+        units of EPSILON: from the wedge interpolant (``_wedge_cell``) where v lies in a clean
+        cell of it, else from the Nystrom sum (``scaled_complex_direct``)."""
+        v = np.asarray(v, dtype=complex)
+        shape = v.shape
+        v = v.ravel()
+        value, magnitude = np.empty(v.size, dtype=complex), np.empty(v.size)
+        rho, theta = np.abs(v), np.angle(v)
+        inside = (
+            (rho >= WEDGE_SMALLEST_SPEED)
+            & (rho <= self.largest)
+            & (theta >= -1e-12)
+            & (theta <= THETA_MAX + 1e-12)
+        )
+        sigma = coordinate_of_speed(np.where(inside, rho, 1.0))
+        row = np.floor((sigma - self._wedge_origin) / WEDGE_SPEED_WIDTH).astype(int)
+        column = np.clip(np.floor(theta / WEDGE_ANGLE_WIDTH), 0, WEDGE_ANGLE_PANELS - 1).astype(int)
+        direct = ~inside
+        for key in set(zip(row[inside].tolist(), column[inside].tolist())):
+            members = inside & (row == key[0]) & (column == key[1])
+            cell = self._wedge_cell(*key)
+            if cell is None:
+                direct |= members
+                continue
+            value[members], magnitude[members] = _evaluate_wedge_cell(
+                cell, key, self._wedge_origin, sigma[members], theta[members], v[members], self.beta
+            )
+        if direct.any():
+            value[direct], magnitude[direct] = self.scaled_complex_direct(v[direct])
+        return value.reshape(shape), magnitude.reshape(shape)
+
+    @functools.cached_property
+    def _wedge_origin(self):
+        return float(coordinate_of_speed(WEDGE_SMALLEST_SPEED))
+
+    def _wedge_cell(self, row, column):
+        """One cell of the interpolant of P(0, v) e^(q v) in the wedge 0 <= arg v <= THETA_MAX:
+        the Chebyshev coefficients (in s = ln |v| + |v|^(1/2) and arg v) of
+        ln(P(0, v) e^(q v)) + beta ln v, and magnitude / |value| of the Nystrom sums at its
+        nodes; None for a cell in which that ratio exceeds WEDGE_CLEAN somewhere (such v are
+        summed directly)."""
+        key = (row, column)
+        if key not in self.cells:
+            self.cells[key] = self._build_wedge_cell(row, column)
+        return self.cells[key]
+
+    def _build_wedge_cell(self, row, column):
+        sigma = self._wedge_origin + WEDGE_SPEED_WIDTH * (row + 0.5 * (_WEDGE_SPEED_X + 1.0))
+        theta = WEDGE_ANGLE_WIDTH * (column + 0.5 * (_WEDGE_ANGLE_X + 1.0))
+        # the noisiest node first (largest |v| and arg v): a dirty cell costs one sum
+        corner = speed_of_coordinate(sigma.max()) * np.exp(1j * theta.max())
+        value, magnitude = self.scaled_complex_direct(np.array([corner]))
+        if not magnitude[0] <= WEDGE_CLEAN * abs(value[0]):
+            return None
+        rho = speed_of_coordinate(sigma)
+        v = rho[:, None] * np.exp(1j * theta[None, :])
+        value, magnitude = (part.reshape(v.shape) for part in self.scaled_complex_direct(v))
+        noise = magnitude / np.abs(value)
+        if not np.all(noise <= WEDGE_CLEAN):
+            return None
+        log_value = np.log(value) + self.beta * np.log(v)
+        return _WEDGE_INVERSE_SPEED @ log_value @ _WEDGE_INVERSE_ANGLE.T, noise
+
+    def scaled_complex_direct(self, v):
+        """P(0, v) e^(q v) at complex v, |arg v| < pi/3, by the Nystrom sum, and the sum of the
+        magnitudes of its terms (rounding errors are ~1e-16 of it: at complex v the terms
         cancel, increasingly so as Im(v)^2 / Re(v) grows)."""
         v = np.ascontiguousarray(np.asarray(v, dtype=complex).ravel())
         r = self.restitution
@@ -258,6 +349,22 @@ class _OutgoingDensity:
         )
 
 
+def _evaluate_wedge_cell(cell, key, origin, sigma, theta, v, beta):
+    """P(0, v) e^(q v) from a wedge cell, and the sum of the rounding errors of its nodes'
+    Nystrom sums weighted by |Lagrange basis| at v (in the units of ``scaled_complex_direct``'s
+    magnitude: the interpolant carries the rounding errors of all its nodes)."""
+    coefficients, noise = cell
+    t_speed = 2.0 * (sigma - origin) / WEDGE_SPEED_WIDTH - 2.0 * key[0] - 1.0
+    t_angle = 2.0 * theta / WEDGE_ANGLE_WIDTH - 2.0 * key[1] - 1.0
+    speed = np.polynomial.chebyshev.chebvander(t_speed, WEDGE_SPEED_NODES - 1)
+    angle = np.polynomial.chebyshev.chebvander(t_angle, WEDGE_ANGLE_NODES - 1)
+    value = np.exp(np.einsum("pi,ij,pj->p", speed, coefficients, angle) - beta * np.log(v))
+    lagrange_speed = np.abs(speed @ _WEDGE_INVERSE_SPEED)
+    lagrange_angle = np.abs(angle @ _WEDGE_INVERSE_ANGLE)
+    spread = np.einsum("pi,ij,pj->p", lagrange_speed, noise, lagrange_angle)
+    return value, np.abs(value) * spread
+
+
 @njit(cache=True)
 def _complex_kernel_sums(v, r, q, u, log_weights, tau_x, tau_w, out, magnitude):
     """out_i = e^(q v_i) r^-2 sum_j exp(log_weights_j) G_g(v_i / r, u_j) for complex v_i: the
@@ -265,26 +372,30 @@ def _complex_kernel_sums(v, r, q, u, log_weights, tau_x, tau_w, out, magnitude):
     along the straight segment from 0 to tau1).  Terms below e^-SKIP_EFOLDS of the largest
     are skipped (at large |v| the kernel confines u to a window of width ~ |v|^(1/2))."""
     root3_pi = math.sqrt(3.0) / math.pi
+    # per u: z0, the exponent and its real part with the u^(1/2) bound (first pass, reused)
+    z0s = np.empty(u.size, dtype=np.complex128)
+    exponents = np.empty(u.size, dtype=np.complex128)
+    levels = np.empty(u.size)
     for i in range(v.size):
         big_v = v[i] / r
+        size_v = abs(big_v)
         best = -1e300
         for j in range(u.size):
             d = big_v - u[j]
             z0 = cmath.sqrt(d * d + big_v * u[j])
-            e = (-0.75 * d * d / (0.5 * (big_v + u[j]) + z0)).real + log_weights[j]
-            e += 0.5 * math.log(min(u[j] / abs(big_v), 1.0))  # G ~ u^(1/2) for u << |v|
-            if e > best:
-                best = e
+            exponent = -0.75 * d * d / (0.5 * (big_v + u[j]) + z0) + log_weights[j]
+            z0s[j] = z0
+            exponents[j] = exponent
+            # G ~ u^(1/2) for u << |v|
+            levels[j] = exponent.real + 0.5 * math.log(min(u[j] / size_v, 1.0))
+            if levels[j] > best:
+                best = levels[j]
         total = 0.0 + 0.0j
         size = 0.0
         for j in range(u.size):
-            d = big_v - u[j]
-            z0_squared = d * d + big_v * u[j]
-            z0 = cmath.sqrt(z0_squared)
-            exponent = -0.75 * d * d / (0.5 * (big_v + u[j]) + z0) + log_weights[j]
-            if exponent.real + 0.5 * math.log(min(u[j] / abs(big_v), 1.0)) < best - 46.0:
+            if levels[j] < best - 46.0:
                 continue
-            if u[j] < 1e-13 * abs(big_v):
+            if u[j] < 1e-13 * size_v:
                 # kernel.kernel_small_u_limit: relative error O(u / |v|)
                 term = (
                     1.5
@@ -297,6 +408,7 @@ def _complex_kernel_sums(v, r, q, u, log_weights, tau_x, tau_w, out, magnitude):
                 total += term
                 size += abs(term)
                 continue
+            z0 = z0s[j]
             tau1 = cmath.sqrt(3.0 * big_v * u[j] / ((big_v + u[j] + z0) * z0))
             decay = (z0 * tau1 * tau1).real
             upper = tau1
@@ -312,7 +424,7 @@ def _complex_kernel_sums(v, r, q, u, log_weights, tau_x, tau_w, out, magnitude):
                     * (1.0 + z0 * one_t2)
                     / (one_t2 * one_t2 * cmath.sqrt(2.0 + t2))
                 )
-            term = cmath.exp(exponent + q * v[i]) * root3_pi * upper * acc / z0_squared
+            term = cmath.exp(exponents[j] + q * v[i]) * root3_pi * upper * acc / (z0 * z0)
             total += term
             size += abs(term)
         out[i] = total / (r * r)
@@ -501,13 +613,10 @@ def _kernel_transform_table(density):
     return table
 
 
-def _compute_kernel_transform_table(density):
-    """ln T(G) at Gauss-Legendre nodes in ln G, with the weights of int dG/(2 pi) e^(-1/(12G)) ...,
-    and the closed-form remainder above LARGEST_KERNEL_FORCE (returned as a coefficient of
-    int_{G_c}^inf G^alpha / (F + G) dG)."""
+def _kernel_transforms(density, g):
+    """T(G) = int_0^inf dv v h(v) psi_G(v) at the forces ``g`` (Gauss-Legendre panels in s, and
+    the closed form C psi_G(0) eps^(2-beta) / (2-beta) below eps = SMALLEST_SPEED)."""
     beta = density.beta
-    log_g, wg = _panels(np.log(2e-3), np.log(LARGEST_KERNEL_FORCE), 1.0)
-    g = np.exp(log_g)
     # v grid: Gauss-Legendre panels in s up to where P(0, v) has fallen by e^-60 from its peak
     top = min(density.largest, 20.0 + NEGLIGIBLE_EFOLDS / density.q)
     s, ws = _panels(coordinate_of_speed(SMALLEST_SPEED), coordinate_of_speed(top), 0.5)
@@ -515,7 +624,11 @@ def _compute_kernel_transform_table(density):
     log_vh = np.log(ws * _jacobian(v) * v) + 0.5 * v + density.log_density(v)
     transforms = np.empty(g.size)
     for k, gk in enumerate(g):
-        body = np.sum(np.exp(log_vh + _log_psi(gk, v)))
+        # psi_G(v) <= G^(-1/6) exp(-(2/3) (G^(1/3) v)^(3/2)): the terms beyond e^-120 of the
+        # largest such bound are dropped before the Airy function is evaluated
+        bound = log_vh - np.log(gk) / 6.0 - (2.0 / 3.0) * (gk ** (1.0 / 3.0) * v) ** 1.5
+        kept = bound > np.max(bound) - 2.0 * NEGLIGIBLE_EFOLDS
+        body = np.sum(np.exp(log_vh[kept] + _log_psi(gk, v[kept])))
         small = (
             np.exp(density.log_amplitude + _log_psi(gk, 0.0))
             * SMALLEST_SPEED ** (2.0 - beta)
@@ -523,8 +636,38 @@ def _compute_kernel_transform_table(density):
             * (1.0 + _small_speed_slope(gk, beta))
         )
         transforms[k] = body + small
-    weights = wg * g * np.exp(-1.0 / (12.0 * g)) / (2.0 * np.pi)
+    return transforms
+
+
+# T(G) G^-alpha e^(1/(12G)) (smooth in ln G, alpha = (2 beta - 5)/6) is computed at
+# KERNEL_TRANSFORM_NODES Chebyshev nodes on panels KERNEL_TRANSFORM_WIDTH wide in ln G and
+# interpolated to the quadrature nodes of B(F)
+KERNEL_TRANSFORM_WIDTH = 3.0
+KERNEL_TRANSFORM_NODES = 16
+
+
+def _compute_kernel_transform_table(density):
+    """T(G) at Gauss-Legendre nodes in ln G, with the weights of int dG/(2 pi) e^(-1/(12G)) ...,
+    and the closed-form remainder above LARGEST_KERNEL_FORCE (returned as a coefficient of
+    int_{G_c}^inf G^alpha / (F + G) dG)."""
+    beta = density.beta
     alpha = (2.0 * beta - 5.0) / 6.0
+    lo, hi = np.log(2e-3), np.log(LARGEST_KERNEL_FORCE)
+    log_g, wg = _panels(lo, hi, 1.0)
+    g = np.exp(log_g)
+    count = int(np.ceil((hi - lo) / KERNEL_TRANSFORM_WIDTH))
+    edges = np.linspace(lo, hi, count + 1)
+    x = np.cos(np.pi * (np.arange(KERNEL_TRANSFORM_NODES) + 0.5) / KERNEL_TRANSFORM_NODES)
+    nodes = 0.5 * (edges[:-1, None] + edges[1:, None]) + 0.5 * np.diff(edges)[:, None] * x
+    at_nodes = np.exp(nodes)
+    smooth = _kernel_transforms(density, at_nodes.ravel()).reshape(nodes.shape)
+    smooth *= np.exp(1.0 / (12.0 * at_nodes) - alpha * nodes)
+    index = np.clip(np.searchsorted(edges, log_g) - 1, 0, count - 1)
+    t = (2.0 * log_g - edges[index] - edges[index + 1]) / (edges[index + 1] - edges[index])
+    coefficients = np.array([np.polynomial.chebyshev.chebfit(x, row, x.size - 1) for row in smooth])
+    interpolated = np.polynomial.chebyshev.chebval(t, coefficients[index].T, tensor=False)
+    transforms = interpolated * np.exp(alpha * log_g - 1.0 / (12.0 * g))
+    weights = wg * g * np.exp(-1.0 / (12.0 * g)) / (2.0 * np.pi)
     tail_coefficient = np.exp(density.log_amplitude) * _airy_mellin(2.0 - beta) / (2.0 * np.pi)
     tail = tail_coefficient * LARGEST_KERNEL_FORCE**alpha / -alpha  # F << G_c
     return g, weights, transforms, tail
@@ -565,15 +708,16 @@ def _log_contour_part(density, force):
     v, wv = _contour(force, v1, q)
     # drop the nodes where the Airy factor times e^((1/2 - q) Re v) (|h| up to powers of v)
     # is below e^-50 of the largest term
-    estimate = np.log(np.abs(wv * v)) + (0.5 - q) * v.real + _log_psi_omega(force, v).real
+    log_airy = _log_psi_omega(force, v)
+    estimate = np.log(np.abs(wv * v)) + (0.5 - q) * v.real + log_airy.real
     keep = estimate > max(np.max(estimate), np.max(all_terms)) - 50.0
-    v, wv = v[keep], wv[keep]
+    v, wv, log_airy = v[keep], wv[keep], log_airy[keep]
     if np.max(np.abs(v)) > density.largest:
         raise ValueError(
             f"w({force}) needs P(0, v) at |v| = {np.max(np.abs(v)):.4g} > {density.largest:.4g}"
         )
     scaled, magnitude = density.scaled_complex(v)
-    log_rest = np.log(wv * v) + (0.5 - q) * v + _log_psi_omega(force, v)
+    log_rest = np.log(wv * v) + (0.5 - q) * v + log_airy
     log_terms_c = np.log(scaled) + log_rest  # complex logs
     top = max(np.max(log_terms_c.real), np.max(all_terms))
     contour = 2.0 * np.sum(np.exp(log_terms_c - top)).real
@@ -652,9 +796,9 @@ class WeightFunction:
     def _smooth(self, y):
         index = np.clip(np.searchsorted(self.edges, y) - 1, 0, len(self.series) - 1)
         out = np.empty_like(y)
-        for k, piece in enumerate(self.series):
+        for k in np.unique(index):
             chosen = index == k
-            out[chosen] = piece(y[chosen])
+            out[chosen] = self.series[k](y[chosen])
         return out
 
     def log(self, force):
@@ -663,31 +807,43 @@ class WeightFunction:
         y = np.atleast_1d(np.log(force)).astype(float)
         lo, hi = self.edges[0], self.edges[-1]
         smooth = self._smooth(np.clip(y, lo, hi))
-        last = self.series[-1]
         below = y < lo
         f_below = np.exp(y[below])
         smooth[below] = self.small_force_power * y[below] + self.small_force_series(f_below)
         above = y > hi
         if above.any():
-            decay = self.small_force_decay
-            value = last(hi) - decay * np.exp(-hi)  # ln w at F_max
-            slope = last.deriv()(hi) + decay * np.exp(-hi)  # d ln w / d ln F
-            alpha = (2.0 * self.small_speed_exponent - 5.0) / 6.0
-            kappa = 3.0 * (alpha - slope)
+            value, alpha, kappa = self._large_force_law
             t = y[above] - hi
             smooth[above] = (
                 value
                 + alpha * t
                 + np.log((1.0 - kappa) + kappa * np.exp(-t / 3.0))
-                + decay * np.exp(-y[above])
+                + self.small_force_decay * np.exp(-y[above])
             )
         return (smooth - self.small_force_decay * np.exp(-y)).reshape(np.shape(force))
+
+    @functools.cached_property
+    def _large_force_law(self):
+        """ln w(F_max), alpha and kappa of the continuation above F_max."""
+        hi, last, decay = self.edges[-1], self.series[-1], self.small_force_decay
+        value = last(hi) - decay * np.exp(-hi)  # ln w at F_max
+        slope = last.deriv()(hi) + decay * np.exp(-hi)  # d ln w / d ln F
+        alpha = (2.0 * self.small_speed_exponent - 5.0) / 6.0
+        return float(value), alpha, float(3.0 * (alpha - slope))
 
     def log_scalar(self, force: float) -> float:
         """ln w(F) for one F (a fast path for scalar integrands: Clenshaw on the panel's series)."""
         y = math.log(force)
-        if not self.edges[0] <= y <= self.edges[-1]:
-            return float(self.log(force))
+        if y > self._edge_list[-1]:
+            value, alpha, kappa = self._large_force_law
+            t = y - self._edge_list[-1]
+            return value + alpha * t + math.log((1.0 - kappa) + kappa * math.exp(-t / 3.0))
+        if y < self._edge_list[0]:
+            return float(
+                self.small_force_power * y
+                + self.small_force_series(force)
+                - self.small_force_decay / force
+            )
         index = min(bisect.bisect_right(self._edge_list, y) - 1, len(self.series) - 1)
         a, b = self._edge_list[index], self._edge_list[index + 1]
         t = (2.0 * y - a - b) / (b - a)
@@ -919,10 +1075,11 @@ def _distribution_integrand(log_force, x, v, weight, width=0.0):
     log_rest = log_w + log_force - f * x - 0.5 * v - log_force / 6.0
     if width > 0.0:
         log_rest += math.log(-math.expm1(-f * width) / (f * width))
-    if argument > 0.0:
-        airy = special.airye(argument)[0] if argument < 1e6 else float(_airy_scaled(argument))
-        return airy * math.exp(log_rest - (2.0 / 3.0) * argument**1.5)
-    return special.airy(argument)[0] * math.exp(log_rest)
+    if argument <= 0.0 or (argument < 30.0 and abs(log_rest) < 600.0):
+        # (Ai alone: scipy's airy is half the cost of airye; Ai(30) ~ 1e-48 is still a double)
+        return special.airy(argument)[0] * math.exp(log_rest)
+    airy = special.airye(argument)[0] if argument < 1e6 else float(_airy_scaled(argument))
+    return airy * math.exp(log_rest - (2.0 / 3.0) * argument**1.5)
 
 
 def check_force_integral_point(x: float, v: float) -> None:
