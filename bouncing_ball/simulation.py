@@ -133,6 +133,7 @@ from .free_flight import (
     root_predictor,
     slope_zeros,
     speed_squared_coefficients,
+    whole_step_integrals,
 )
 from .jit import njit
 from .pcg64 import next_double, standard_normal, stream_words
@@ -614,9 +615,14 @@ def _run(
         high, low, normal_r = standard_normal(high, low, inc_high, inc_low)
         high, low, normal_s = standard_normal(high, low, inc_high, inc_low)
         x1, v1 = free_flight_step(x, v, dt, normal_r, normal_s)
-        a = hermite_cubic(x, v, x1, v1, dt)
-        a0, a1, a2, a3 = a
         collided = x1 < 0.0
+        # the bridge's mean path, where something uses it (a step with no collision
+        # integrates x and x^2 from its ends alone)
+        if collided or (recording and parts & (POSITION | JOINT)):
+            a = hermite_cubic(x, v, x1, v1, dt)
+        else:
+            a = (x, v, 0.0, 0.0)  # not used
+        a0, a1, a2, a3 = a
         if collided:  # the step ends where the mean path first reaches 0
             tau = first_crossing_time(a0, a1, a2, a3, dt, x1)
             x_tau = 0.0
@@ -655,7 +661,10 @@ def _run(
                 position_noise_v_sum += v * eta
                 position_noise_x_sum += x * eta
             if parts & MEAN_PATH_INTEGRALS:
-                ix, ix2 = mean_path_integrals(a0, a1, a2, a3, dt, tau)
+                if collided:
+                    ix, ix2 = mean_path_integrals(a0, a1, a2, a3, dt, tau)
+                else:
+                    ix, ix2 = whole_step_integrals(x, v, x1, v1, dt)
                 int_x += ix
                 int_x2 += ix2
             if parts & (POSITION | JOINT):
