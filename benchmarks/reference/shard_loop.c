@@ -37,10 +37,11 @@
  * The normals come from numpy's own C generator,
  * ``random_standard_normal`` of libnpyrandom.a, called on the bit generator that
  * Python passes in (``np.random.PCG64(seed).ctypes.bit_generator``), i.e. the
- * same ziggurat that numba's ``Generator.standard_normal`` ports, on the same
- * stream.  The bridge point's draws (a uniform and two normals per recorded
- * step) come likewise from a second bit generator, ``tallies.tally_seed_sequence``'s,
- * with numpy's ``random_standard_uniform`` (= numba's ``Generator.random``).
+ * same ziggurat that ``pcg64.standard_normal`` ports, on the same stream
+ * (which the numba loop advances inline, ``pcg64.next_uint64``).  The bridge
+ * point's draws (a uniform and two normals per recorded step) come likewise from
+ * a second bit generator, ``tallies.tally_seed_sequence``'s, with numpy's
+ * ``random_standard_uniform`` (= ``pcg64.next_double``).
  *
  * What it is for: the yardstick of the performance target "the numba simulation
  * runs at >= 90 % of the speed of a plain C implementation of the same loop
