@@ -1,6 +1,7 @@
 """Benchmarks on the machine it runs on (from the repository root):
 
     python -m benchmarks [--json] [--markdown FILE] [--scaling] [--efficiency-only]
+                         [--breakdown-only]
 
 prints the tables as Markdown (``report``), or writes them to FILE with the machine and
 the time of the run (e.g. ``--markdown results/benchmarks/benchmark.md``); ``--json``
@@ -11,7 +12,8 @@ Measured here (about 3 minutes; ``--scaling`` adds about 2.5 more, outside that 
     config's c and delta rule (c = 3, 1/500) and with the paper's c = 5:
     collisions and simulated time per CPU second, steps per collision, ns per
     step, and the CPU per simulated time the default c saves;
-  * where a step's time goes at r = 1/2 and c = 5, 3 (``breakdown``): ns per step of the
+  * where a step's time goes at r = 1/2 and c = 5, 3 (``breakdown``; about 30 seconds,
+    alone with ``--breakdown-only``): ns per step of the
     stepping and of each tally, of the criterion root and of the normals, and collisions
     per CPU second against the hand-tuned C loop (``reference/hand_tuned.c``, measured in
     the same run; targets: 0.9 of it stepping, 0.8 with every tally);
@@ -424,6 +426,11 @@ def main(argv=None):
         action="store_true",
         help="measure only the statistical efficiency per observable (``efficiency``)",
     )
+    parser.add_argument(
+        "--breakdown-only",
+        action="store_true",
+        help="measure only where a step goes, against the hand-tuned C loop (``breakdown``)",
+    )
     args = parser.parse_args(argv)
     started = time.perf_counter()
     results = {
@@ -432,6 +439,8 @@ def main(argv=None):
     }
     if args.efficiency_only:
         results["efficiency"] = efficiency_benchmark()
+    elif args.breakdown_only:
+        results["breakdown"] = breakdown(SHARD_SETTINGS)
     else:
         _full_benchmark(results, args.scaling)
     results["seconds"] = time.perf_counter() - started

@@ -9,9 +9,9 @@ Two kinds of measurement, both CPU time on one core, best of ``repeats``:
   * the two pieces of a step that cannot be switched off, timed on their own: the step-size
     root of eq. (criterion) (``free_flight.criterion_root``, from the loop's warm start and
     from the cold start, over the states of a real trajectory, which ``_trajectory``
-    records) and the two normals a step draws from numpy's Generator.  These run
-    alongside the step's other arithmetic in the loop, so they bound, not add up to, the
-    stepping time.
+    records) and the two normals a step draws (numpy's PCG64 and ziggurat, inline as the loop
+    draws them: ``pcg64``).  These run alongside the step's other arithmetic in the loop, so
+    they bound, not add up to, the stepping time.
 """
 
 import time
@@ -28,6 +28,7 @@ from bouncing_ball.free_flight import (
     root_predictor,
 )
 from bouncing_ball.jit import njit
+from bouncing_ball.pcg64 import standard_normal, stream_words
 from bouncing_ball.simulation import (
     CONTROL_VARIATES,
     EVERY_TALLY,
@@ -120,10 +121,14 @@ def _roots(xs, vs, starts, c):
 
 
 @njit(cache=True)
-def _normals(rng, steps):
+def _normals(words, steps):
+    """Two normals a step, drawn as the loop draws them (``pcg64.standard_normal``)."""
+    high, low, inc_high, inc_low = words
     total = 0.0
     for _ in range(steps):
-        total += rng.standard_normal() + rng.standard_normal()
+        high, low, normal_r = standard_normal(high, low, inc_high, inc_low)
+        high, low, normal_s = standard_normal(high, low, inc_high, inc_low)
+        total += normal_r + normal_s
     return total
 
 
@@ -134,10 +139,11 @@ def step_pieces(settings, r=0.5, steps=2_000_000, repeats=3):
     xs, vs, starts = _trajectory(rng, steps, r, c, settings.min_step_divisor)
     cold = np.zeros(steps)
     _roots(xs[:10], vs[:10], starts[:10], c)
-    _normals(rng, 10)
+    words = stream_words(rng)
+    _normals(words, 10)
     warm_seconds, _ = _best_cpu(lambda: _roots(xs, vs, starts, c), repeats)
     cold_seconds, _ = _best_cpu(lambda: _roots(xs, vs, cold, c), repeats)
-    normal_seconds, _ = _best_cpu(lambda: _normals(rng, steps), repeats)
+    normal_seconds, _ = _best_cpu(lambda: _normals(words, steps), repeats)
     return {
         "criterion_root_ns": 1e9 * warm_seconds / steps,
         "criterion_root_cold_start_ns": 1e9 * cold_seconds / steps,

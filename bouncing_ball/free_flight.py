@@ -45,6 +45,7 @@ __all__ = [
     "cubic_value",
     "cubic_slope",
     "mean_path_integrals",
+    "whole_step_integrals",
     "bridge_covariance",
     "bridge_sample",
     "bridge_speed_squared_given_position",
@@ -422,6 +423,43 @@ def mean_path_integrals(a0, a1, a2, a3, dt, tau):
     tau2 = tau * tau
     int_var = (2.0 / 3.0) * tau2 * tau2 * (0.25 - u * (3.0 / 5.0 - u * (0.5 - u * (1.0 / 7.0))))
     return int_x, int_m2 + int_var
+
+
+@njit(cache=True, inline="always")
+def whole_step_integrals(x0, v0, x1, v1, dt):
+    """``mean_path_integrals`` over a whole step (tau = dt), from its two ends: no cubic.
+
+    Over [0, dt] the integrals of the cubic Hermite mean path and of its square are the
+    Hermite mass matrix applied to the ends (x0, v0), (x1, v1), and the bridge variance of x
+    integrates to dt^4 / 210.  Equal to ``mean_path_integrals`` of ``hermite_cubic`` at
+    tau = dt up to rounding, with no division and a third of the operations: the shard loop
+    takes it for every step not cut by a collision.
+
+    Parameters
+    ----------
+    x0, v0 : float
+        Position and velocity at the step's start.
+    x1, v1 : float
+        Position and velocity at its end.
+    dt : float
+        The step.
+
+    Returns
+    -------
+    int_x, int_x2 : float
+
+    Examples
+    --------
+    >>> from bouncing_ball.free_flight import whole_step_integrals
+    >>> int_x, int_x2 = whole_step_integrals.py_func(1.0, 0.0, 1.0, 0.0, 1.0)
+    >>> print(int_x, round((int_x2 - 1.0) * 210, 12))
+    1.0 1.0
+    """
+    int_x = dt * (0.5 * (x0 + x1) + dt * (1.0 / 12.0) * (v0 - v1))
+    m0 = (13.0 / 35.0) * (x0 * x0 + x1 * x1) + (9.0 / 35.0) * (x0 * x1)
+    m1 = (11.0 / 105.0) * (x0 * v0 - x1 * v1) + (13.0 / 210.0) * (x1 * v0 - x0 * v1)
+    m2 = (1.0 / 105.0) * (v0 * v0 + v1 * v1) - (1.0 / 70.0) * (v0 * v1)
+    return int_x, dt * (m0 + dt * (m1 + dt * (m2 + dt * (1.0 / 210.0))))
 
 
 def bridge_covariance(dt, t):

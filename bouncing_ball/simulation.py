@@ -133,8 +133,10 @@ from .free_flight import (
     root_predictor,
     slope_zeros,
     speed_squared_coefficients,
+    whole_step_integrals,
 )
 from .jit import njit
+from .pcg64 import next_double, standard_normal, stream_words
 from .settings import ShardSettings
 from .tallies import EARLY_FRACTION, SCALAR_INDEX, ShardTallies, tally_seed_sequence
 
@@ -433,7 +435,10 @@ EVERY_TALLY = MEAN_PATH_INTEGRALS | POSITION | JOINT | FLIGHTS | CONTROL_VARIATE
 
 @njit(cache=True)
 def _tally_second_bridge_point(
-    rng_tally,
+    tally_high,
+    tally_low,
+    tally_inc_high,
+    tally_inc_low,
     a,
     dt,
     s,
@@ -454,12 +459,16 @@ def _tally_second_bridge_point(
     position_velocity_time,
 ):
     """The second bridge point of a step from the floor (``floor_stratum_end``), at time s
-    in [0, t_low] with ``weight`` t_low, its normals drawn here: the bridge correction (with
-    POSITION; k_s is the bin the assignment gives s) and P(x, v) (with JOINT), as the loop
-    does for the first point."""
+    in [0, t_low] with ``weight`` t_low, its normals drawn here from the tally stream (whose
+    new state it returns): the bridge correction (with POSITION; k_s is the bin the
+    assignment gives s) and P(x, v) (with JOINT), as the loop does for the first point."""
     a0, a1, a2, a3 = a
-    normal_1 = rng_tally.standard_normal()
-    normal_2 = rng_tally.standard_normal()
+    tally_high, tally_low, normal_1 = standard_normal(
+        tally_high, tally_low, tally_inc_high, tally_inc_low
+    )
+    tally_high, tally_low, normal_2 = standard_normal(
+        tally_high, tally_low, tally_inc_high, tally_inc_low
+    )
     x_s, v_s = bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2)
     if parts & POSITION:
         x_cell = _walked_bin_index(x_s, k_s, x_bin_lower, x_bin_upper)
@@ -472,6 +481,7 @@ def _tally_second_bridge_point(
     if parts & JOINT:
         cell_v = _linear_bin_index(v_s, u_lo, u_per_unit, u_edges.shape[0] - 1, u_edges)
         position_velocity_time[x_cell, cell_v] += weight
+    return tally_high, tally_low
 
 
 # a step this short only happens in a collapse (v ~ 1e-37); much shorter ones overflow the bridge's
@@ -481,8 +491,8 @@ COLLAPSED_STEP = 1.0e-80
 
 @njit(cache=True)
 def _run(
-    rng,
-    rng_tally,
+    stream,
+    tally_stream,
     restitution,
     c,
     min_step_divisor,
@@ -504,7 +514,9 @@ def _run(
     parts,
 ):
     # v_edges: speeds (log); x_edges: heights (log); u_edges: velocities of P(x, v) (linear);
-    # f_edges: flight times (log)
+    # f_edges: flight times (log); stream, tally_stream: the PCG64 states (pcg64.stream_words)
+    high, low, inc_high, inc_low = stream
+    tally_high, tally_low, tally_inc_high, tally_inc_low = tally_stream
     nv = v_edges.shape[0] - 1
     v_log_lo = math.log(v_edges[0])
     v_per_ln = nv / (math.log(v_edges[nv]) - v_log_lo)
@@ -600,12 +612,17 @@ def _run(
             dt = t_stop - t
         # the next root starts from a first-order prediction off this one
         predictor = root_predictor(root, slope_at_root, x, v)
-        normal_r = rng.standard_normal()
-        normal_s = rng.standard_normal()
+        high, low, normal_r = standard_normal(high, low, inc_high, inc_low)
+        high, low, normal_s = standard_normal(high, low, inc_high, inc_low)
         x1, v1 = free_flight_step(x, v, dt, normal_r, normal_s)
-        a = hermite_cubic(x, v, x1, v1, dt)
-        a0, a1, a2, a3 = a
         collided = x1 < 0.0
+        # the bridge's mean path, where something uses it (a step with no collision
+        # integrates x and x^2 from its ends alone)
+        if collided or (recording and parts & (POSITION | JOINT)):
+            a = hermite_cubic(x, v, x1, v1, dt)
+        else:
+            a = (x, v, 0.0, 0.0)  # not used
+        a0, a1, a2, a3 = a
         if collided:  # the step ends where the mean path first reaches 0
             tau = first_crossing_time(a0, a1, a2, a3, dt, x1)
             x_tau = 0.0
@@ -644,7 +661,10 @@ def _run(
                 position_noise_v_sum += v * eta
                 position_noise_x_sum += x * eta
             if parts & MEAN_PATH_INTEGRALS:
-                ix, ix2 = mean_path_integrals(a0, a1, a2, a3, dt, tau)
+                if collided:
+                    ix, ix2 = mean_path_integrals(a0, a1, a2, a3, dt, tau)
+                else:
+                    ix, ix2 = whole_step_integrals(x, v, x1, v1, dt)
                 int_x += ix
                 int_x2 += ix2
             if parts & (POSITION | JOINT):
@@ -652,16 +672,25 @@ def _run(
                 # bridge-law correction of P(x), <v^2>_x.  One, s uniform in [0, tau] with weight
                 # tau; two in a step from the floor, one in each stratum of floor_stratum_end
                 t_low = floor_stratum_end(tau, x, v)
-                u = rng_tally.random()
-                normal_1 = rng_tally.standard_normal()
-                normal_2 = rng_tally.standard_normal()
+                tally_high, tally_low, u = next_double(
+                    tally_high, tally_low, tally_inc_high, tally_inc_low
+                )
+                tally_high, tally_low, normal_1 = standard_normal(
+                    tally_high, tally_low, tally_inc_high, tally_inc_low
+                )
+                tally_high, tally_low, normal_2 = standard_normal(
+                    tally_high, tally_low, tally_inc_high, tally_inc_low
+                )
                 s = u * tau
                 weight = tau
                 s2 = s
                 if t_low < tau:
                     s = t_low + u * (tau - t_low)
                     weight = tau - t_low
-                    s2 = rng_tally.random() * t_low
+                    tally_high, tally_low, u2 = next_double(
+                        tally_high, tally_low, tally_inc_high, tally_inc_low
+                    )
+                    s2 = u2 * t_low
             if parts & POSITION:
                 x_bin, k_s, k_s2 = _tally_step(
                     a,
@@ -711,8 +740,11 @@ def _run(
                 ] += weight
             if parts & (POSITION | JOINT) and t_low < tau:
                 # the second point of a step from the floor, in [0, t_low] (rare: its own function)
-                _tally_second_bridge_point(
-                    rng_tally,
+                tally_high, tally_low = _tally_second_bridge_point(
+                    tally_high,
+                    tally_low,
+                    tally_inc_high,
+                    tally_inc_low,
                     a,
                     dt,
                     s2,
@@ -817,8 +849,8 @@ def simulate_shard(
     rng_tally = np.random.Generator(np.random.PCG64(tally_seed_sequence(seed_sequence)))
     arrays = ShardTallies.loop_arrays(settings)
     _run(
-        rng,
-        rng_tally,
+        stream_words(rng),
+        stream_words(rng_tally),
         float(restitution),
         settings.criterion_c,
         settings.min_step_divisor,

@@ -6,7 +6,7 @@
  *
  *   bouncing_ball/free_flight.py: free_flight_step, _floor_root, _fitted_root,
  *       criterion_root, hermite_cubic, cubic_value, cubic_slope,
- *       mean_path_integrals, speed_squared_coefficients,
+ *       mean_path_integrals, whole_step_integrals, speed_squared_coefficients,
  *       quintic_antiderivative_value, piece_inverse, level_time_estimate,
  *       level_time_one_step, level_time, cubic_level_time, slope_zeros,
  *       monotone_piece_end, first_crossing_time, bridge_sample,
@@ -37,10 +37,11 @@
  * The normals come from numpy's own C generator,
  * ``random_standard_normal`` of libnpyrandom.a, called on the bit generator that
  * Python passes in (``np.random.PCG64(seed).ctypes.bit_generator``), i.e. the
- * same ziggurat that numba's ``Generator.standard_normal`` ports, on the same
- * stream.  The bridge point's draws (a uniform and two normals per recorded
- * step) come likewise from a second bit generator, ``tallies.tally_seed_sequence``'s,
- * with numpy's ``random_standard_uniform`` (= numba's ``Generator.random``).
+ * same ziggurat that ``pcg64.standard_normal`` ports, on the same stream
+ * (which the numba loop advances inline, ``pcg64.next_uint64``).  The bridge
+ * point's draws (a uniform and two normals per recorded step) come likewise from
+ * a second bit generator, ``tallies.tally_seed_sequence``'s, with numpy's
+ * ``random_standard_uniform`` (= ``pcg64.next_double``).
  *
  * What it is for: the yardstick of the performance target "the numba simulation
  * runs at >= 90 % of the speed of a plain C implementation of the same loop
@@ -227,6 +228,16 @@ static inline void mean_path_integrals(double a0, double a1, double a2, double a
     double int_var = (2.0 / 3.0) * tau2 * tau2 * (0.25 - u * (3.0 / 5.0 - u * (0.5 - u * (1.0 / 7.0))));
     *int_x_out = int_x;
     *int_x2_out = int_m2 + int_var;
+}
+
+static inline void whole_step_integrals(double x0, double v0, double x1, double v1, double dt,
+                                        double *int_x_out, double *int_x2_out)
+{
+    *int_x_out = dt * (0.5 * (x0 + x1) + dt * (1.0 / 12.0) * (v0 - v1));
+    double m0 = (13.0 / 35.0) * (x0 * x0 + x1 * x1) + (9.0 / 35.0) * (x0 * x1);
+    double m1 = (11.0 / 105.0) * (x0 * v0 - x1 * v1) + (13.0 / 210.0) * (x1 * v0 - x0 * v1);
+    double m2 = (1.0 / 105.0) * (v0 * v0 + v1 * v1) - (1.0 / 70.0) * (v0 * v1);
+    *int_x2_out = dt * (m0 + dt * (m1 + dt * (m2 + dt * (1.0 / 210.0))));
 }
 
 typedef struct {
@@ -793,7 +804,10 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
             position_noise_v_sum += v * eta;
             position_noise_x_sum += x * eta;
             double ix, ix2;
-            mean_path_integrals(a0, a1, a2, a3, dt, tau, &ix, &ix2);
+            if (collided)
+                mean_path_integrals(a0, a1, a2, a3, dt, tau, &ix, &ix2);
+            else
+                whole_step_integrals(x, v, x1, v1, dt, &ix, &ix2);
             int_x += ix;
             int_x2 += ix2;
             /* the step's bridge points, (x(s), v(s)), from the tally stream: P(x, v), and the

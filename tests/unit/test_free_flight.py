@@ -15,6 +15,7 @@ from bouncing_ball.free_flight import (
     mean_path_integrals,
     quintic_antiderivative_value,
     speed_squared_coefficients,
+    whole_step_integrals,
 )
 
 
@@ -196,3 +197,20 @@ def test_a_grazing_crossing_has_the_right_impact_speed():
         1.0 - np.sqrt(depth), abs=1e-10
     )  # bisection stops at 1e-10 of the piece
     assert cubic_slope(*a[1:], t) == pytest.approx(-2.0 * np.sqrt(depth), rel=1e-6)
+
+
+def test_whole_step_integrals_are_the_mean_path_integrals_over_the_step():
+    """The Hermite mass matrix of the ends gives mean_path_integrals at tau = dt, to rounding,
+    over states and steps from the floor to far above it."""
+    rng = np.random.default_rng(8)
+    for _ in range(2000):
+        x0, x1 = rng.uniform(0.0, 5.0, 2) ** 2
+        v0, v1 = rng.normal(0.0, 2.0, 2)
+        dt = 10.0 ** rng.uniform(-8.0, 0.5)
+        expected = mean_path_integrals(*hermite_cubic(x0, v0, x1, v1, dt), dt, dt)
+        got = whole_step_integrals(x0, v0, x1, v1, dt)
+        # the terms cancel at most by the size of the largest one: rounding of that size
+        scale_x = dt * (abs(x0) + abs(x1) + dt * (abs(v0) + abs(v1)))
+        scale_x2 = dt * (x0 + x1 + dt * (abs(v0) + abs(v1)) + dt * dt) ** 2
+        assert got[0] == pytest.approx(expected[0], rel=0, abs=1e-13 * scale_x)
+        assert got[1] == pytest.approx(expected[1], rel=0, abs=1e-13 * scale_x2)
