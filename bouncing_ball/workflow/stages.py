@@ -14,6 +14,7 @@ SIMULATION = (
     "bins",
     "free_flight",
     "jit",
+    "pcg64",
     "restitution",
     "settings",
     "simulation",

@@ -77,3 +77,14 @@ def test_public_api_is_the_top_level():
     )
     for name in bouncing_ball.__all__:
         assert getattr(bouncing_ball, name) is not None
+
+
+def test_the_simulation_stage_names_every_module_the_shard_loop_compiles():
+    """An edit of any module numba compiles for the shard loop must re-run the shards: the
+    simulation stage's sources hold every compiled module the loop imports."""
+    from bouncing_ball import jit
+    from bouncing_ball.workflow import stages
+
+    loop = {"free_flight", "jit", "pcg64", "simulation", "tallies"}
+    assert loop <= set(jit.COMPILED)
+    assert loop <= set(stages.SIMULATION)
