@@ -26,6 +26,7 @@ MODULES = [
     "bouncing_ball.kernel",
     "bouncing_ball.restitution",
     "bouncing_ball.settings",
+    "bouncing_ball.simulation",
     "bouncing_ball.solver",
     "bouncing_ball.tallies",
 ]
@@ -46,6 +47,7 @@ DOCUMENTED = [
     "bouncing_ball.kernel",
     "bouncing_ball.restitution",
     "bouncing_ball.settings",
+    "bouncing_ball.simulation",
     "bouncing_ball.solver",
     "bouncing_ball.tallies",
 ]
