@@ -18,6 +18,7 @@ interpolated crossing does not.
 What a shard records after its equilibration time (integrals over each step
 given both its ends, not left-point sums, which are biased because Delta
 depends on the state):
+
   * outgoing speeds at collisions, on log bins;
   * the time, collisions and steps (all after equilibration);
   * int x dt and int x^2 dt, exact in expectation given the ends (mean path
