@@ -35,8 +35,8 @@ Ai(z) = 2 Re[-omega Ai(omega z)] (omega = e^(2 pi i / 3); -omega Ai(omega z) =
 F^(-1/6) Ai(omega zeta(v)) along a path into the upper half plane: first at
 angle pi/3 (the steepest descent direction at the saddle) until arg v =
 THETA_MAX, then radially.  Along that path the Airy factor decays like
-exp(-c F^(1/2) |v|^(3/2)), faster than any exponential.  h is analytic for
-|arg v| < pi/3 (the kernel of eq. (kernel3) is); at complex v it is the
+exp(-c F^(1/2) abs(v)^(3/2)), faster than any exponential.  h is analytic for
+abs(arg v) < pi/3 (the kernel of eq. (kernel3) is); at complex v it is the
 Nystrom formula of the solver, P(0, v) = r^-2 int du u G_g(v/r, u) P(0, u),
 with G_g continued to complex v (``_complex_kernel_sums``) and the u integral
 on a grid REFINE times finer than the solver's (the trapezoidal rule in
@@ -61,6 +61,24 @@ below 1e-10 in every result here.
 From w: P(x) by eq. (P(x)1); int_x^inf P and <v^2>_x by eq. (moment2);
 moments and bin averages of P(x) in closed form under the F integral; P(x, v)
 by eq. (fpsol) (x > 0), and at x = 0 from P(0, v) and eq. (bc).
+
+Solving eq. (inteq) compiles the kernel on its first call (a minute), and a ``WeightFunction``
+takes seconds to build, so the Examples that need them are not run as doctests; the unit and
+numerical tests check the same values.  The Examples that run use the exact w(F) of r = 1/2,
+eq. (weightfunc2) (``closed_form_weight_function``): every function of w here takes it as it
+takes an interpolated one.
+
+Examples
+--------
+P(x) of eq. (P(x)1) and its moments at r = 1/2 from the exact w(F): the paper's <x> = 6 and
+Delta x = 6 3^(1/2), eq. (xandDeltax):
+
+>>> import numpy as np
+>>> from bouncing_ball import exact
+>>> from bouncing_ball.distribution import closed_form_weight_function, position_averages
+>>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+>>> print({name: round(value, 9) for name, value in position_averages(weight).items()})
+{'normalization': 1.0, 'mean_x': 6.0, 'delta_x': 10.392304845}
 """
 
 import bisect
@@ -89,8 +107,51 @@ from .solver import (
     speed_of_coordinate,
 )
 
+__all__ = [
+    "THETA_MAX",
+    "WEDGE_CLEAN",
+    "PANEL_CHEBYSHEV_NODES",
+    "NOISE_TOLERANCE",
+    "LARGEST_AIRY_PHASE",
+    "CELL_SPEED_NODES",
+    "EXPONENT_TOLERANCES",
+    "DISTRIBUTION_NOISE",
+    "check_restitution",
+    "outgoing_speed_solution",
+    "small_force_decay",
+    "small_force_power",
+    "log_weight_function",
+    "weight_function",
+    "WeightFunction",
+    "interpolated_weight_function",
+    "closed_form_weight_function",
+    "ClosedFormWeight",
+    "position_density",
+    "position_tail",
+    "mean_speed_squared_given_position",
+    "position_moment",
+    "position_averages",
+    "position_bin_average",
+    "speed_squared_given_position_bin_average",
+    "check_force_integral_point",
+    "distribution_by_force_integral",
+    "distribution_cell_average",
+    "distribution_with_error",
+    "distribution",
+    "weight_table",
+    "position_table",
+    "distribution_table",
+    "predicted_exponents",
+    "measured_exponents",
+    "exponents_table",
+    "solve_table_defects",
+    "check_solve_tables",
+]
+
 OMEGA = np.exp(2j * np.pi / 3.0)
-THETA_MAX = 0.5  # largest arg v on the contour: trapezoid error ~ exp(-2 pi (pi/3 - 0.5) / step)
+#: The largest arg v on the contour of A(F) in eq. (weightfunc): the trapezoidal rule of the
+#: complex Nystrom sum loses accuracy there as exp(-2 pi (pi/3 - THETA_MAX) / step).
+THETA_MAX = 0.5
 REFINE = 2  # the u grid for complex v is this many times finer than the solver's
 SKIP_EFOLDS = 46.0  # a term of the Nystrom sum below e^-46 of the largest is skipped
 SMALLEST_SPEED = 1e-14  # below, P(0, v) = C v^-beta and the v integrals are done in closed form
@@ -99,6 +160,7 @@ LARGEST_FORCE = 1e8  # w computed up to here, continued by its power law (and co
 PANEL_WIDTH = 3.5  # of the interpolation panels, in ln F (F < 1)
 LARGE_PANEL_WIDTH = 5.0  # (F > 1: w is close to its power law there)
 SMALL_PANEL_WIDTH = 1.2  # (F < 1, r > 1/2)
+#: Chebyshev nodes per panel in ln F of the interpolated w(F) (``interpolated_weight_function``).
 PANEL_CHEBYSHEV_NODES = 12
 SMALL_FORCE_DEGREE = 5  # of the polynomial in F continuing ln w below F_min
 PANEL_NODES = 10  # Gauss-Legendre nodes per panel of the real-axis v integrals
@@ -112,9 +174,10 @@ WEDGE_SPEED_NODES = 14
 WEDGE_ANGLE_PANELS = 2
 WEDGE_ANGLE_WIDTH = THETA_MAX / WEDGE_ANGLE_PANELS
 WEDGE_ANGLE_NODES = 8
-# a cell whose Nystrom sums cancel by more (magnitude / |value|) is not interpolated: its nodes'
-# rounding errors would spread over it (the bound of the spread, in the noise estimate of w,
-# would raise F_min where r > 0.9)
+#: A cell of the interpolant of P(0, v) e^(q v) in the wedge 0 <= arg v <= THETA_MAX whose
+#: Nystrom sums cancel by more (magnitude / abs(value)) is not interpolated: its nodes' rounding
+#: errors would spread over it (the bound of the spread, in the noise estimate of w, would raise
+#: F_min where r > 0.9); its v are summed directly.
 WEDGE_CLEAN = 1e6
 ACCURATE_RANGE = 0.4  # P(0, v) of a solution is used up to this fraction of its highest node
 NEGLIGIBLE_EFOLDS = 60.0
@@ -133,10 +196,10 @@ _WEDGE_SPEED_X, _WEDGE_INVERSE_SPEED = _chebyshev_nodes_and_inverse(WEDGE_SPEED_
 _WEDGE_ANGLE_X, _WEDGE_INVERSE_ANGLE = _chebyshev_nodes_and_inverse(WEDGE_ANGLE_NODES)
 
 
-# On the outgoing side v > 0 the Airy factor of the F integral of eq. (fpsol) oscillates; up to
-# F = 60 / x its phase (2/3) F^(1/2) v^(3/2) reaches (2/3) (60 / x)^(1/2) v^(3/2).  quad follows
-# it to ~4e4 (against P(0, v) as x -> 0: 1e-7 at (x, v) = (1e-8, 0.8), (1e-7, 1.7)) and fails
-# beyond (1e-5 wrong at (1e-6, 6), phase 7.6e4; a negative density at (1e-8, 2), phase 1.5e5)
+#: On the outgoing side v > 0 the Airy factor of the F integral of eq. (fpsol) oscillates; up to
+#: F = 60 / x its phase (2/3) F^(1/2) v^(3/2) reaches (2/3) (60 / x)^(1/2) v^(3/2).  quad follows
+#: it to ~4e4 (against P(0, v) as x -> 0: 1e-7 at (x, v) = (1e-8, 0.8), (1e-7, 1.7)) and fails
+#: beyond (1e-5 wrong at (1e-6, 6), phase 7.6e4; a negative density at (1e-8, 2), phase 1.5e5).
 LARGEST_AIRY_PHASE = 4.0e4
 
 
@@ -146,8 +209,34 @@ def _airy_phase(x, v):
 
 
 def check_restitution(restitution) -> float:
-    """r as a float (a float or a fraction string, "1/3"), if w(F), P(x) and P(x, v) are computed
-    to the solver's accuracy there (``DISTRIBUTION_RESTITUTION_RANGE``); ValueError otherwise."""
+    """r as a float, if w(F), P(x) and P(x, v) are computed to the solver's accuracy there.
+
+    Parameters
+    ----------
+    restitution : float or str
+        r, a float or an exact fraction string ("1/3").
+
+    Returns
+    -------
+    float
+        r, if it lies in ``restitution.DISTRIBUTION_RESTITUTION_RANGE``.
+
+    Raises
+    ------
+    ValueError
+        Naming r and the range, if r lies outside it (P(0, v) alone, ``bouncing_ball.solver``,
+        reaches further).
+
+    Examples
+    --------
+    >>> from bouncing_ball.distribution import check_restitution
+    >>> print(check_restitution("1/3"), check_restitution(0.6))
+    0.3333333333333333 0.6
+    >>> check_restitution(0.99)
+    Traceback (most recent call last):
+    ...
+    ValueError: restitution 0.99: w(F), P(x) and P(x, v) are computed to 1e-8 only for ...
+    """
     exact = parse_restitution(restitution, "restitution")
     if not in_range(exact, DISTRIBUTION_RESTITUTION_RANGE):
         low, high = DISTRIBUTION_RESTITUTION_RANGE
@@ -160,10 +249,42 @@ def check_restitution(restitution) -> float:
 
 
 def outgoing_speed_solution(restitution, step=DEFAULT_STEP):
-    """P(0, v) solved with the highest node where P(0, v) reaches exp(-690) (the default stops at
-    exp(-45) below its value at v = 20): w(F) at small F needs P(0, v) far out (v ~ q (1-q) / F).
-    ``restitution``: a float or a fraction string in ``DISTRIBUTION_RESTITUTION_RANGE``;
-    ``step``: the solver's quadrature step."""
+    """P(0, v) of eq. (inteq), solved out to where it falls to exp(-690), as w(F) needs it.
+
+    The solver's default highest node stops where P(0, v) has fallen by exp(-45) below its value
+    at v = 20; w(F) of eq. (weightfunc) at small F needs P(0, v) far out (v ~ q (1 - q) / F), so
+    the highest node here is where P(0, v) reaches exp(-690).
+
+    Parameters
+    ----------
+    restitution : float or str
+        r, a float or a fraction string ("1/3"), in ``DISTRIBUTION_RESTITUTION_RANGE``
+        (``check_restitution``).
+    step : float, optional
+        The solver's quadrature step in s = ln u + u^(1/2) (``solver.DEFAULT_STEP``).
+
+    Returns
+    -------
+    solver.OutgoingSpeedSolution
+        P(0, v) at the solver's nodes, absolutely normalised.
+
+    Raises
+    ------
+    ValueError
+        If r lies outside ``DISTRIBUTION_RESTITUTION_RANGE``, or the solver refuses ``step``.
+
+    Examples
+    --------
+    Compiles the kernel on its first call (so not run as a doctest); at r = 1/2 the solution
+    is eq. (P(0,v)), e^(-v) / (3 v):
+
+    >>> from bouncing_ball.distribution import outgoing_speed_solution
+    >>> solution = outgoing_speed_solution("1/2")  # doctest: +SKIP
+    >>> print(round(solution.speeds[-1], 2))  # doctest: +SKIP
+    680.97
+    >>> print(solution.outgoing_speed_density([0.5, 1.0]).round(8))  # doctest: +SKIP
+    [0.40435377 0.12262648]
+    """
     r = check_restitution(restitution)
     q = large_speed_decay_rate(r)
     return solve_outgoing_speed_density(r, step=step, highest_speed=0.985 * UNDERFLOW_EFOLDS / q)
@@ -483,15 +604,56 @@ def _outgoing_density(solution, panel_width=1.0, panel_order=20) -> _OutgoingDen
 
 
 def small_force_decay(restitution) -> float:
-    """S(q) in w(F) ~ exp(-S / F) as F -> 0: (3p - p^3) / 24 with p = min(2q - 1, 1)."""
+    """S(q) in w(F) ~ exp(-S / F) as F -> 0, the small-F decay of w of eq. (weightfunc).
+
+    S = (3p - p^3) / 24 with p = min(2q - 1, 1), q = q(r) of eqs. (asym4), (asym6): for q < 1
+    (r > 1/2) the saddle v = q (1 - q) / F of the v integral dominates, for q >= 1 the end point
+    v = 0 does (S = 1/12, the e^(-1/(12F)) of eq. (weightfunc2)).  S < 0 where q < 1/2
+    (r > 3^(1/2) - 1): w then grows without bound as F -> 0.
+
+    Parameters
+    ----------
+    restitution : float or str
+        r, 0 < r < 1, a float or a fraction string ("1/3").
+
+    Returns
+    -------
+    float
+        S.
+
+    Examples
+    --------
+    >>> from bouncing_ball.distribution import small_force_decay
+    >>> print(small_force_decay(0.25) == small_force_decay("1/2") == 1 / 12)
+    True
+    >>> print(round(small_force_decay(0.6), 10), round(small_force_decay(0.9), 10))
+    0.0642829373 -0.0712409094
+    """
     p = min(2.0 * large_speed_decay_rate(restitution_float(restitution)) - 1.0, 1.0)
     return (3.0 * p - p**3) / 24.0
 
 
 def small_force_power(restitution) -> float:
-    """gamma in w(F) ~ F^gamma exp(-S/F) as F -> 0: m - 3/2 where q < 1 (r > 1/2: the saddle
-    v* = q (1 - q) / F of eq. (weightfunc), with P(0, v) ~ v^-m e^(-q v) of eq. (asym3)), -1/2 at
-    q = 1 (r = 1/2, eq. (weightfunc2)), 0 where q > 1 (r < 1/2: the end point v = 0)."""
+    """gamma in w(F) ~ F^gamma exp(-S / F) as F -> 0, eqs. (weightfunc), (weightfunc2).
+
+    Parameters
+    ----------
+    restitution : float or str
+        r, 0 < r < 1, a float or a fraction string ("1/3").
+
+    Returns
+    -------
+    float
+        gamma = m - 3/2 where q < 1 (r > 1/2: the saddle v* = q (1 - q) / F of
+        eq. (weightfunc), with P(0, v) ~ v^-m e^(-q v) of eq. (asym3)); -1/2 at q = 1 (r = 1/2,
+        eq. (weightfunc2)); 0 where q > 1 (r < 1/2: the end point v = 0).
+
+    Examples
+    --------
+    >>> from bouncing_ball.distribution import small_force_power
+    >>> print(small_force_power(0.25), small_force_power(0.5), round(small_force_power(0.6), 10))
+    0.0 -0.5 -1.0526867233
+    """
     restitution = restitution_float(restitution)
     q = large_speed_decay_rate(restitution)
     if abs(q - 1.0) < 1e-12:
@@ -751,14 +913,72 @@ def _log_weight_with_noise(forces, density):
 
 
 def log_weight_function(force, solution, density=None):
-    """ln w(F) of eq. (weightfunc), evaluated directly (see the module docstring); NaN where the
-    solution's P(0, v) does not reach far enough (``outgoing_speed_solution`` reaches further)."""
+    """ln w(F) of eq. (weightfunc), evaluated directly (not interpolated).
+
+    w(F) = A(F) - e^(-1/(12F)) B(F), A along a contour into the complex v plane (the module's
+    account of the method).
+
+    Parameters
+    ----------
+    force : array_like
+        Values of F > 0.
+    solution : solver.OutgoingSpeedSolution
+        P(0, v) of eq. (inteq); ``outgoing_speed_solution`` reaches as far as small F needs.
+    density : optional
+        The solution's P(0, v) prepared for the contour integrals, to reuse across calls (a
+        private type of this module); built from ``solution`` if None.
+
+    Returns
+    -------
+    numpy.ndarray
+        ln w(F), the shape of ``force``; NaN where the solution's P(0, v) does not reach far
+        enough.
+
+    Examples
+    --------
+    Solving compiles the kernel on its first call (so not run as a doctest); at r = 1/2 w(F)
+    is eq. (weightfunc2):
+
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> from bouncing_ball.distribution import log_weight_function, outgoing_speed_solution
+    >>> solution = outgoing_speed_solution("1/2")  # doctest: +SKIP
+    >>> print(np.exp(log_weight_function([0.1, 1.0], solution)).round(8))  # doctest: +SKIP
+    [0.22905337 0.15334074]
+    >>> print(exact.weight_function([0.1, 1.0], "1/2").round(8))
+    [0.22905337 0.15334074]
+    """
     density = _outgoing_density(solution) if density is None else density
     return _log_weight_with_noise(force, density)[0].reshape(np.shape(force))
 
 
 def weight_function(force, solution, density=None):
-    """w(F) of eq. (weightfunc); over- or underflows where ``log_weight_function`` does not."""
+    """w(F) of eq. (weightfunc), evaluated directly (``log_weight_function``, exponentiated).
+
+    Parameters
+    ----------
+    force : array_like
+        Values of F > 0.
+    solution : solver.OutgoingSpeedSolution
+        P(0, v) of eq. (inteq), from ``outgoing_speed_solution``.
+    density : optional
+        As in ``log_weight_function``.
+
+    Returns
+    -------
+    numpy.ndarray
+        w(F), the shape of ``force``; it over- or underflows where ``log_weight_function``
+        does not.
+
+    Examples
+    --------
+    Solving compiles the kernel on its first call (so not run as a doctest):
+
+    >>> from bouncing_ball.distribution import outgoing_speed_solution, weight_function
+    >>> solution = outgoing_speed_solution("1/2")  # doctest: +SKIP
+    >>> print(weight_function([0.1, 1.0], solution).round(8))  # doctest: +SKIP
+    [0.22905337 0.15334074]
+    """
     return np.exp(log_weight_function(force, solution, density))
 
 
@@ -768,11 +988,51 @@ def weight_function(force, solution, density=None):
 
 @dataclass(frozen=True)
 class WeightFunction:
-    """ln w(F) of eq. (weightfunc), interpolated: ln w + S/F by Chebyshev series in ln F on panels
-    covering [smallest_force, largest_force]; above, w = w(F_max) (F/F_max)^alpha
-    [(1 - kappa) + kappa (F/F_max)^(-1/3)] with alpha = (2 beta - 5)/6 (from h ~ v^-beta; the
-    correction from the next term of P(0, v) at small v) and kappa matching the slope; below,
-    the end value and slope of ln w + S/F in ln F (see the module docstring)."""
+    """w(F) of eq. (weightfunc), interpolated in ln F (``interpolated_weight_function``).
+
+    ln w + S/F by Chebyshev series in ln F on panels covering [smallest_force, largest_force];
+    above, w = w(F_max) (F/F_max)^alpha [(1 - kappa) + kappa (F/F_max)^(-1/3)] with
+    alpha = (2 beta - 5)/6 (from h ~ v^-beta; the correction from the next term of P(0, v) at
+    small v) and kappa matching the slope; below, gamma ln F plus a polynomial in F fitted on
+    the first panel (w ~ F^gamma e^(-S/F), ``small_force_power``; see the module docstring).
+    Calling it gives w(F); ``log(F)`` gives ln w(F) (which neither over- nor underflows), and
+    ``log_scalar(F)`` the same for one float F, fast; ``smallest_force`` and ``largest_force``
+    are F_min and F_max.
+
+    Parameters
+    ----------
+    restitution : float
+        r.
+    small_speed_exponent : float
+        beta(r) of eq. (asym2).
+    small_force_decay : float
+        S of ``small_force_decay``.
+    edges : numpy.ndarray
+        The panel edges in ln F.
+    series : tuple of numpy.polynomial.Chebyshev
+        Per panel, ln w + S/F against ln F.
+    small_force_power : float
+        gamma in w ~ F^gamma e^(-S/F) as F -> 0 (``small_force_power``).
+    small_force_series : numpy.polynomial.Polynomial
+        ln w + S/F - gamma ln F against F, below F_min.
+    interpolation_error : float, optional
+        The largest difference of the interpolated and the direct ln w at two points of every
+        panel between the nodes: an estimate of the relative error of w, and so of P(x) (NaN:
+        not estimated).
+
+    Examples
+    --------
+    Built by ``interpolated_weight_function`` in seconds, after the solve (which compiles the
+    kernel on its first call), so not run as a doctest; at r = 1/2 it is eq. (weightfunc2):
+
+    >>> from bouncing_ball.distribution import interpolated_weight_function
+    >>> from bouncing_ball.distribution import outgoing_speed_solution
+    >>> weight = interpolated_weight_function(outgoing_speed_solution("1/2"))  # doctest: +SKIP
+    >>> print(weight([0.1, 1.0]).round(8), weight.interpolation_error < 1e-12)  # doctest: +SKIP
+    [0.22905337 0.15334074] True
+    >>> print(weight.smallest_force, weight.largest_force)  # doctest: +SKIP
+    0.0008333333333333333 100000000.00000018
+    """
 
     restitution: float
     small_speed_exponent: float
@@ -787,10 +1047,12 @@ class WeightFunction:
 
     @property
     def smallest_force(self) -> float:
+        """F_min, the lowest panel edge: below, w is continued by its small-F form."""
         return float(np.exp(self.edges[0]))
 
     @property
     def largest_force(self) -> float:
+        """F_max, the highest panel edge: above, w is continued by its power law."""
         return float(np.exp(self.edges[-1]))
 
     def _smooth(self, y):
@@ -802,7 +1064,18 @@ class WeightFunction:
         return out
 
     def log(self, force):
-        """ln w(F)."""
+        """ln w(F).
+
+        Parameters
+        ----------
+        force : array_like
+            Values of F > 0.
+
+        Returns
+        -------
+        numpy.ndarray
+            ln w(F), the shape of ``force``.
+        """
         force = np.asarray(force, dtype=float)
         y = np.atleast_1d(np.log(force)).astype(float)
         lo, hi = self.edges[0], self.edges[-1]
@@ -832,7 +1105,18 @@ class WeightFunction:
         return float(value), alpha, float(3.0 * (alpha - slope))
 
     def log_scalar(self, force: float) -> float:
-        """ln w(F) for one F (a fast path for scalar integrands: Clenshaw on the panel's series)."""
+        """ln w(F) for one F (a fast path for scalar integrands: Clenshaw on the panel's series).
+
+        Parameters
+        ----------
+        force : float
+            F > 0.
+
+        Returns
+        -------
+        float
+            ln w(F), as ``log`` gives it.
+        """
         y = math.log(force)
         if y > self._edge_list[-1]:
             value, alpha, kappa = self._large_force_law
@@ -862,11 +1146,24 @@ class WeightFunction:
         return [[float(c) for c in piece.coef] for piece in self.series]
 
     def __call__(self, force):
-        """w(F) (over- or underflows where ``log`` does not)."""
+        """w(F).
+
+        Parameters
+        ----------
+        force : array_like
+            Values of F > 0.
+
+        Returns
+        -------
+        numpy.ndarray
+            w(F), the shape of ``force`` (over- or underflows where ``log`` does not).
+        """
         return np.exp(self.log(force))
 
 
-NOISE_TOLERANCE = 2e-9  # the largest estimated relative rounding error of w accepted
+#: The largest estimated relative rounding error of w(F) accepted: the interpolated w starts
+#: at the smallest F at which the direct evaluation is this accurate.
+NOISE_TOLERANCE = 2e-9
 
 
 def _accurate(density, force) -> bool:
@@ -902,10 +1199,44 @@ def _smallest_force(density, floor) -> float:
 
 
 def interpolated_weight_function(solution, panel_nodes=PANEL_CHEBYSHEV_NODES) -> WeightFunction:
-    """w(F) of eq. (weightfunc) at Chebyshev nodes on panels in ln F, interpolated
-    (``WeightFunction``).  Where r > 1/2 the panels at F < 1 are SMALL_PANEL_WIDTH wide (there
-    the saddle e^(-S/F) and end-point e^(-1/(12F)) terms of w cross over), else PANEL_WIDTH;
-    LARGE_PANEL_WIDTH at F > 1."""
+    """w(F) of eq. (weightfunc), computed at Chebyshev nodes on panels in ln F and interpolated.
+
+    The panels run from F_min, the smallest F at which the direct evaluation
+    (``log_weight_function``) is accurate to ``NOISE_TOLERANCE``, to LARGEST_FORCE.  Where
+    r > 1/2 the panels at F < 1 are SMALL_PANEL_WIDTH wide (there the saddle e^(-S/F) and
+    end-point e^(-1/(12F)) terms of w cross over), else PANEL_WIDTH; LARGE_PANEL_WIDTH at
+    F > 1.  The interpolation error is estimated against w computed directly between the nodes.
+
+    Parameters
+    ----------
+    solution : solver.OutgoingSpeedSolution
+        P(0, v) of eq. (inteq), from ``outgoing_speed_solution`` (which reaches as far as
+        small F needs).
+    panel_nodes : int, optional
+        Chebyshev nodes per panel (``PANEL_CHEBYSHEV_NODES``).
+
+    Returns
+    -------
+    WeightFunction
+        The interpolated w(F), with its estimated ``interpolation_error``.
+
+    Raises
+    ------
+    ValueError
+        If r lies outside ``DISTRIBUTION_RESTITUTION_RANGE``, w(1) cannot be computed
+        accurately from the solution, or w is not finite at an interpolation node.
+
+    Examples
+    --------
+    Takes seconds, after the solve (which compiles the kernel on its first call), so not run
+    as a doctest:
+
+    >>> from bouncing_ball.distribution import interpolated_weight_function
+    >>> from bouncing_ball.distribution import outgoing_speed_solution
+    >>> weight = interpolated_weight_function(outgoing_speed_solution("1/2"))  # doctest: +SKIP
+    >>> print(weight([0.1, 1.0]).round(8))  # doctest: +SKIP
+    [0.22905337 0.15334074]
+    """
     check_restitution(solution.restitution)
     density = _outgoing_density(solution)
     decay = small_force_decay(solution.restitution)
@@ -961,16 +1292,75 @@ def interpolated_weight_function(solution, panel_nodes=PANEL_CHEBYSHEV_NODES) ->
 
 
 def closed_form_weight_function(restitution, log_weight) -> "ClosedFormWeight":
-    """A weight function known in closed form (exact.py), usable wherever a ``WeightFunction`` is."""
+    """A weight function known in closed form, usable wherever a ``WeightFunction`` is.
+
+    Everything here that takes a weight function takes it, except ``measured_exponents`` and
+    ``exponents_table`` (they need the interpolant's beta and F_min).
+
+    Parameters
+    ----------
+    restitution : float
+        r.
+    log_weight : callable
+        ln w(F) for an array of F > 0, e.g. from ``exact.weight_function``,
+        eq. (weightfunc2).
+
+    Returns
+    -------
+    ClosedFormWeight
+        The weight function.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> from bouncing_ball.distribution import closed_form_weight_function
+    >>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> print(weight([0.1, 1.0]).round(8))
+    [0.22905337 0.15334074]
+    """
     return ClosedFormWeight(float(restitution), log_weight)
 
 
 @dataclass(frozen=True)
 class ClosedFormWeight:
+    """w(F) given by its logarithm in closed form (``closed_form_weight_function``).
+
+    Calling it gives w(F); ``log(F)`` gives ln w(F).
+
+    Parameters
+    ----------
+    restitution : float
+        r.
+    log : callable
+        ln w(F) for an array of F > 0.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> from bouncing_ball.distribution import ClosedFormWeight
+    >>> weight = ClosedFormWeight(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> print(round(float(weight(1.0)), 8))
+    0.15334074
+    """
+
     restitution: float
     log: object  # callable: ln w(F)
 
     def __call__(self, force):
+        """w(F).
+
+        Parameters
+        ----------
+        force : array_like
+            Values of F > 0.
+
+        Returns
+        -------
+        numpy.ndarray
+            w(F), the shape of ``force``.
+        """
         return np.exp(self.log(force))
 
 
@@ -1005,28 +1395,156 @@ def _laplace(weight, power, x):
 
 
 def position_density(x, weight):
-    """P(x) = int dF F^(-1/2) w(F) exp(-1/(12F) - F x), eq. (P(x)1)."""
+    """P(x) = int dF F^(-1/2) w(F) exp(-1/(12F) - F x), eq. (P(x)1).
+
+    The F integral by Gauss-Legendre in ln F, from where the integrand has fallen below e^-100
+    up to F = 1e24.
+
+    Parameters
+    ----------
+    x : array_like
+        Heights x >= 0.
+    weight : WeightFunction or ClosedFormWeight
+        w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
+        ``closed_form_weight_function``).
+
+    Returns
+    -------
+    numpy.ndarray
+        P(x), the shape of ``x``.
+
+    Examples
+    --------
+    At r = 1/2, from the exact w(F), it is eq. (P(x)2):
+
+    >>> from bouncing_ball.distribution import closed_form_weight_function, position_density
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> print(position_density([0.1, 1.0, 10.0], weight).round(8))
+    [0.50377641 0.18378367 0.01886243]
+    >>> print(exact.position_density([0.1, 1.0, 10.0], "1/2").round(8))
+    [0.50377641 0.18378367 0.01886243]
+    """
     return _laplace(weight, 0.0, x)
 
 
 def position_tail(x, weight):
-    """int_x^inf P(x') dx' = int dF F^(-3/2) w(F) exp(-1/(12F) - F x), from eq. (P(x)1)."""
+    """int_x^inf P(x') dx' = int dF F^(-3/2) w(F) exp(-1/(12F) - F x), from eq. (P(x)1).
+
+    Parameters
+    ----------
+    x : array_like
+        Heights x >= 0.
+    weight : WeightFunction or ClosedFormWeight
+        w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
+        ``closed_form_weight_function``).
+
+    Returns
+    -------
+    numpy.ndarray
+        The probability above x, the shape of ``x``; 1 at x = 0 (eq. (normalization2)).
+
+    Examples
+    --------
+    >>> from bouncing_ball.distribution import closed_form_weight_function, position_tail
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> print(position_tail([0.1, 1.0, 10.0], weight).round(8))
+    [0.93357681 0.68198146 0.17235138]
+    >>> print(round(float(position_tail(0.0, weight)), 12))
+    1.0
+    """
     return _laplace(weight, 1.0, x)
 
 
 def mean_speed_squared_given_position(x, weight):
-    """<v^2>_x = P(x)^-1 int_x^inf P(x') dx', eq. (moment2)."""
+    """<v^2>_x = P(x)^-1 int_x^inf P(x') dx', eq. (moment2).
+
+    Parameters
+    ----------
+    x : array_like
+        Heights x >= 0.
+    weight : WeightFunction or ClosedFormWeight
+        w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
+        ``closed_form_weight_function``).
+
+    Returns
+    -------
+    numpy.ndarray
+        The mean square speed at height x, the shape of ``x``.
+
+    Examples
+    --------
+    >>> from bouncing_ball.distribution import closed_form_weight_function
+    >>> from bouncing_ball.distribution import mean_speed_squared_given_position
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> print(mean_speed_squared_given_position([0.1, 1.0, 10.0], weight).round(8))
+    [1.85315706 3.71078371 9.13728189]
+    >>> print(exact.mean_speed_squared_given_position([0.1, 1.0, 10.0], "1/2").round(8))
+    [1.85315706 3.71078371 9.13728189]
+    """
     return position_tail(x, weight) / position_density(x, weight)
 
 
 def position_moment(k: int, weight) -> float:
-    """int_0^inf x^k P(x) dx = k! int dF F^(-3/2 - k) w(F) e^(-1/(12F)), eqs. (P(x)1),
-    (normalization2) (k = 0)."""
+    """int_0^inf x^k P(x) dx = k! int dF F^(-3/2 - k) w(F) e^(-1/(12F)), eq. (P(x)1).
+
+    At k = 0 it is the normalisation, eq. (normalization2).
+
+    Parameters
+    ----------
+    k : int
+        The power of x, k >= 0.
+    weight : WeightFunction or ClosedFormWeight
+        w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
+        ``closed_form_weight_function``).
+
+    Returns
+    -------
+    float
+        The k-th moment of P(x).
+
+    Examples
+    --------
+    At r = 1/2: 1, <x> = 6 and <x^2> = 6^2 + 108, eq. (xandDeltax):
+
+    >>> from bouncing_ball.distribution import closed_form_weight_function, position_moment
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> print([round(position_moment(k, weight), 9) for k in (0, 1, 2)])
+    [1.0, 6.0, 144.0]
+    """
     return float(math.factorial(k) * _laplace(weight, 1.0 + k, 0.0))
 
 
 def position_averages(weight) -> dict:
-    """The normalisation, <x> and Delta x (eq. (xandDeltax)) from P(x)."""
+    """The normalisation, <x> and Delta x (eq. (xandDeltax)) from P(x) of eq. (P(x)1).
+
+    Parameters
+    ----------
+    weight : WeightFunction or ClosedFormWeight
+        w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
+        ``closed_form_weight_function``).
+
+    Returns
+    -------
+    dict
+        normalization (int P dx, eq. (normalization2)), mean_x (<x>) and delta_x (Delta x).
+
+    Examples
+    --------
+    >>> from bouncing_ball.distribution import closed_form_weight_function, position_averages
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> print({name: round(value, 9) for name, value in position_averages(weight).items()})
+    {'normalization': 1.0, 'mean_x': 6.0, 'delta_x': 10.392304845}
+    """
     norm, first, second = (position_moment(k, weight) for k in (0, 1, 2))
     mean_x = first / norm
     return {
@@ -1049,15 +1567,70 @@ def _bin_laplace(weight, power, lo, hi):
 
 
 def position_bin_average(lo, hi, weight):
-    """int_lo^hi P(x) dx / (hi - lo), the quantity a simulation's position bin measures."""
+    """int_lo^hi P(x) dx / (hi - lo), the quantity a simulation's position bin measures.
+
+    P(x) of eq. (P(x)1), the x integral done under the F integral in closed form (no
+    cancellation in narrow bins).
+
+    Parameters
+    ----------
+    lo, hi : array_like
+        The bins' lower and upper edges, 0 <= lo < hi; they broadcast.
+    weight : WeightFunction or ClosedFormWeight
+        w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
+        ``closed_form_weight_function``).
+
+    Returns
+    -------
+    numpy.ndarray
+        The bin averages of P(x), the broadcast shape of ``lo`` and ``hi``.
+
+    Examples
+    --------
+    >>> from bouncing_ball.distribution import closed_form_weight_function, position_bin_average
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> print(position_bin_average([0.0, 1.0], [1.0, 2.0], weight).round(8))
+    [0.31801854 0.1429493 ]
+    >>> print(exact.position_bin_average([0.0, 1.0], [1.0, 2.0], "1/2").round(8))
+    [0.31801854 0.1429493 ]
+    """
     lo, hi = np.broadcast_arrays(np.asarray(lo, dtype=float), np.asarray(hi, dtype=float))
     return _bin_laplace(weight, 1.0, lo, hi) / (hi - lo)
 
 
 def speed_squared_given_position_bin_average(lo, hi, weight):
-    """<v^2>_x of eq. (moment2) averaged over [lo, hi) with weight P(x):
+    """<v^2>_x of eq. (moment2) averaged over [lo, hi) with weight P(x), as a bin measures it.
+
     int_bin dx int_x^inf P / int_bin P dx; under the F integral,
-    int_lo^hi dx int_x^inf e^(-F x') dx' = (e^(-F lo) - e^(-F hi)) / F^2."""
+    int_lo^hi dx int_x^inf e^(-F x') dx' = (e^(-F lo) - e^(-F hi)) / F^2.
+
+    Parameters
+    ----------
+    lo, hi : array_like
+        The bins' lower and upper edges, 0 <= lo < hi; they broadcast.
+    weight : WeightFunction or ClosedFormWeight
+        w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
+        ``closed_form_weight_function``).
+
+    Returns
+    -------
+    numpy.ndarray
+        The bin averages of <v^2>_x, the broadcast shape of ``lo`` and ``hi``.
+
+    Examples
+    --------
+    >>> from bouncing_ball.distribution import closed_form_weight_function
+    >>> from bouncing_ball.distribution import speed_squared_given_position_bin_average
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> print(speed_squared_given_position_bin_average([0.0, 1.0], [1.0, 2.0], weight).round(8))
+    [2.53258574 4.23045873]
+    >>> print(exact.speed_squared_given_position_bin_average([0, 1], [1, 2], "1/2").round(8))
+    [2.53258574 4.23045873]
+    """
     return _bin_laplace(weight, 2.0, lo, hi) / _bin_laplace(weight, 1.0, lo, hi)
 
 
@@ -1083,9 +1656,41 @@ def _distribution_integrand(log_force, x, v, weight, width=0.0):
 
 
 def check_force_integral_point(x: float, v: float) -> None:
-    """ValueError naming x unless the F integral of eq. (fpsol) converges at (x, v) and quad
-    evaluates it: x > 0 where the phase of psi_F(-v) stays below LARGEST_AIRY_PHASE (any x > 0
-    where v <= 0; x >= 1e-4 up to v = 18), and x = 0 only with v < 0."""
+    """Refuse an (x, v) at which the F integral of eq. (fpsol) diverges or quad cannot follow it.
+
+    The integral converges and quad evaluates it at x > 0 where the phase of psi_F(-v) stays
+    below ``LARGEST_AIRY_PHASE`` (any x > 0 where v <= 0; x >= 1e-4 up to v = 18), and at x = 0
+    only with v < 0.
+
+    Parameters
+    ----------
+    x : float
+        The height.
+    v : float
+        The velocity.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    ValueError
+        Naming x (and the smallest x it can be at this v), elsewhere.
+
+    Examples
+    --------
+    >>> from bouncing_ball.distribution import check_force_integral_point
+    >>> check_force_integral_point(0.0, -1.0)
+    >>> check_force_integral_point(0.0, 1.0)
+    Traceback (most recent call last):
+    ...
+    ValueError: x = 0.0: the F integral of eq. (fpsol) needs x > 0, or x = 0 with v < 0 (v = 1.0)
+    >>> check_force_integral_point(1e-8, 2.0)
+    Traceback (most recent call last):
+    ...
+    ValueError: x = 1e-08: at v = 2.0 the F integral of eq. (fpsol) ... below x = 1.3e-07; ...
+    """
     if not x >= 0.0 or (x == 0.0 and not v < 0.0):
         raise ValueError(
             f"x = {x}: the F integral of eq. (fpsol) needs x > 0, or x = 0 with v < 0 (v = {v})"
@@ -1103,6 +1708,41 @@ def distribution_by_force_integral(x, v, weight):
 
     Converges absolutely for x > 0, and for x = 0 on the incoming side v < 0
     (there the Airy function decays); at x = 0, v > 0 only conditionally.
+
+    Parameters
+    ----------
+    x : float
+        The height, x >= 0 (x = 0 only with v < 0: ``check_force_integral_point``).
+    v : float
+        The velocity.
+    weight : WeightFunction or ClosedFormWeight
+        w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
+        ``closed_form_weight_function``).
+
+    Returns
+    -------
+    value : float
+        P(x, v).
+    error : float
+        quad's estimate of its absolute error.
+
+    Raises
+    ------
+    ValueError
+        As ``check_force_integral_point``.
+
+    Examples
+    --------
+    >>> from bouncing_ball.distribution import closed_form_weight_function
+    >>> from bouncing_ball.distribution import distribution_by_force_integral
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> value, error = distribution_by_force_integral(0.5, 1.0, weight)
+    >>> print(round(value, 8), error < 1e-10)
+    0.07568971 True
+    >>> print(round(exact.distribution_by_force_integral(0.5, 1.0, "1/2")[0], 8))
+    0.07568971
     """
     xi, vi = float(x), float(v)
     check_force_integral_point(xi, vi)
@@ -1123,13 +1763,15 @@ def distribution_by_force_integral(x, v, weight):
     return value, error
 
 
-CELL_SPEED_NODES = 8  # Gauss-Legendre nodes per panel in v of ``distribution_cell_average``
+#: Gauss-Legendre nodes per panel in v of ``distribution_cell_average``.
+CELL_SPEED_NODES = 8
 
 
 def distribution_cell_average(x_lo, x_hi, v_lo, v_hi, weight, speed_nodes=CELL_SPEED_NODES):
-    """(1 / area) int_{x_lo}^{x_hi} dx int_{v_lo}^{v_hi} dv P(x, v): what a cell of a simulation's
-    P(x, v) histogram measures, for broadcast arrays of cells with 0 < x_lo < x_hi and finite
-    v_lo < v_hi.
+    """The average of P(x, v) of eq. (fpsol) over a cell, as a simulation's histogram measures it.
+
+    (1 / area) int_{x_lo}^{x_hi} dx int_{v_lo}^{v_hi} dv P(x, v), for broadcast arrays of cells
+    with 0 < x_lo < x_hi and finite v_lo < v_hi.
 
     The x average is done under the F integral of eq. (fpsol) in closed form,
     (1 / (x_hi - x_lo)) int dx e^{-F x} = e^{-F x_lo} (1 - e^{-F (x_hi - x_lo)}) / (F (x_hi - x_lo)),
@@ -1139,6 +1781,37 @@ def distribution_cell_average(x_lo, x_hi, v_lo, v_hi, weight, speed_nodes=CELL_S
     quadrature of the exact solutions for x_lo >= 0.01 (tests/unit/test_distribution_cells.py);
     at x_lo = 1e-3 (r = 0.25, v in [0, 1)) 3 to 12 nodes per panel agree to 1e-8, not checked
     against an independent computation.
+
+    Parameters
+    ----------
+    x_lo, x_hi, v_lo, v_hi : array_like
+        The cells' edges in x and v; they broadcast.
+    weight : WeightFunction or ClosedFormWeight
+        w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
+        ``closed_form_weight_function``).
+    speed_nodes : int, optional
+        Gauss-Legendre nodes per panel in v (``CELL_SPEED_NODES``).
+
+    Returns
+    -------
+    numpy.ndarray
+        The cell averages of P(x, v), the broadcast shape of the edges.
+
+    Raises
+    ------
+    ValueError
+        If a cell is not 0 < x_lo < x_hi < inf with finite v_lo < v_hi, or reaches an x and
+        v > 0 at which the F integral oscillates too fast (``LARGEST_AIRY_PHASE``).
+
+    Examples
+    --------
+    >>> from bouncing_ball.distribution import closed_form_weight_function
+    >>> from bouncing_ball.distribution import distribution_cell_average
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> print(distribution_cell_average([0.5, 1.0], [1.0, 2.0], 0.0, 1.0, weight).round(8))
+    [0.06005725 0.03294018]
     """
     x_lo, x_hi, v_lo, v_hi = np.broadcast_arrays(
         *(np.asarray(a, dtype=float) for a in (x_lo, x_hi, v_lo, v_hi))
@@ -1182,6 +1855,48 @@ def distribution_with_error(x, v, weight, solution):
     x > 0: eq. (fpsol) by the F integral.  x = 0: the outgoing side is the
     solver's P(0, v), the incoming side the boundary condition eq. (bc),
     P(0, -v) = r^2 P(0, r v); P(0, 0) diverges and is NaN.
+
+    Parameters
+    ----------
+    x, v : array_like
+        Heights x >= 0 and velocities; they broadcast.
+    weight : WeightFunction or ClosedFormWeight
+        w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
+        ``closed_form_weight_function``).
+    solution : solver.OutgoingSpeedSolution
+        P(0, v) of eq. (inteq), used at x = 0 only (evaluating it there compiles the kernel on
+        its first call).
+
+    Returns
+    -------
+    values : numpy.ndarray
+        P(x, v), the broadcast shape.
+    errors : numpy.ndarray
+        quad's estimates of their absolute errors (0 at x = 0).
+
+    Raises
+    ------
+    ValueError
+        Before any integral, as ``check_force_integral_point`` for each (x, v) with x != 0.
+
+    Examples
+    --------
+    At x > 0 (``solution``, the exact P(0, v) of r = 1/2 on the solver's nodes, is not used):
+
+    >>> from bouncing_ball.distribution import closed_form_weight_function
+    >>> from bouncing_ball.distribution import distribution_with_error
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> from bouncing_ball.solver import OutgoingSpeedSolution
+    >>> from bouncing_ball.solver import coordinate_of_speed, speed_of_coordinate
+    >>> s = np.arange(coordinate_of_speed(1e-12), coordinate_of_speed(65.0), 0.25)
+    >>> nodes = speed_of_coordinate(s)
+    >>> density = exact.outgoing_speed_density(nodes, "1/2")
+    >>> solution = OutgoingSpeedSolution(0.5, 1.0, 0.25, nodes, density, 1.0)
+    >>> values, errors = distribution_with_error([0.5, 1.0], 1.0, weight, solution)
+    >>> print(values.round(8), bool(np.all(errors < 1e-10 * values)))
+    [0.07568971 0.04549126] True
     """
     x, v = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(v, dtype=float))
     for index in np.ndindex(x.shape):
@@ -1204,7 +1919,48 @@ def distribution_with_error(x, v, weight, solution):
 
 
 def distribution(x, v, weight, solution):
-    """P(x, v), eq. (fpsol) for x > 0 (eq. (bc) and the solver's P(0, v) at x = 0)."""
+    """P(x, v), eq. (fpsol) for x > 0 (eq. (bc) and the solver's P(0, v) at x = 0).
+
+    Parameters
+    ----------
+    x, v : array_like
+        Heights x >= 0 and velocities; they broadcast.
+    weight : WeightFunction or ClosedFormWeight
+        w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
+        ``closed_form_weight_function``).
+    solution : solver.OutgoingSpeedSolution
+        P(0, v) of eq. (inteq), used at x = 0 only (``distribution_with_error``).
+
+    Returns
+    -------
+    numpy.ndarray
+        P(x, v), the broadcast shape of ``x`` and ``v``; NaN at x = v = 0.
+
+    Raises
+    ------
+    ValueError
+        As ``check_force_integral_point`` for each (x, v) with x != 0.
+
+    Examples
+    --------
+    At r = 1/2, from the exact w(F), it is eq. (fpsol) with eq. (weightfunc2) (``solution``,
+    the exact P(0, v) on the solver's nodes, is used only at x = 0):
+
+    >>> from bouncing_ball.distribution import closed_form_weight_function, distribution
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> from bouncing_ball.solver import OutgoingSpeedSolution
+    >>> from bouncing_ball.solver import coordinate_of_speed, speed_of_coordinate
+    >>> s = np.arange(coordinate_of_speed(1e-12), coordinate_of_speed(65.0), 0.25)
+    >>> nodes = speed_of_coordinate(s)
+    >>> density = exact.outgoing_speed_density(nodes, "1/2")
+    >>> solution = OutgoingSpeedSolution(0.5, 1.0, 0.25, nodes, density, 1.0)
+    >>> print(distribution([0.5, 1.0], [1.0, -1.0], weight, solution).round(8))
+    [0.07568971 0.02794986]
+    >>> print(exact.distribution([0.5, 1.0], [1.0, -1.0], "1/2").round(8))
+    [0.07568971 0.02794986]
+    """
     return distribution_with_error(x, v, weight, solution)[0]
 
 
@@ -1213,22 +1969,118 @@ def distribution(x, v, weight, solution):
 
 
 def weight_table(weight, forces):
-    """w(F) at ``forces``: columns F, w, log_w (w over- or underflows where log_w does not)."""
+    """w(F) of eq. (weightfunc) at ``forces``, as a table.
+
+    Parameters
+    ----------
+    weight : WeightFunction or ClosedFormWeight
+        w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
+        ``closed_form_weight_function``).
+    forces : array_like
+        Values of F > 0.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns F, w and log_w (w over- or underflows where log_w does not).
+
+    Examples
+    --------
+    >>> from bouncing_ball.distribution import closed_form_weight_function, weight_table
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> print(weight_table(weight, [0.1, 1.0]).round(6).to_string(index=False))
+      F        w     log_w
+    0.1 0.229053 -1.473800
+    1.0 0.153341 -1.875093
+    """
     forces = np.asarray(forces, dtype=float)
     log_w = weight.log(forces)
     return pd.DataFrame({"F": forces, "w": np.exp(log_w), "log_w": log_w})
 
 
 def position_table(weight, positions):
-    """P(x) and <v^2>_x at ``positions``: columns x, px, v2_given_x."""
+    """P(x) of eq. (P(x)1) and <v^2>_x of eq. (moment2) at ``positions``, as a table.
+
+    Parameters
+    ----------
+    weight : WeightFunction or ClosedFormWeight
+        w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
+        ``closed_form_weight_function``).
+    positions : array_like
+        Heights x >= 0.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns x, px and v2_given_x.
+
+    Examples
+    --------
+    >>> from bouncing_ball.distribution import closed_form_weight_function, position_table
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> print(position_table(weight, [0.1, 1.0]).round(6).to_string(index=False))
+      x       px  v2_given_x
+    0.1 0.503776    1.853157
+    1.0 0.183784    3.710784
+    """
     x = np.asarray(positions, dtype=float)
     px = position_density(x, weight)
     return pd.DataFrame({"x": x, "px": px, "v2_given_x": position_tail(x, weight) / px})
 
 
 def distribution_table(weight, solution, positions, speeds):
-    """P(x, v) for every x in ``positions`` and v in ``speeds`` (long format: x, v, pxv), and
-    the largest relative error quad estimates for it."""
+    """P(x, v) of eq. (fpsol) for every x in ``positions`` and v in ``speeds``, as a table.
+
+    Parameters
+    ----------
+    weight : WeightFunction or ClosedFormWeight
+        w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
+        ``closed_form_weight_function``).
+    solution : solver.OutgoingSpeedSolution
+        P(0, v) of eq. (inteq), used at x = 0 only (``distribution_with_error``).
+    positions : array_like
+        Heights x >= 0.
+    speeds : array_like
+        Velocities v.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        Long format: columns x, v and pxv, x varying slowest.
+    worst : float
+        The largest relative error quad estimates for a positive P(x, v) of the table.
+
+    Raises
+    ------
+    ValueError
+        As ``check_force_integral_point`` for each (x, v) with x != 0.
+
+    Examples
+    --------
+    At x > 0 (``solution``, the exact P(0, v) of r = 1/2 on the solver's nodes, is not used):
+
+    >>> from bouncing_ball.distribution import closed_form_weight_function, distribution_table
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> from bouncing_ball.solver import OutgoingSpeedSolution
+    >>> from bouncing_ball.solver import coordinate_of_speed, speed_of_coordinate
+    >>> s = np.arange(coordinate_of_speed(1e-12), coordinate_of_speed(65.0), 0.25)
+    >>> nodes = speed_of_coordinate(s)
+    >>> density = exact.outgoing_speed_density(nodes, "1/2")
+    >>> solution = OutgoingSpeedSolution(0.5, 1.0, 0.25, nodes, density, 1.0)
+    >>> table, worst = distribution_table(weight, solution, [0.5, 1.0], [-1.0, 1.0])
+    >>> print(table.round(6).to_string(index=False), worst < 1e-9)
+      x    v      pxv
+    0.5 -1.0 0.042010
+    0.5  1.0 0.075690
+    1.0 -1.0 0.027950
+    1.0  1.0 0.045491 True
+    """
     x, v = np.meshgrid(np.asarray(positions, dtype=float), speeds, indexing="ij")
     pxv, error = distribution_with_error(x, v, weight, solution)
     finite = np.isfinite(pxv) & (pxv > 0.0)
@@ -1248,6 +2100,26 @@ def predicted_exponents(restitution) -> dict:
     (S of ``small_force_decay``: b = (2/3)^(1/2) for r <= 1/2, q (2 (3 - 2q) / 3)^(1/2) above)
     and c = -(gamma + 1)/2 (gamma of ``small_force_power``: -1/2 for r < 1/2, -1/4 at r = 1/2,
     1/4 - m/2 above), from the saddle point F ~ ((S + 1/12)/x)^(1/2) of eq. (P(x)1).
+
+    Parameters
+    ----------
+    restitution : float or str
+        r, 0 < r < 1, a float or a fraction string ("1/3").
+
+    Returns
+    -------
+    dict
+        small_x_power ((1 - beta)/3), small_x_power_at_zero_speed (-beta/3), large_x_rate (b)
+        and large_x_power (c).
+
+    Examples
+    --------
+    At r = 1/3 P(x) ~ x^(-1/6) at small x (eq. (P(x)2)):
+
+    >>> from bouncing_ball.distribution import predicted_exponents
+    >>> print({key: round(float(value), 6) for key, value in predicted_exponents("1/3").items()})
+    {'small_x_power': -0.166667, 'small_x_power_at_zero_speed': -0.5, 'large_x_rate': 0.816497,
+    'large_x_power': -0.5}
     """
     restitution = restitution_float(restitution)
     beta = small_speed_exponent(restitution)
@@ -1276,6 +2148,35 @@ def measured_exponents(weight, large_window=None) -> dict:
     on ``large_window`` = (x_lo, x_hi) (default: where the saddle point F_s = ((S + 1/12)/x)^(1/2)
     lies between 2 F_min and (S + 1/12)/8, so that w(F) there is computed, not continued, and
     x_hi at most 75^2 / (S + 1/12)).
+
+    Parameters
+    ----------
+    weight : WeightFunction
+        The interpolated w(F) of eq. (weightfunc) (its beta and F_min are used).
+    large_window : tuple of float, optional
+        (x_lo, x_hi) of the large-x fit; the default as above.
+
+    Returns
+    -------
+    dict
+        The keys of ``predicted_exponents``, measured, and large_x_window, the (x_lo, x_hi)
+        used.
+
+    Examples
+    --------
+    A ``WeightFunction`` takes seconds to build, after the solve (which compiles the kernel on
+    its first call), so not run as a doctest; at r = 1/2 the small-x slope carries the log
+    correction (predicted 0):
+
+    >>> from bouncing_ball.distribution import measured_exponents
+    >>> from bouncing_ball.distribution import interpolated_weight_function
+    >>> from bouncing_ball.distribution import outgoing_speed_solution
+    >>> weight = interpolated_weight_function(outgoing_speed_solution("1/2"))  # doctest: +SKIP
+    >>> measured = measured_exponents(weight)  # doctest: +SKIP
+    >>> del measured["large_x_window"]  # doctest: +SKIP
+    >>> print({key: round(value, 3) for key, value in measured.items()})  # doctest: +SKIP
+    {'small_x_power': -0.06, 'small_x_power_at_zero_speed': -0.337, 'large_x_rate': 0.816,
+    'large_x_power': -0.25}
     """
     beta = weight.small_speed_exponent
     x_small = np.geomspace(1e-8, 1e-6, 9)
@@ -1309,7 +2210,33 @@ def measured_exponents(weight, large_window=None) -> dict:
 
 
 def exponents_table(weights) -> pd.DataFrame:
-    """Measured and predicted exponents of P(x) for each weight function: one row per r."""
+    """Measured and predicted exponents of P(x) for each weight function: one row per r.
+
+    Parameters
+    ----------
+    weights : iterable of WeightFunction
+        Interpolated w(F) of eq. (weightfunc), one per r.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns r, <key>_measured and <key>_predicted for each key of ``predicted_exponents``
+        (``measured_exponents``), and large_x_window_lo, large_x_window_hi.
+
+    Examples
+    --------
+    Not run as a doctest (as ``measured_exponents``):
+
+    >>> from bouncing_ball.distribution import exponents_table
+    >>> from bouncing_ball.distribution import interpolated_weight_function
+    >>> from bouncing_ball.distribution import outgoing_speed_solution
+    >>> weight = interpolated_weight_function(outgoing_speed_solution("1/2"))  # doctest: +SKIP
+    >>> table = exponents_table([weight])  # doctest: +SKIP
+    >>> columns = ["r", "large_x_rate_measured", "large_x_rate_predicted"]
+    >>> print(table[columns].round(4))  # doctest: +SKIP
+         r  large_x_rate_measured  large_x_rate_predicted
+    0  0.5                 0.8165                  0.8165
+    """
     rows = []
     for weight in weights:
         measured = measured_exponents(weight)
@@ -1326,13 +2253,13 @@ def exponents_table(weights) -> pd.DataFrame:
 # ---------------------------------------------------------------------------------------------
 # the checks of rule solve's tables
 
-# how far the measured exponents of P(x) (``measured_exponents``) may lie from the predicted ones
-# (``predicted_exponents``) over DISTRIBUTION_RESTITUTION_RANGE: the small-x slopes at x ~ 1e-7
-# carry corrections of relative order x^((beta - 1)/3) (the log at r = 1/2: -0.06), absolute
-# tolerances; the large-x rate relative, its power absolute, the power checked only where the
-# fit window starts beyond 100 (1 - q)^-4 / 6, where the power law has set in (close to r = 1/2
-# it sets in much further out than any window; there the rate is held to 10 times its
-# tolerance: 7e-4 off at r = 0.48)
+#: How far the measured exponents of P(x) (``measured_exponents``) may lie from the predicted
+#: ones (``predicted_exponents``) over DISTRIBUTION_RESTITUTION_RANGE: the small-x slopes at
+#: x ~ 1e-7 carry corrections of relative order x^((beta - 1)/3) (the log at r = 1/2: -0.06),
+#: absolute tolerances; the large-x rate relative, its power absolute, the power checked only
+#: where the fit window starts beyond 100 (1 - q)^-4 / 6, where the power law has set in (close
+#: to r = 1/2 it sets in much further out than any window; there the rate is held to 10 times
+#: its tolerance: 7e-4 off at r = 0.48).
 EXPONENT_TOLERANCES = {
     "small_x_power": 0.1,
     "small_x_power_at_zero_speed": 0.02,
@@ -1341,10 +2268,10 @@ EXPONENT_TOLERANCES = {
 }
 
 
-# P(x, v) at x > 0 by the F integral of eq. (fpsol) is accurate to about this fraction of its
-# largest value at that x (w(F) is known to ~1e-10 relative, and the oscillating Airy factor
-# cancels): far-tail values below it are noise of either sign (at r = 0.05, x = 0.0126,
-# v = 2.3 to 6: +-9e-11 where the peak is 3.4; quad's own error estimate does not see it)
+#: P(x, v) at x > 0 by the F integral of eq. (fpsol) is accurate to about this fraction of its
+#: largest value at that x (w(F) is known to ~1e-10 relative, and the oscillating Airy factor
+#: cancels): far-tail values below it are noise of either sign (at r = 0.05, x = 0.0126,
+#: v = 2.3 to 6: +-9e-11 where the peak is 3.4; quad's own error estimate does not see it).
 DISTRIBUTION_NOISE = 1e-10
 
 
@@ -1360,8 +2287,14 @@ def _nan_defects(name, table, allowed=None) -> list:
 
 
 def solve_table_defects(summary, tables, target=1e-8) -> list:
-    """What fails among the checks every table of rule solve passes before it is written (an
-    empty list if all pass).
+    """What fails among the checks every table of rule solve passes before it is written.
+
+    The checks: no NaN where a value is defined (P(0, 0) is not, nor rho(T) where I is infinite,
+    below r_c, nor the return-speed law given a u-bin above the highest node, where P(0, u)
+    underflows); no P(x, v) below -DISTRIBUTION_NOISE (or the weight_interpolation_error, where
+    larger) of its largest value at that x; int P dx = 1, and <x>, Delta x from P(x) equal the
+    Ito values from P(0, v), within the tolerance; every measured exponent within
+    ``EXPONENT_TOLERANCES`` of its prediction.
 
     Parameters
     ----------
@@ -1376,11 +2309,27 @@ def solve_table_defects(summary, tables, target=1e-8) -> list:
         of it, the summary's accuracy_estimate (of P(0, v)) and its weight_interpolation_error
         (of w(F), and so of P(x): ``WeightFunction.interpolation_error``).
 
-    Checks: no NaN where a value is defined (P(0, 0) is not, nor rho(T) where I is infinite, below
-    r_c, nor the return-speed law given a u-bin above the highest node, where P(0, u) underflows);
-    no P(x, v) below -DISTRIBUTION_NOISE (or the weight_interpolation_error, where larger) of its
-    largest value at that x; int P dx = 1, and <x>, Delta x from P(x) equal the Ito values from P(0, v), within the
-    tolerance; every measured exponent within ``EXPONENT_TOLERANCES`` of its prediction.
+    Returns
+    -------
+    list of str
+        One message per failing check, naming the table or summary key and the values; empty
+        if all pass.
+
+    Examples
+    --------
+    The values of r = 1/2 (eq. (xandDeltax)), with int P dx off by 2e-7:
+
+    >>> from bouncing_ball.distribution import predicted_exponents, solve_table_defects
+    >>> summary = {
+    ...     "r": 0.5, "collision_rate": 1 / 3, "mean_x": 6.0, "delta_x": 108**0.5,
+    ...     "position_normalization": 1.0 + 2e-7, "mean_x_from_position": 6.0,
+    ...     "delta_x_from_position": 108**0.5, "large_x_window_lo": 384.0,
+    ...     "large_x_window_hi": 33750.0,
+    ... }
+    >>> for key, value in predicted_exponents(0.5).items():
+    ...     summary[f"{key}_measured"] = summary[f"{key}_predicted"] = value
+    >>> solve_table_defects(summary, {})
+    ['int P dx - 1 = 2.00e-07, beyond the tolerance 1e-08']
     """
     defects = [
         f"summary: {key} is NaN"
@@ -1445,7 +2394,42 @@ def solve_table_defects(summary, tables, target=1e-8) -> list:
 
 
 def check_solve_tables(label, summary, tables, target=1e-8) -> None:
-    """ValueError naming r (``label``) and every failing check of ``solve_table_defects``."""
+    """Refuse the tables of rule solve if any check of ``solve_table_defects`` fails.
+
+    Parameters
+    ----------
+    label : str
+        r as the pipeline names it, named in the error.
+    summary, tables, target
+        As ``solve_table_defects``.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    ValueError
+        Naming r and every failing check.
+
+    Examples
+    --------
+    The values of r = 1/2 (eq. (xandDeltax)), with int P dx off by 2e-7:
+
+    >>> from bouncing_ball.distribution import check_solve_tables, predicted_exponents
+    >>> summary = {
+    ...     "r": 0.5, "collision_rate": 1 / 3, "mean_x": 6.0, "delta_x": 108**0.5,
+    ...     "position_normalization": 1.0 + 2e-7, "mean_x_from_position": 6.0,
+    ...     "delta_x_from_position": 108**0.5, "large_x_window_lo": 384.0,
+    ...     "large_x_window_hi": 33750.0,
+    ... }
+    >>> for key, value in predicted_exponents(0.5).items():
+    ...     summary[f"{key}_measured"] = summary[f"{key}_predicted"] = value
+    >>> check_solve_tables("0.5", summary, {})
+    Traceback (most recent call last):
+    ...
+    ValueError: r = 0.5: the solver's tables fail their checks: int P dx - 1 = 2.00e-07, ...
+    """
     defects = solve_table_defects(summary, tables, target)
     if defects:
         low, high = DISTRIBUTION_RESTITUTION_RANGE

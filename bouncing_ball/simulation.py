@@ -18,6 +18,7 @@ interpolated crossing does not.
 What a shard records after its equilibration time (integrals over each step
 given both its ends, not left-point sums, which are biased because Delta
 depends on the state):
+
   * outgoing speeds at collisions, on log bins;
   * the time, collisions and steps (all after equilibration);
   * int x dt and int x^2 dt, exact in expectation given the ends (mean path
@@ -64,7 +65,7 @@ depends on the state):
   * the flights: for each recorded collision that has an earlier collision
     (in the recording or in equilibration), the time T since that collision
     (its count on log bins, sum T, sum T^2), and the pair (outgoing speed u
-    of that earlier collision, return speed |v| at this one) on the speed
+    of that earlier collision, return speed abs(v) at this one) on the speed
     bins.  A flight is counted at the collision that ends it, so in a
     stationary shard the expected sum of f(T) over the recorded flights is
     I x (recorded time) x E[f(T)] with E the equilibrium average per
@@ -108,6 +109,9 @@ exceeds the speed and lifts the particle off the floor: the collapse is
 cut off at speeds of order (2 min_step_floor)^(1/2).
 What the regularised process gives above that speed scale, and how I grows
 as the floor goes to zero, is measured, not assumed (docs/methods.md, 'Below r_c').
+
+The loop is numba-compiled: a shard compiles it on its first call (a minute), so the Examples
+that run a shard are not run as doctests; the unit and statistical tests run shards.
 """
 
 import math
@@ -139,6 +143,19 @@ from .jit import njit
 from .pcg64 import next_double, standard_normal, stream_words
 from .settings import ShardSettings
 from .tallies import EARLY_FRACTION, SCALAR_INDEX, ShardTallies, tally_seed_sequence
+
+__all__ = [
+    "MEAN_PATH_INTEGRALS",
+    "POSITION",
+    "JOINT",
+    "FLIGHTS",
+    "CONTROL_VARIATES",
+    "EVERY_TALLY",
+    "FLOOR_STRATUM_HEIGHT",
+    "floor_stratum_end",
+    "shard_seed_sequence",
+    "simulate_shard",
+]
 
 # indices into the scalar tally array of the compiled loop (its layout: tallies.SCALARS)
 _TIME = SCALAR_INDEX["time"]
@@ -179,6 +196,34 @@ def shard_seed_sequence(seed: int, label: str, shard: int) -> np.random.SeedSequ
 
     The r label (see ``restitution.restitution_label``) enters the spawn key as the integer
     spelled by its ASCII bytes, so different r never share a stream.
+
+    Parameters
+    ----------
+    seed : int
+        The run's seed (the config's ``seed``), >= 0.
+    label : str
+        r as the pipeline names it (``restitution.restitution_label``), ASCII.
+    shard : int
+        The shard's index, >= 0.
+
+    Returns
+    -------
+    numpy.random.SeedSequence
+        The shard's stream: entropy ``seed``, spawn key (the label's integer, ``shard``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bouncing_ball.simulation import shard_seed_sequence
+    >>> stream = shard_seed_sequence(1, "0.5", 3)
+    >>> print(stream.spawn_key, int.from_bytes(b"0.5", "big"))
+    (3157557, 3) 3157557
+    >>> again = shard_seed_sequence(1, "0.5", 3).generate_state(4)
+    >>> print(np.array_equal(stream.generate_state(4), again))
+    True
+    >>> other_shard = shard_seed_sequence(1, "0.5", 4).generate_state(4)
+    >>> print(np.array_equal(again, other_shard))
+    False
     """
     r_key = int.from_bytes(label.encode("ascii"), "big")
     return np.random.SeedSequence(entropy=seed, spawn_key=(r_key, shard))
@@ -399,24 +444,50 @@ def _bridge_correction(a1, a2, a3, dt, weight, s, normal_1, k_s, k_x, time_in, v
     v2_in[k_s] -= v2_s
 
 
-# A step that starts at the floor (the outgoing step of a collision) draws a second bridge point
-# while its mean path is still below FLOOR_STRATUM_HEIGHT, where the x bins are narrow
+#: A step that starts at the floor (the outgoing step of a collision) draws a second bridge point
+#: while its mean path is still below this height, where the x bins are narrow
+#: (``floor_stratum_end``).
 FLOOR_STRATUM_HEIGHT = 0.1
 
 
 @njit(cache=True, inline="always")
 def floor_stratum_end(tau, x, v):
-    """Where the bridge points of a step of length tau from (x, v) are stratified: t_low =
-    FLOOR_STRATUM_HEIGHT / v in a step that starts at the floor (x = 0, v = v_out) with
+    """Where the bridge points of a step of length tau from (x, v) are stratified: t_low.
+
+    t_low = FLOOR_STRATUM_HEIGHT / v in a step that starts at the floor (x = 0, v = v_out) with
     v tau > FLOOR_STRATUM_HEIGHT, about where its mean path (v t - t^2 / 2 + ...) reaches
     that height; else tau (one point, no strata).  With t_low < tau the step draws two
     points, s uniform in [t_low, tau] with weight tau - t_low and s uniform in [0, t_low]
     with weight t_low: P(x, v) and the bridge correction stay exact in expectation and the
     weights still add up to tau.  Why: such a step is long (D ~ (v / c)^2 from the floor, up
-    to a few time units) and crosses the narrow bins near the floor in a small part of it;
-    its one uniform point landed there rarely and then moved a whole step's tau (and tau V
-    in <v^2>_x) into one of them, a heavy tail of the shards' <v^2>_x at x < 0.003 (excess
-    kurtosis 9-12 over the 64 shards of the default run at r = 1/2 and 3/4)."""
+    to a few time units, eq. (criterion)) and crosses the narrow bins near the floor in a small
+    part of it; its one uniform point landed there rarely and then moved a whole step's tau
+    (and tau V in <v^2>_x) into one of them, a heavy tail of the shards' <v^2>_x at x < 0.003
+    (excess kurtosis 9-12 over the 64 shards of the default run at r = 1/2 and 3/4).
+
+    Parameters
+    ----------
+    tau : float
+        The step's length in time (up to a collision, if it has one).
+    x, v : float
+        The step's start.
+
+    Returns
+    -------
+    float
+        t_low: FLOOR_STRATUM_HEIGHT / v for a step from the floor that rises past that height
+        on its mean path, else tau.
+
+    Examples
+    --------
+    The Python function (``py_func``: no compile):
+
+    >>> from bouncing_ball.simulation import floor_stratum_end
+    >>> print(floor_stratum_end.py_func(2.0, 0.0, 1.0), floor_stratum_end.py_func(2.0, 0.5, 1.0))
+    0.1 2.0
+    >>> print(floor_stratum_end.py_func(0.05, 0.0, 1.0))
+    0.05
+    """
     if x == 0.0 and v * tau > FLOOR_STRATUM_HEIGHT:
         return FLOOR_STRATUM_HEIGHT / v
     return tau
@@ -425,11 +496,12 @@ def floor_stratum_end(tau, x, v):
 # What the compiled loop records, by bit of its ``parts`` argument: the benchmark leaves
 # them out one at a time to time each (``python -m benchmarks``); a shard records them all.
 # The collisions, their outgoing speeds, the time and the steps are always recorded.
-MEAN_PATH_INTEGRALS = 1  # int x dt and int x^2 dt
-POSITION = 2  # P(x) and <v^2>_x: the mean path and its bridge correction
-JOINT = 4  # P(x, v) from the bridge sample
-FLIGHTS = 8  # flight times and (outgoing, return) speed pairs
-CONTROL_VARIATES = 16  # the noise sums of histograms.control_variate_rate
+MEAN_PATH_INTEGRALS = 1  #: Bit of ``parts``: int x dt and int x^2 dt.
+POSITION = 2  #: Bit of ``parts``: P(x) and <v^2>_x (the mean path and its bridge correction).
+JOINT = 4  #: Bit of ``parts``: P(x, v) from the bridge sample.
+FLIGHTS = 8  #: Bit of ``parts``: flight times and (outgoing, return) speed pairs.
+CONTROL_VARIATES = 16  #: Bit of ``parts``: the noise sums of the martingale control variates.
+#: Every bit of ``parts``: what a shard records.
 EVERY_TALLY = MEAN_PATH_INTEGRALS | POSITION | JOINT | FLIGHTS | CONTROL_VARIATES
 
 
@@ -839,9 +911,57 @@ def simulate_shard(
 ) -> ShardTallies:
     """Run one shard of r = ``restitution`` and return its tallies (pure: no I/O).
 
-    ``settings.min_step_floor`` is a lower bound on delta (0: the paper's rule
-    alone); below r_c it is what keeps the simulation going (module docstring).
-    ``parts`` leaves tallies out (for the benchmark's breakdown); a shard records them all.
+    The particle moves by eqs. (xstep), (vstep) with the step of eq. (criterion) and collides
+    by eq. (restitution) (the module's account of the method).  It runs
+    ``settings.equilibration_time`` first, then records ``settings.shard_time``, or stops
+    after ``settings.max_steps`` steps (equilibration included) and says so
+    (``budget_exhausted``).  ``settings.min_step_floor`` is a lower bound on delta (0: the
+    paper's rule alone); below r_c it is what keeps the simulation going (module docstring).
+
+    Parameters
+    ----------
+    restitution : float
+        r, 0 < r < 1.
+    seed_sequence : numpy.random.SeedSequence
+        The shard's stream (``shard_seed_sequence``); the bridge points draw from its first
+        child (``tallies.tally_seed_sequence``).
+    settings : settings.ShardSettings
+        The shard's parameters: shard_time, equilibration_time, criterion_c (c of
+        eq. (criterion)), min_step_divisor, min_step_floor and max_steps, and the bins
+        speed_bins, position_bins, velocity_bins and flight_time_bins.
+    parts : int, optional
+        The bits of what to record (``EVERY_TALLY``, a shard records them all; the benchmark's
+        breakdown leaves ``MEAN_PATH_INTEGRALS``, ``POSITION``, ``JOINT``, ``FLIGHTS`` or
+        ``CONTROL_VARIATES`` out); the collisions, their outgoing speeds, the time and the
+        steps are always recorded.
+
+    Returns
+    -------
+    tallies.ShardTallies
+        The shard's tallies, on the settings' bins.
+
+    Raises
+    ------
+    ValueError
+        If r is not in (0, 1).
+
+    Examples
+    --------
+    Compiles the loop on its first call (a minute), so not run as a doctest.  Same stream,
+    same numbers:
+
+    >>> from bouncing_ball.settings import ShardSettings
+    >>> from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
+    >>> settings = ShardSettings(
+    ...     shard_time=100.0, equilibration_time=10.0, criterion_c=5, min_step_divisor=10,
+    ...     max_steps=10**7,
+    ... )
+    >>> shard = simulate_shard(0.5, shard_seed_sequence(1, "0.5", 0), settings)  # doctest: +SKIP
+    >>> print(shard.time, shard.budget_exhausted, shard.collisions > 0)  # doctest: +SKIP
+    100.0 0 True
+    >>> again = simulate_shard(0.5, shard_seed_sequence(1, "0.5", 0), settings)  # doctest: +SKIP
+    >>> print(again.collisions == shard.collisions, again.int_x == shard.int_x)  # doctest: +SKIP
+    True True
     """
     if not 0.0 < restitution < 1.0:
         raise ValueError(f"restitution must lie in (0, 1), got {restitution}")

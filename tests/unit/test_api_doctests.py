@@ -15,6 +15,7 @@ MODULES = [
     "bouncing_ball.asymptotics",
     "bouncing_ball.bins",
     "bouncing_ball.comparison",
+    "bouncing_ball.distribution",
     "bouncing_ball.equilibration",
     "bouncing_ball.exact",
     "bouncing_ball.fits",
@@ -25,6 +26,7 @@ MODULES = [
     "bouncing_ball.kernel",
     "bouncing_ball.restitution",
     "bouncing_ball.settings",
+    "bouncing_ball.simulation",
     "bouncing_ball.solver",
     "bouncing_ball.tallies",
 ]
@@ -34,6 +36,7 @@ DOCUMENTED = [
     "bouncing_ball.asymptotics",
     "bouncing_ball.bins",
     "bouncing_ball.comparison",
+    "bouncing_ball.distribution",
     "bouncing_ball.equilibration",
     "bouncing_ball.exact",
     "bouncing_ball.fits",
@@ -44,6 +47,7 @@ DOCUMENTED = [
     "bouncing_ball.kernel",
     "bouncing_ball.restitution",
     "bouncing_ball.settings",
+    "bouncing_ball.simulation",
     "bouncing_ball.solver",
     "bouncing_ball.tallies",
 ]
