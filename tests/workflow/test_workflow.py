@@ -35,7 +35,16 @@ def test_run_produces_the_documented_tables(finished_run):
             f"shards{batch}.parquet" for batch in batches
         ]  # simulation.shards_per_job: 2
         p0v, provenance = read_table(folder / "p0v.parquet")
-        assert list(p0v.columns) == ["v_lo", "v_hi", "v", "p0v", "p0v_err", "count"]
+        assert list(p0v.columns) == [
+            "v_lo",
+            "v_hi",
+            "v",
+            "p0v",
+            "p0v_err",
+            "count",
+            "p0v_controlled",
+            "p0v_controlled_err",
+        ]
         assert provenance["r_label"] == label and provenance["shards"] == shards
         position, _ = read_table(folder / "position.parquet")
         assert list(position.columns) == [
@@ -46,6 +55,10 @@ def test_run_produces_the_documented_tables(finished_run):
             "px_err",
             "v2_given_x",
             "v2_given_x_err",
+            "px_controlled",
+            "px_controlled_err",
+            "v2_given_x_controlled",
+            "v2_given_x_controlled_err",
         ]
         summary, _ = read_table(folder / "summary.parquet")
         for column in (
