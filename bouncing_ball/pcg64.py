@@ -76,7 +76,20 @@ def stream_words(generator: np.random.Generator):
 
 @intrinsic
 def next_uint64(typingctx, high, low, inc_high, inc_low):
-    """One PCG64 draw: (new state high, new state low, the 64-bit output), all uint64."""
+    """One PCG64 draw: the state advanced once and its 64-bit output.
+
+    Parameters
+    ----------
+    high, low : numpy.uint64
+        The generator's 128-bit state, its upper and lower word.
+    inc_high, inc_low : numpy.uint64
+        Its odd 128-bit increment, upper and lower word (fixed for a stream).
+
+    Returns
+    -------
+    tuple of numpy.uint64
+        (new state high, new state low, the 64-bit output), as numpy's PCG64 gives them.
+    """
     signature = types.UniTuple(types.uint64, 3)(
         types.uint64, types.uint64, types.uint64, types.uint64
     )
@@ -108,7 +121,20 @@ def next_uint64(typingctx, high, low, inc_high, inc_low):
 
 @njit(cache=True, inline="always")
 def next_double(high, low, inc_high, inc_low):
-    """A uniform double in [0, 1) (numpy's ``Generator.random``): (high, low, u)."""
+    """A uniform double in [0, 1), numpy's ``Generator.random`` (53 bits of one draw).
+
+    Parameters
+    ----------
+    high, low : numpy.uint64
+        The generator's 128-bit state, its upper and lower word.
+    inc_high, inc_low : numpy.uint64
+        Its odd 128-bit increment, upper and lower word (fixed for a stream).
+
+    Returns
+    -------
+    tuple
+        (new state high, new state low, u).
+    """
     high, low, bits = next_uint64(high, low, inc_high, inc_low)
     return high, low, (bits >> np.uint64(11)) * _TO_DOUBLE
 
@@ -145,7 +171,20 @@ def _normal_rejected(high, low, inc_high, inc_low, idx, rabs, x):
 
 @njit(cache=True, inline="always")
 def standard_normal(high, low, inc_high, inc_low):
-    """A standard normal (numpy's ziggurat, ``Generator.standard_normal``): (high, low, z)."""
+    """A standard normal, numpy's ziggurat (``Generator.standard_normal``), bit for bit.
+
+    Parameters
+    ----------
+    high, low : numpy.uint64
+        The generator's 128-bit state, its upper and lower word.
+    inc_high, inc_low : numpy.uint64
+        Its odd 128-bit increment, upper and lower word (fixed for a stream).
+
+    Returns
+    -------
+    tuple
+        (new state high, new state low, z).
+    """
     high, low, r = next_uint64(high, low, inc_high, inc_low)
     idx = r & _LOW_BYTE
     r >>= np.uint64(8)
