@@ -251,7 +251,8 @@ def workflow_benchmark():
             "skipped": f"no Snakefile next to the package ({REPOSITORY}): run from a repository checkout"
         }
     config = yaml.safe_load((REPOSITORY / "config" / "config.yaml").read_text())
-    config["restitution"] = [round(0.2 + 0.0375 * k, 4) for k in range(20)]
+    # 20 r inside the run's range (restitution.DISTRIBUTION_RESTITUTION_RANGE)
+    config["restitution"] = [round(0.2 + 0.035 * k, 4) for k in range(20)]
     config["simulation"]["shards"] = 16
     config["simulation"]["shards_per_job"] = 1  # a job per shard: the largest plan
     config["simulation"]["per_restitution"] = {}
@@ -260,6 +261,8 @@ def workflow_benchmark():
     with tempfile.TemporaryDirectory() as folder:
         _workflow_copy(Path(folder), config)
         dry_run, result = _timed_snakemake(folder, "--cores", "2", "--dry-run", "--quiet", "rules")
+        if result.returncode != 0:
+            raise RuntimeError(f"the grid's dry run failed:\n{result.stderr[-2000:]}")
         jobs = next(
             (
                 int(line.split()[1])
