@@ -139,6 +139,20 @@ def next_double(high, low, inc_high, inc_low):
     return high, low, (bits >> np.uint64(11)) * _TO_DOUBLE
 
 
+@njit(cache=True, inline="always")
+def _ziggurat_layer(high, low, inc_high, inc_low):
+    """One draw of the ziggurat: its layer ``idx``, the bits ``rabs`` (bit 8 of them the tail's
+    sign) and the candidate ``x``, accepted where ``rabs < ki_double[idx]``."""
+    high, low, r = next_uint64(high, low, inc_high, inc_low)
+    idx = r & _LOW_BYTE
+    r >>= np.uint64(8)
+    rabs = (r >> np.uint64(1)) & _ABSCISSA
+    x = rabs * wi_double[idx]
+    if r & np.uint64(1):
+        x = -x
+    return high, low, idx, rabs, x
+
+
 @njit(cache=True)
 def _normal_rejected(high, low, inc_high, inc_low, idx, rabs, x):
     """The rare part of ``standard_normal``: the tail (idx 0) or the wedge test, then fresh
@@ -158,13 +172,7 @@ def _normal_rejected(high, low, inc_high, inc_low, idx, rabs, x):
             high, low, u = next_double(high, low, inc_high, inc_low)
             if (fi_double[idx - 1] - fi_double[idx]) * u + fi_double[idx] < np.exp(-0.5 * x * x):
                 return high, low, x
-        high, low, r = next_uint64(high, low, inc_high, inc_low)
-        idx = r & _LOW_BYTE
-        r >>= np.uint64(8)
-        rabs = (r >> np.uint64(1)) & _ABSCISSA
-        x = rabs * wi_double[idx]
-        if r & np.uint64(1):
-            x = -x
+        high, low, idx, rabs, x = _ziggurat_layer(high, low, inc_high, inc_low)
         if rabs < ki_double[idx]:
             return high, low, x
 
@@ -185,13 +193,7 @@ def standard_normal(high, low, inc_high, inc_low):
     tuple
         (new state high, new state low, z).
     """
-    high, low, r = next_uint64(high, low, inc_high, inc_low)
-    idx = r & _LOW_BYTE
-    r >>= np.uint64(8)
-    rabs = (r >> np.uint64(1)) & _ABSCISSA
-    x = rabs * wi_double[idx]
-    if r & np.uint64(1):
-        x = -x
+    high, low, idx, rabs, x = _ziggurat_layer(high, low, inc_high, inc_low)
     if rabs < ki_double[idx]:
         return high, low, x
     return _normal_rejected(high, low, inc_high, inc_low, idx, rabs, x)
