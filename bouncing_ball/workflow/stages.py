@@ -20,18 +20,20 @@ SIMULATION = (
     "simulation",
     "tallies",
 )
-MERGE = (
-    "workflow.audit",
-    "workflow.batches",
+# reading a job's batch files back and merging their shards (workflow.shards checks each file's
+# provenance against the config with workflow.audit)
+READ_SHARDS = (
     "bins",
-    "equilibration",
     "histograms",
-    "workflow.io",
     "restitution",
     "settings",
-    "workflow.shards",
     "tallies",
+    "workflow.audit",
+    "workflow.batches",
+    "workflow.io",
+    "workflow.shards",
 )
+MERGE = (*READ_SHARDS, "equilibration")
 SOLVER = (
     "asymptotics",
     "bins",
@@ -45,49 +47,11 @@ SOLVER = (
 )
 EXACT = ("bins", "exact")
 THEORY = ("asymptotics", "bins")
-FITS = (
-    "asymptotics",
-    "workflow.audit",
-    "workflow.batches",
-    "bins",
-    "fits",
-    "histograms",
-    "workflow.io",
-    "restitution",
-    "settings",
-    "workflow.shards",
-    "tallies",
-)
+FITS = (*READ_SHARDS, "asymptotics", "fits")
 PLOTTING = ("workflow.io", "workflow.plotting", "restitution")
 COMPARISON = ("comparison", "fits", "workflow.io", "restitution")
 # the studies' reports (workflow/rules/studies.smk); their shards are SIMULATION's
-STUDIES = (
-    "workflow.audit",
-    "workflow.batches",
-    "bins",
-    "comparison",
-    "exact",
-    "fits",
-    "histograms",
-    "workflow.io",
-    "restitution",
-    "settings",
-    "workflow.shards",
-    "workflow.studies",
-    "tallies",
-)
+STUDIES = (*READ_SHARDS, "comparison", "exact", "fits", "workflow.studies")
 # results/tables/validation: the comparison, the exact bin averages, the solver curve's bin
 # averages, and the shards read back for the sign-flip p-values
-VALIDATION = (
-    "workflow.batches",
-    "bins",
-    "comparison",
-    "exact",
-    "fits",
-    "histograms",
-    "workflow.io",
-    "restitution",
-    "settings",
-    "workflow.shards",
-    "tallies",
-)
+VALIDATION = (*READ_SHARDS, "comparison", "exact", "fits")
