@@ -186,16 +186,21 @@ def _provenance(path, schema) -> dict:
     return json.loads(raw)
 
 
-def read_provenance(path) -> dict:
-    """The provenance of a table written by ``write_table``, without reading its data."""
-    path = Path(path)
+def _read_parquet(read, path: Path):
+    """``read(path)`` (pyarrow's ``read_table`` or ``read_schema``), its failures an
+    ``UnreadableFileError`` naming the file."""
     try:
-        schema = pq.read_schema(path)
+        return read(path)
     except FileNotFoundError:
         raise UnreadableFileError(f"{path}: file not found") from None
     except (pa.ArrowException, OSError) as error:
         raise _unreadable(path, error) from None
-    return _provenance(path, schema)
+
+
+def read_provenance(path) -> dict:
+    """The provenance of a table written by ``write_table``, without reading its data."""
+    path = Path(path)
+    return _provenance(path, _read_parquet(pq.read_schema, path))
 
 
 def read_table(
@@ -205,12 +210,7 @@ def read_table(
     refused (naming the file) unless that kind's rule wrote it with its columns; with
     ``label``, unless it was made for the r of that label (``restitution_label``)."""
     path = Path(path)
-    try:
-        table = pq.read_table(path)
-    except FileNotFoundError:
-        raise UnreadableFileError(f"{path}: file not found") from None
-    except (pa.ArrowException, OSError) as error:
-        raise _unreadable(path, error) from None
+    table = _read_parquet(pq.read_table, path)
     frame, provenance = table.to_pandas(), _provenance(path, table.schema)
     if kind is not None:
         if provenance.get("rule") != kind.rule:
