@@ -22,15 +22,12 @@ from .restitution import parse_restitution, restitution_label
 __all__ = ["simulate", "SimulationResult", "DEFAULT_SETTINGS"]
 
 # the shard settings ``simulate`` uses where it is not told otherwise (the default config's
-# ``simulation`` section holds the workflow's; the velocity and flight-time bins are
-# ``settings``' defaults)
+# ``simulation`` section holds the workflow's); every bin set is ``ShardSettings``' default
 DEFAULT_SETTINGS = {
     "equilibration_time": 1.0e3,
     "criterion_c": 3.0,
     "min_step_divisor": 500.0,
     "max_steps": 10**9,
-    "speed_bins": {"lo": 1.0e-4, "hi": 1.0e2, "per_decade": 10},
-    "position_bins": {"lo": 1.0e-3, "hi": 1.0e3, "per_decade": 5},
 }
 
 
@@ -137,7 +134,8 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
         draws fresh entropy (``numpy.random.SeedSequence``), recorded in the result's ``seed``.
     settings : ShardSettings or dict, optional
         The shard settings (``settings.ShardSettings``), or a dict overriding some of
-        ``DEFAULT_SETTINGS`` (equilibration_time, criterion_c, min_step_divisor, max_steps,
+        ``DEFAULT_SETTINGS`` and ``ShardSettings``' defaults (equilibration_time, criterion_c,
+        min_step_divisor, max_steps,
         speed_bins, position_bins, velocity_bins, flight_time_bins, min_step_floor).
     processes : int, optional
         Worker processes (spawned); 1 runs the shards in this process.  The numbers do not
