@@ -135,8 +135,8 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
     settings : ShardSettings or dict, optional
         The shard settings (``settings.ShardSettings``), or a dict overriding some of
         ``DEFAULT_SETTINGS`` and ``ShardSettings``' defaults (equilibration_time, criterion_c,
-        min_step_divisor, max_steps,
-        speed_bins, position_bins, velocity_bins, flight_time_bins, min_step_floor).
+        min_step_divisor, max_steps, speed_bins, position_bins, velocity_bins,
+        flight_time_bins, min_step_floor).
     processes : int, optional
         Worker processes (spawned); 1 runs the shards in this process.  The numbers do not
         depend on it.  A script that uses more than one must call ``simulate`` under
