@@ -94,3 +94,17 @@ def test_the_simulation_stage_names_every_module_the_shard_loop_compiles():
     loop = ({"simulation"} | imported) & set(jit.COMPILED)
     assert {"free_flight", "pcg64", "simulation", "tallies"} <= loop
     assert loop <= set(stages.SIMULATION)
+
+
+def test_the_distribution_holds_every_package():
+    """``pip install .`` (not editable) installs every package of the library, the workflow's
+    plumbing included: pyproject.toml lists each folder with an __init__.py."""
+    import tomllib
+
+    project = tomllib.loads((bouncing_ball.PACKAGE.parent / "pyproject.toml").read_text())
+    listed = set(project["tool"]["setuptools"]["packages"])
+    packages = {
+        ".".join(path.parent.relative_to(bouncing_ball.PACKAGE.parent).parts)
+        for path in bouncing_ball.PACKAGE.rglob("__init__.py")
+    }
+    assert packages == listed
