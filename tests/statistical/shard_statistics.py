@@ -3,7 +3,7 @@
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
-from conftest import DEFAULT_SETTINGS as DEFAULT_CONFIG_SETTINGS
+from default_settings import DEFAULT_SETTINGS as DEFAULT_CONFIG_SETTINGS
 
 from bouncing_ball.histograms import outgoing_speed_density, outgoing_speed_histogram
 from bouncing_ball.restitution import restitution_label

@@ -9,7 +9,7 @@ reaches a steady state whose P(0,v), away from the floor's speed scale
 
 import numpy as np
 import pytest
-from conftest import DEFAULT_SETTINGS
+from default_settings import DEFAULT_SETTINGS
 from shard_statistics import outgoing_speed_bins, simulate_shards
 
 from bouncing_ball import solver

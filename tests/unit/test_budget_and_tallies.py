@@ -1,7 +1,7 @@
 """A shard's work is bounded by its step budget; its tallies add up."""
 
 import pytest
-from conftest import DEFAULT_SETTINGS
+from default_settings import DEFAULT_SETTINGS
 
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 

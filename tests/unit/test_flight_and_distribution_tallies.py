@@ -11,7 +11,7 @@ from dataclasses import fields
 
 import numpy as np
 import pytest
-from conftest import DEFAULT_SETTINGS
+from default_settings import DEFAULT_SETTINGS
 from numba import njit
 
 from bouncing_ball import simulation, tallies

@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import DEFAULT_SETTINGS
+from default_settings import DEFAULT_SETTINGS
 from numba import njit
 from scipy import integrate, optimize, special
 

@@ -2,7 +2,7 @@
 shards are grouped into jobs."""
 
 import numpy as np
-from conftest import DEFAULT_SETTINGS
+from default_settings import DEFAULT_SETTINGS
 
 from bouncing_ball.histograms import position_moments_summary
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard

@@ -1,7 +1,8 @@
-"""What the unit and statistical tests share: the shard settings of the default config.
+"""What the unit and statistical tests share: the shard settings of the default config (a
+support module, as workflow_support.py; tests/workflow has a conftest.py of its own).
 
 The one home of the bins and shard settings the tests run with (import it as
-``from conftest import DEFAULT_SETTINGS``): a test that needs other settings replaces
+``from default_settings import DEFAULT_SETTINGS``): a test that needs other settings replaces
 them (``DEFAULT_SETTINGS.replace(shard_time=...)``) and keeps the rest.
 """
 

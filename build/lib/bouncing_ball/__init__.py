@@ -1,0 +1,78 @@
+"""Equilibrium statistics of an inelastically bouncing ball (Burkhardt & Kotsev 2006).
+
+The public API:
+
+- ``Equilibrium(r)``: the equilibrium state at any r the solver answers (eq. (inteq)): the
+  time averages, the exponents, P(0, v), P(x), <v^2>_x, P(x, v), w(F), the flight times;
+- ``ExactEquilibrium(r)``: the paper's exact r = 1/2 and 1/3 solutions, the same interface;
+- ``simulate(r, shards=..., shard_time=...)``: the Monte Carlo simulation of the paper's
+  Sec. IV, returning a ``SimulationResult`` with the same observables and their errors.
+
+They are loaded on first use, so that ``import bouncing_ball`` (as the workflow does to plan a
+run) loads neither numba nor scipy.
+"""
+
+import hashlib
+from pathlib import Path
+
+__version__ = "0.3.0"
+
+PACKAGE = Path(__file__).parent
+
+__all__ = [
+    "Equilibrium",
+    "ExactEquilibrium",
+    "simulate",
+    "SimulationResult",
+    "PACKAGE",
+    "source_digest",
+    "__version__",
+]
+
+# public name -> the module that defines it (imported on first access, PEP 562)
+_LAZY = {
+    "Equilibrium": "equilibrium",
+    "ExactEquilibrium": "equilibrium",
+    "simulate": "monte_carlo",
+    "SimulationResult": "monte_carlo",
+}
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))
+
+
+def source_digest(modules=None, files=()) -> str:
+    """A short hash of the source of the named modules of this package (all if None), dotted
+    below it (``"solver"``, ``"workflow.io"``), and of ``files`` (a rule's script).
+
+    The workflow passes it to its rules as a parameter, so that editing the
+    code behind a stage re-runs that stage and nothing else, and touching a
+    file without changing it re-runs nothing.
+    """
+    names = (
+        sorted(
+            ".".join(path.relative_to(PACKAGE).with_suffix("").parts)
+            for path in PACKAGE.rglob("*.py")
+        )
+        if modules is None
+        else sorted(modules)
+    )
+    digest = hashlib.sha256()
+    for name in names:
+        digest.update(name.encode())
+        digest.update(PACKAGE.joinpath(*name.split(".")).with_suffix(".py").read_bytes())
+    for path in files:
+        digest.update(Path(path).name.encode())
+        digest.update(Path(path).read_bytes())
+    return digest.hexdigest()[:16]

@@ -1,0 +1,882 @@
+"""The simulation held against the exact solutions and the solver: z-scores and residuals.
+
+Pure functions on the tables the workflow writes; the figures (Figs. 5-7),
+results/tables/moments.{csv,md} and results/tables/validation.{csv,md} are
+drawn from them.
+"""
+
+from fractions import Fraction
+
+import numpy as np
+import pandas as pd
+
+from . import exact
+from .fits import LARGE_SPEED, SMALL_SPEED, bin_averages_of_curve, usable_curve
+from .histograms import outgoing_speed_density
+
+__all__ = [
+    "moment_rows",
+    "moments_table",
+    "moments_markdown",
+    "value_with_error",
+    "outgoing_speed_residuals",
+    "exact_outgoing_speed_residuals",
+    "sign_flip_test",
+    "ratio_deviations",
+    "shard_ratios",
+    "outgoing_speed_checks",
+    "position_checks",
+    "fit_checks",
+    "validation_rows",
+    "validation_table",
+    "validation_markdown",
+    "position_asymptotics_table",
+    "position_asymptotics_markdown",
+]
+
+# the time averages of eq. (xandDeltax)
+QUANTITIES = ("mean_x", "delta_x", "collision_rate")
+SYMBOLS = {"mean_x": "<x>", "delta_x": "Delta x", "collision_rate": "I"}
+
+# the numbers as printed in eq. (xandDeltax) (rounded there); the exact stage
+# recomputes them from eqs. (P(x)2), (collrate) and (constants)
+PAPER_VALUES = {
+    Fraction(1, 2): {"mean_x": 6.0, "delta_x": 10.4, "collision_rate": 1.0 / 3.0},
+    Fraction(1, 3): {"mean_x": 3.89, "delta_x": 7.68, "collision_rate": 3.0 / 4.0},
+}
+
+MOMENT_COLUMNS = (
+    "r_label",
+    "r",
+    "quantity",
+    "paper",
+    "exact",
+    "solver",
+    "simulation",
+    "simulation_err",
+    "estimator",
+    "reference",
+    "z",
+)
+
+
+def smaller_error_estimate(summary, quantity):
+    """(value, error, estimator) of ``quantity`` in a simulation summary: the plain estimate
+    or the one corrected by control variates (``{quantity}_controlled``, the same
+    expectation), whichever has the smaller error; estimator is "plain" or "controlled"."""
+    value, error = float(summary[quantity]), float(summary[f"{quantity}_err"])
+    controlled = f"{quantity}_controlled"
+    if controlled in summary:
+        other, other_error = float(summary[controlled]), float(summary[f"{controlled}_err"])
+        if np.isfinite(other) and other_error > 0 and not other_error >= error:
+            return other, other_error, "controlled"
+    return value, error, "plain"
+
+
+def moment_rows(label, restitution, simulation, solver, exact=None):
+    """The time averages <x>, Delta x and I of eq. (xandDeltax) of one r, with their z.
+
+    The simulation's value is that of ``smaller_error_estimate``, plain or controlled
+    (``estimator`` says which). z = (simulation - reference) / simulation_err, the reference
+    being the exact value where there is one and the solver's otherwise.
+
+    Parameters
+    ----------
+    label : str
+        The r label.
+    restitution : float or fractions.Fraction
+        r.
+    simulation : mapping
+        The merge stage's summary: each quantity and its ``<quantity>_err``.
+    solver : mapping
+        The solve stage's summary.
+    exact : mapping, optional
+        The exact stage's summary (None where r is not 1/2 or 1/3).
+
+    Returns
+    -------
+    list of dict
+        One row per quantity, keys ``MOMENT_COLUMNS`` (with the paper's rounded numbers at
+        r = 1/2 and 1/3).
+
+    Examples
+    --------
+    >>> from bouncing_ball.comparison import moment_rows
+    >>> simulation = {"mean_x": 6.01, "mean_x_err": 0.01, "delta_x": 10.4,
+    ...               "delta_x_err": 0.1, "collision_rate": 0.333, "collision_rate_err": 0.001}
+    >>> exact = {"mean_x": 6.0, "delta_x": 10.39, "collision_rate": 1 / 3}
+    >>> row = moment_rows("0.5", 0.5, simulation, exact, exact)[0]
+    >>> print(row["quantity"], row["paper"], row["reference"], round(row["z"], 6))
+    mean_x 6.0 exact 1.0
+    """
+    paper = PAPER_VALUES.get(Fraction(restitution))
+    rows = []
+    for quantity in QUANTITIES:
+        reference_name = "exact" if exact is not None else "solver"
+        reference = float((exact if exact is not None else solver)[quantity])
+        value, error, estimator = smaller_error_estimate(simulation, quantity)
+        z = (value - reference) / error if np.isfinite(reference) and error > 0 else np.nan
+        rows.append(
+            {
+                "r_label": label,
+                "r": float(restitution),
+                "quantity": quantity,
+                "paper": paper[quantity] if paper else np.nan,
+                "exact": float(exact[quantity]) if exact is not None else np.nan,
+                "solver": float(solver[quantity]),
+                "simulation": value,
+                "simulation_err": error,
+                "estimator": estimator,
+                "reference": reference_name,
+                "z": z,
+            }
+        )
+    return rows
+
+
+def moments_table(rows) -> pd.DataFrame:
+    """The rows of ``moment_rows`` (of every r) as results/tables/moments.csv.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Rows of ``moment_rows``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``MOMENT_COLUMNS``.
+    """
+    return pd.DataFrame(rows, columns=list(MOMENT_COLUMNS))
+
+
+def _number(value, digits=6):
+    return "" if not np.isfinite(value) else f"{value:.{digits}g}"
+
+
+def value_with_error(value, error) -> str:
+    """A value with its error, to the second significant digit of the error.
+
+    Parameters
+    ----------
+    value, error : float
+        The value and its standard error.
+
+    Returns
+    -------
+    str
+        "value ± error"; the value alone (6 significant digits) where the error is not
+        finite and positive, "" where the value is not finite.
+
+    Examples
+    --------
+    >>> from bouncing_ball.comparison import value_with_error
+    >>> value_with_error(3.42803, 0.003)
+    '3.4280 ± 0.0030'
+    >>> value_with_error(1234.5, 25.0)
+    '1234 ± 25'
+    """
+    if not (np.isfinite(value) and np.isfinite(error) and error > 0):
+        return _number(value)
+    decimals = max(0, 1 - int(np.floor(np.log10(error))))
+    return f"{value:.{decimals}f} ± {error:.{decimals}f}"
+
+
+def moments_markdown(table: pd.DataFrame) -> str:
+    """The moments table for a reader, as results/tables/moments.md.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The table of ``moments_table``.
+
+    Returns
+    -------
+    str
+        A Markdown table: value ± error, the paper's rounded numbers, the exact and the
+        solver's values, z.
+    """
+    shown = pd.DataFrame(
+        {
+            "r": table.r_label,
+            "quantity": table.quantity.map(SYMBOLS),
+            "paper, eq. (xandDeltax)": table.paper.map(lambda value: _number(value, 4)),
+            "exact": table.exact.map(lambda value: _number(value, 10)),
+            "solver, eq. (inteq)": table.solver.map(lambda value: _number(value, 10)),
+            "simulation": [
+                value_with_error(value, error)
+                for value, error in zip(table.simulation, table.simulation_err)
+            ],
+            "estimator": table.estimator,
+            "z": [
+                f"{z:+.2f} (vs {reference})" if np.isfinite(z) else ""
+                for z, reference in zip(table.z, table.reference)
+            ],
+        }
+    )
+    return shown.to_markdown(index=False, disable_numparse=True) + "\n"
+
+
+def outgoing_speed_residuals(simulated: pd.DataFrame, solver_curve: pd.DataFrame) -> pd.DataFrame:
+    """(simulation - solver) / sigma for every bin of the simulated P(0, v), Fig. 7.
+
+    The solver's P(0, v) of eq. (inteq) enters as its average over each bin (eq. (collrate)),
+    like the data.  Bins without an error (no collisions, the under- and overflow bins) and
+    bins beyond the solver's grid (or beyond where its P(0, v) underflows) are left out.
+
+    Parameters
+    ----------
+    simulated : pandas.DataFrame
+        A merged p0v table (columns v, v_lo, v_hi, p0v, p0v_err, count).
+    solver_curve : pandas.DataFrame
+        The solver's grid (columns v, p0v).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns v, v_lo, v_hi, residual, count, reference (the solver's bin average) and bin
+        (the bin's position in ``simulated``).
+    """
+    speeds, density = usable_curve(solver_curve.v.to_numpy(), solver_curve.p0v.to_numpy())
+    inside = (
+        (simulated.v_lo >= speeds[0])
+        & (simulated.v_hi <= speeds[-1])
+        & np.isfinite(simulated.p0v_err)
+        & (simulated.p0v_err > 0)
+    )
+    bins = simulated[inside]
+    reference = bin_averages_of_curve(speeds, density, bins.v_lo.to_numpy(), bins.v_hi.to_numpy())
+    return pd.DataFrame(
+        {
+            "v": bins.v.to_numpy(),
+            "v_lo": bins.v_lo.to_numpy(),
+            "v_hi": bins.v_hi.to_numpy(),
+            "residual": (bins.p0v.to_numpy() - reference) / bins.p0v_err.to_numpy(),
+            "count": bins["count"].to_numpy(),
+            "reference": reference,
+            "bin": np.flatnonzero(inside.to_numpy()),
+        }
+    )
+
+
+def exact_outgoing_speed_residuals(simulated: pd.DataFrame, restitution) -> pd.DataFrame:
+    """(simulation - exact) / sigma for every bin of the simulated P(0, v) at r = 1/2 or 1/3.
+
+    The exact bin averages of eq. (P(0,v)) are in closed form
+    (``exact.outgoing_speed_bin_average``).
+
+    Parameters
+    ----------
+    simulated : pandas.DataFrame
+        A merged p0v table; its finite bins with an error are compared.
+    restitution : float or fractions.Fraction
+        1/2 or 1/3.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns v, residual, reference (the exact bin average) and bin (the bin's position in
+        ``simulated``).
+    """
+    usable = (
+        (simulated.v_lo > 0.0)
+        & np.isfinite(simulated.v_hi)
+        & np.isfinite(simulated.p0v_err)
+        & (simulated.p0v_err > 0.0)
+    )
+    bins = simulated[usable]
+    truth = exact.outgoing_speed_bin_average(
+        bins.v_lo.to_numpy(), bins.v_hi.to_numpy(), restitution
+    )
+    return pd.DataFrame(
+        {
+            "v": bins.v.to_numpy(),
+            "residual": (bins.p0v.to_numpy() - truth) / bins.p0v_err.to_numpy(),
+            "reference": truth,
+            "bin": np.flatnonzero(usable.to_numpy()),
+        }
+    )
+
+
+# results/tables/validation.{csv,md}: one row per r and check (long format)
+VALIDATION_COLUMNS = (
+    "r_label",
+    "r",
+    "check",
+    "reference",
+    "bins",
+    "value",
+    "bin_centre",
+    "p_sign_flip",
+    "detail",
+)
+
+# the checks, in the order of the table, and how the Markdown names them
+VALIDATION_CHECKS = {
+    "p0v_chi2_per_bin": "P(0,v): chi^2/n",
+    "p0v_worst_bin": "P(0,v): worst bin, z",
+    "p0v_largest_relative_error": "P(0,v): largest relative error, 0.01 <= v <= 5",
+    "px_chi2_per_bin": "P(x): chi^2/n",
+    "px_worst_bin": "P(x): worst bin, z",
+    "v2_given_x_chi2_per_bin": "<v^2>_x: chi^2/n",
+    "v2_given_x_worst_bin": "<v^2>_x: worst bin, z",
+    "small_speed_fit_joint_p_value": "small-v fit: joint p-value of the theory's exponents",
+    "small_speed_fit_chi2_per_dof": "small-v fit: chi^2/dof",
+    "large_speed_fit_joint_p_value": "large-v fit: joint p-value of the theory's exponents",
+    "large_speed_fit_chi2_per_dof": "large-v fit: chi^2/dof",
+}
+
+# "paper quality": the speeds over which the relative error of P(0, v) is reported
+QUALITY_SPEEDS = (0.01, 5.0)
+# the heights over which P(x) and <v^2>_x are held against eqs. (P(x)2), (moment2)
+POSITION_RANGE = (1.0e-3, 50.0)
+FIT_SIDES = (SMALL_SPEED, LARGE_SPEED)
+
+
+# the sign-flip test of the chi^2/n rows: this many random flips, from a fixed seed, so that
+# the table is the same on every machine
+SIGN_FLIPS = 10_000
+SIGN_FLIP_SEED = 20061121
+_FLIPS_PER_BLOCK = 1000  # flips evaluated at once (memory: block x bins)
+
+
+def sign_flip_test(deviations, flips=SIGN_FLIPS, seed=SIGN_FLIP_SEED):
+    """The sign-flip test of shard-level deviations from a prediction.
+
+    chi^2 per bin of the deviations, and the p-values of chi^2 and of the largest z^2 against
+    their sign-flip null distributions.
+
+    Parameters
+    ----------
+    deviations : array (shards, bins)
+        Each shard's deviation from the prediction: its estimate minus the prediction (shards
+        of equal time) or its share of the merged estimate's deviation (``ratio_deviations``).
+    flips : int
+        How many random sign patterns are drawn.
+    seed : int
+        Seed of ``numpy.random.default_rng`` for the signs: the same deviations give the same
+        p-values on every machine.
+
+    Returns
+    -------
+    chi2_per_bin, p_chi2, p_worst : float
+        z of a bin is the deviations' mean over its standard error from the scatter between
+        the shards (the jackknife's, for a mean over shards); chi2_per_bin is the mean of z^2
+        over the bins.  Under the null the shards are independent and each shard's deviation
+        vector is symmetric about 0, so flipping the signs of whole shards leaves the joint
+        distribution unchanged: the flipped statistics are the null distribution, and it
+        carries the correlations between bins (shared shards, the normalisation, cascades of
+        collisions filling neighbouring bins).  p = (1 + number of flipped statistics >= the
+        observed) / (1 + flips).  Flipping every sign leaves z^2 alone, so with n shards there
+        are 2^(n - 1) distinct statistics and p is never much below 2^(1 - n).
+
+    Examples
+    --------
+    Two bins, deviations of alternating sign over four shards: no deviation on average.
+
+    >>> import numpy as np
+    >>> from bouncing_ball.comparison import sign_flip_test
+    >>> deviations = np.array([[1.0, 0.5], [-1.0, -0.5], [1.0, -0.5], [-1.0, 0.5]])
+    >>> chi2, p_chi2, p_worst = sign_flip_test(deviations)
+    >>> print(chi2, p_chi2, p_worst)
+    0.0 1.0 1.0
+    """
+    deviations = np.asarray(deviations, dtype=float)
+    n = deviations.shape[0]
+    squares = (deviations**2).sum(axis=0)
+
+    def statistics(signs):
+        mean = signs @ deviations / n
+        with np.errstate(divide="ignore", invalid="ignore"):
+            z_squared = (n - 1) * n * mean**2 / (squares - n * mean**2)
+        return z_squared.mean(axis=-1), z_squared.max(axis=-1)
+
+    chi2, worst = statistics(np.ones(n))
+    rng = np.random.default_rng(seed)
+    chi2_above = worst_above = 0
+    for block in range(0, flips, _FLIPS_PER_BLOCK):
+        signs = rng.choice([-1.0, 1.0], size=(min(_FLIPS_PER_BLOCK, flips - block), n))
+        chi2_null, worst_null = statistics(signs)
+        chi2_above += int(np.sum(chi2_null >= chi2))
+        worst_above += int(np.sum(worst_null >= worst))
+    return float(chi2), (1 + chi2_above) / (1 + flips), (1 + worst_above) / (1 + flips)
+
+
+def ratio_deviations(numerators, denominators, reference):
+    """Each shard's share of the deviation of a ratio estimate from a reference.
+
+    For the estimate sum_k numerators_k / sum_k denominators_k the share of shard k is
+    (numerators_k - reference x denominators_k) / sum_k denominators_k.  The shares add up to
+    the estimate minus the reference; to first order they are what the delete-one jackknife
+    sees of each shard, so ``sign_flip_test`` of them gives the merged table's z to first
+    order.
+
+    Parameters
+    ----------
+    numerators, denominators : array_like, shape (shards, bins)
+        Each shard's numerator and denominator (``shard_ratios``).
+    reference : array_like, shape (bins,)
+        The prediction.
+
+    Returns
+    -------
+    numpy.ndarray, shape (shards, bins)
+
+    Examples
+    --------
+    >>> from bouncing_ball.comparison import ratio_deviations
+    >>> shares = ratio_deviations([[3.0], [5.0]], [[1.0], [3.0]], [1.5])
+    >>> print(shares.ravel(), shares.sum(), 8.0 / 4.0 - 1.5)
+    [0.375 0.125] 0.5 0.5
+    """
+    numerators = np.asarray(numerators, dtype=float)
+    denominators = np.asarray(denominators, dtype=float)
+    return (numerators - np.asarray(reference, dtype=float) * denominators) / denominators.sum(
+        axis=0
+    )
+
+
+def shard_ratios(shards) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Each shard's numerator and denominator of the estimates the validation checks.
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards of one r (with the same bins).
+
+    Returns
+    -------
+    dict
+        Keyed as the merged tables' columns, each a pair of (shards x bins) arrays, bins as
+        in the merged tables: ``p0v``, the collisions over the time times int_bin v dv
+        (eq. (collrate), ``histograms.outgoing_speed_density``); ``px``, the time spent in
+        the x bin over the time times the bin's width; ``v2_given_x``, the integral of
+        v^2 dt in the bin over the time spent there (eq. (moment2)).
+    """
+    speeds, heights = shards[0].speed_bins, shards[0].position_bins
+    times = np.array([s.time for s in shards], dtype=float)[:, None]
+    in_bin = np.stack([s.position_time for s in shards])
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        per_speed = 1.0 / outgoing_speed_density(1.0, 1.0, speeds.lower, speeds.upper)
+        return {
+            "p0v": (np.stack([s.speed_counts for s in shards]), times * per_speed),
+            "px": (in_bin, times * (heights.upper - heights.lower)),
+            "v2_given_x": (np.stack([s.position_v2_time for s in shards]), in_bin),
+        }
+
+
+def _z_rows(quantity, reference, where, z, shards, symbol, deviations=None):
+    """The chi^2/n and worst-bin rows of one set of residuals ``z`` at bin centres ``where``;
+    the chi^2/n row's p_sign_flip from ``sign_flip_test`` of ``deviations`` (shards x the
+    bins of ``z``; None: no p)."""
+    n = len(z)
+    if n == 0:
+        worst, at, chi2 = np.nan, np.nan, np.nan
+    else:
+        k = int(np.argmax(np.abs(z)))
+        worst, at, chi2 = float(z[k]), float(where[k]), float(np.mean(np.square(z)))
+    if deviations is None or n == 0:
+        p_value = np.nan
+        note = f"{shards} shards; no sign-flip p without the shards' tallies"
+    else:
+        _, p_value, _ = sign_flip_test(deviations)
+        note = f"p_sign_flip from {SIGN_FLIPS} sign flips of the {shards} shards' deviations"
+        if 2.0 ** (1 - shards) > 1.0 / (1 + SIGN_FLIPS):
+            note += f" (with {shards} shards p is never below about {2.0 ** (1 - shards):.2g})"
+    return [
+        {
+            "check": f"{quantity}_chi2_per_bin",
+            "reference": reference,
+            "bins": n,
+            "value": chi2,
+            "bin_centre": np.nan,
+            "p_sign_flip": p_value,
+            "detail": f"mean of z^2, z = (simulation - {reference}) / error; the bins are "
+            f"correlated, so it need not be near 1; {note}",
+        },
+        {
+            "check": f"{quantity}_worst_bin",
+            "reference": reference,
+            "bins": n,
+            "value": worst,
+            "bin_centre": at,
+            "p_sign_flip": np.nan,
+            "detail": f"z of the bin with the largest abs(z), at {symbol} = {_number(at, 3)}",
+        },
+    ]
+
+
+def _shard_deviations(per_shard, quantity, bins, reference, count):
+    """``ratio_deviations`` of ``per_shard[quantity]`` (``shard_ratios``) in the merged
+    table's bins at positions ``bins``; None without ``per_shard``."""
+    if per_shard is None:
+        return None
+    numerators, denominators = per_shard[quantity]
+    if numerators.shape[0] != count:
+        raise ValueError(
+            f"{quantity}: tallies of {numerators.shape[0]} shards for a table of {count} shards"
+        )
+    return ratio_deviations(numerators[:, bins], denominators[:, bins], reference)
+
+
+def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None, per_shard=None):
+    """The simulated P(0, v) against eq. (P(0,v)) at r = 1/2 and 1/3, else the solver's.
+
+    At r = 1/2 and 1/3 the reference is the exact bin averages in closed form
+    (``exact.outgoing_speed_bin_average``), else the solver's P(0, v) of eq. (inteq)
+    averaged over each bin like the data (eq. (collrate), ``outgoing_speed_residuals``, as
+    in Fig. 7).
+
+    Parameters
+    ----------
+    simulated : pandas.DataFrame
+        A merged p0v table.
+    restitution : float or fractions.Fraction
+        r.
+    shards : int
+        The number of shards the errors come from.
+    solver_curve : pandas.DataFrame, optional
+        The solver's grid (columns v, p0v); needed where r is not 1/2 or 1/3.
+    per_shard : dict, optional
+        ``shard_ratios`` of the shards: gives chi^2/n its p_sign_flip (``sign_flip_test``).
+
+    Returns
+    -------
+    list of dict
+        Rows of ``VALIDATION_COLUMNS`` without r: chi^2/n and the worst z of
+        z = (simulation - reference) / p0v_err over the bins with an error (not the under-
+        and overflow bins, nor bins beyond the solver's grid), and the largest relative error
+        p0v_err / p0v over the bins with 0.01 <= v <= 5 (an empty bin there counts as an
+        infinite relative error).
+
+    Raises
+    ------
+    ValueError
+        Where r is not 1/2 or 1/3 and no solver curve is given, or ``per_shard`` holds
+        another number of shards.
+    """
+    if Fraction(restitution) in exact.EXACT_RESTITUTIONS:
+        reference = "exact"
+        residuals = exact_outgoing_speed_residuals(simulated, restitution)
+    else:
+        if solver_curve is None:
+            raise ValueError(f"r = {restitution}: no exact P(0, v), and no solver curve given")
+        reference = "solver"
+        residuals = outgoing_speed_residuals(simulated, solver_curve)
+    where, z = residuals.v.to_numpy(), residuals.residual.to_numpy()
+    deviations = _shard_deviations(
+        per_shard, "p0v", residuals.bin.to_numpy(), residuals.reference.to_numpy(), shards
+    )
+    rows = _z_rows("p0v", reference, where, z, shards, "v", deviations)
+    low, high = QUALITY_SPEEDS
+    quality = simulated[(simulated.v >= low) & (simulated.v <= high)]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        relative = np.where(
+            (quality.p0v > 0.0) & np.isfinite(quality.p0v_err),
+            quality.p0v_err / quality.p0v,
+            np.inf,
+        )
+    if len(relative):
+        k = int(np.argmax(relative))
+        largest, at = float(relative[k]), float(quality.v.iloc[k])
+    else:
+        largest, at = np.nan, np.nan
+    rows.append(
+        {
+            "check": "p0v_largest_relative_error",
+            "reference": "none",
+            "bins": len(relative),
+            "value": largest,
+            "bin_centre": at,
+            "p_sign_flip": np.nan,
+            "detail": f"max of p0v_err / p0v over the bins with {low:g} <= v <= {high:g}, "
+            f"at v = {_number(at, 3)}",
+        }
+    )
+    return rows
+
+
+def position_checks(position, restitution, shards, per_shard=None):
+    """The simulated P(x) and <v^2>_x against eqs. (P(x)2) and (moment2) at r = 1/2 and 1/3.
+
+    The references are the exact bin averages (``exact.position_bin_average``,
+    ``exact.speed_squared_given_position_bin_average``).
+
+    Parameters
+    ----------
+    position : pandas.DataFrame
+        A merged position table (columns x, x_lo, x_hi, px, px_err, v2_given_x,
+        v2_given_x_err).
+    restitution : float or fractions.Fraction
+        r.
+    shards : int
+        The number of shards the errors come from.
+    per_shard : dict, optional
+        ``shard_ratios`` of the shards, as in ``outgoing_speed_checks``.
+
+    Returns
+    -------
+    list of dict
+        Rows without r: chi^2/n (with its p_sign_flip where ``per_shard`` is given) and the
+        worst z over the bins inside 1e-3 <= x <= 50 that have an error, for P(x) and for
+        <v^2>_x; no rows for another r (no exact P(x) there).
+    """
+    if Fraction(restitution) not in exact.EXACT_RESTITUTIONS:
+        return []
+    low, high = POSITION_RANGE
+    inside = (
+        (position.x_lo >= low * (1.0 - 1e-9))
+        & (position.x_hi <= high * (1.0 + 1e-9))
+        & np.isfinite(position.x_hi)
+    )
+    rows = []
+    for quantity, bin_average in (
+        ("px", exact.position_bin_average),
+        ("v2_given_x", exact.speed_squared_given_position_bin_average),
+    ):
+        error = position[f"{quantity}_err"]
+        compared = inside & np.isfinite(error) & (error > 0.0)
+        bins = position[compared]
+        truth = np.asarray(
+            bin_average(bins.x_lo.to_numpy(), bins.x_hi.to_numpy(), restitution), dtype=float
+        )
+        z = (bins[quantity].to_numpy() - truth) / bins[f"{quantity}_err"].to_numpy()
+        deviations = _shard_deviations(
+            per_shard, quantity, np.flatnonzero(compared.to_numpy()), truth, shards
+        )
+        for row in _z_rows(quantity, "exact", bins.x.to_numpy(), z, shards, "x", deviations):
+            row["detail"] += f"; bins in {low:g} <= x <= {high:g}"
+            rows.append(row)
+    return rows
+
+
+def fit_checks(fits):
+    """The free-exponent fits of the asymptotic forms to the simulated P(0, v), as checks.
+
+    Per window (small v, eqs. (asym1), (asym2); large v, eqs. (asym3)-(asym6)) the joint
+    p-value of the theory's exponents (Hotelling's T^2 on the jackknife covariance) and the
+    fit's chi^2 per degree of freedom (per-bin errors only: indicative, it ignores the
+    correlations between bins).
+
+    Parameters
+    ----------
+    fits : pandas.DataFrame
+        A fits table (``fits.asymptotic_fits``).
+
+    Returns
+    -------
+    list of dict
+        Two rows per window, without r; a window without a usable fit gives NaN values.
+    """
+    chosen = fits[(fits.source == "simulation") & (fits.fit == "free_exponents")]
+    rows = []
+    for side in FIT_SIDES:
+        window = chosen[chosen.window == side]
+        if window.empty:
+            continue
+        first = window.iloc[0]
+        exponents = window[window.parameter != "prefactor"]
+        fitted = ", ".join(
+            f"{row.parameter} = {value_with_error(row.value, row.error)} "
+            f"(theory {_number(row.theory, 4)})"
+            for row in exponents.itertuples()
+        )
+        dof = int(first.dof) if np.isfinite(first.dof) else 0
+        bins = dof + len(window) if dof > 0 else 0
+        where = (
+            f"v in [{_number(first.v_min, 3)}, {_number(first.v_max, 3)}]"
+            if np.isfinite(first.v_min)
+            else "no usable window"
+        )
+        joint = float(first.joint_p_value)
+        if np.isfinite(first.v_min) and not np.isfinite(joint):
+            # Hotelling's T^2 needs more shards than free exponents (fits.fit_shards)
+            fitted += "; no joint test: too few shards for the exponents"
+        rows += [
+            {
+                "check": f"{side}_fit_joint_p_value",
+                "reference": "theory",
+                "bins": bins,
+                "value": joint,
+                "bin_centre": np.nan,
+                "p_sign_flip": np.nan,
+                "detail": f"{where}; {fitted}",
+            },
+            {
+                "check": f"{side}_fit_chi2_per_dof",
+                "reference": "fit",
+                "bins": bins,
+                "value": float(first.chi2_per_dof),
+                "bin_centre": np.nan,
+                "p_sign_flip": np.nan,
+                "detail": f"{where}; {dof} degrees of freedom; indicative: the bins are "
+                "correlated (the joint p-value is the test)",
+            },
+        ]
+    return rows
+
+
+def validation_rows(
+    label, restitution, p0v, position, fits, shards, solver_curve=None, per_shard=None
+) -> list[dict]:
+    """Every check of one r: ``outgoing_speed_checks``, ``position_checks``, ``fit_checks``.
+
+    Parameters
+    ----------
+    label : str
+        The r label.
+    restitution : float or fractions.Fraction
+        r.
+    p0v, position, fits : pandas.DataFrame
+        The merged p0v and position tables and the fits table.
+    shards : int
+        The number of shards the errors come from.
+    solver_curve : pandas.DataFrame, optional
+        The solver's P(0, v) grid (where r is not 1/2 or 1/3).
+    per_shard : dict, optional
+        The shards' ``shard_ratios`` (for the p_sign_flip of the chi^2/n rows).
+
+    Returns
+    -------
+    list of dict
+        The rows, each with the r label and r.
+    """
+    rows = [
+        *outgoing_speed_checks(p0v, restitution, shards, solver_curve, per_shard),
+        *position_checks(position, restitution, shards, per_shard),
+        *fit_checks(fits),
+    ]
+    return [{"r_label": label, "r": float(restitution), **row} for row in rows]
+
+
+def validation_table(rows) -> pd.DataFrame:
+    """The rows of ``validation_rows`` (of every r) as results/tables/validation.csv.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Rows of ``validation_rows``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``VALIDATION_COLUMNS``.
+    """
+    table = pd.DataFrame(rows, columns=list(VALIDATION_COLUMNS))
+    return table.astype({"bins": "int64"}) if len(table) else table
+
+
+def _shown_value(check, value):
+    if not np.isfinite(value):
+        return "inf" if value == np.inf else ""
+    if check.endswith("relative_error"):
+        percent = 100.0 * value
+        return f"{percent:.0f}%" if percent >= 10.0 else f"{percent:.2g}%"
+    if check.endswith("worst_bin"):
+        return f"{value:+.2f}"
+    return f"{value:.3g}"
+
+
+def validation_markdown(table: pd.DataFrame) -> str:
+    """The validation table for a reader, as results/tables/validation.md.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The table of ``validation_table``.
+
+    Returns
+    -------
+    str
+        A Markdown table, one line per r and check, values to 2-3 digits (z to 2 decimals,
+        relative errors in percent); no '|' in a cell.
+    """
+    shown = pd.DataFrame(
+        {
+            "r": table.r_label.astype(str),
+            "check": table.check.map(VALIDATION_CHECKS),
+            "reference": table.reference,
+            "bins": table.bins.astype(str),
+            "value": [_shown_value(c, v) for c, v in zip(table.check, table.value)],
+            "at v or x": table.bin_centre.map(lambda value: _number(value, 3)),
+            "p_sign_flip": table.p_sign_flip.map(lambda value: _number(value, 2)),
+            "detail": table.detail,
+        }
+    )
+    return shown.to_markdown(index=False, disable_numparse=True) + "\n"
+
+
+# ---- the asymptotics of P(x) for any r (results/tables/position_asymptotics) ----
+
+POSITION_EXPONENTS = {
+    "small_x_power": "P(x) - P(0) or P(x) ~ x^a, x -> 0: a = (1 - beta)/3",
+    "small_x_power_at_zero_speed": "P(x, 0) ~ x^a, x -> 0: a = -beta/3",
+    "large_x_rate": "P(x) ~ x^c exp(-b x^(1/2)), x -> inf: b",
+    "large_x_power": "P(x) ~ x^c exp(-b x^(1/2)), x -> inf: c",
+}
+
+
+def position_asymptotics_table(summaries) -> pd.DataFrame:
+    """The exponents of P(x) at small and large x, measured and predicted, for each r.
+
+    Parameters
+    ----------
+    summaries : iterable of (str, mapping)
+        The r label and the solver's summary row (with ``<exponent>_measured``, from the
+        solver's P(x) of eq. (P(x)1), and ``<exponent>_predicted``, docs/distribution.md).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per r and exponent of ``POSITION_EXPONENTS``: r_label, r, exponent, meaning,
+        measured, predicted, difference.
+    """
+    rows = []
+    for label, summary in summaries:
+        for exponent, meaning in POSITION_EXPONENTS.items():
+            measured = float(summary[f"{exponent}_measured"])
+            predicted = float(summary[f"{exponent}_predicted"])
+            rows.append(
+                {
+                    "r_label": label,
+                    "r": float(summary["r"]),
+                    "exponent": exponent,
+                    "meaning": meaning,
+                    "measured": measured,
+                    "predicted": predicted,
+                    "difference": measured - predicted,
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+def position_asymptotics_markdown(table: pd.DataFrame) -> str:
+    """The exponents of P(x) for a reader, as results/tables/position_asymptotics.md.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The table of ``position_asymptotics_table``.
+
+    Returns
+    -------
+    str
+        A Markdown table and a note on how the exponents are measured.
+    """
+    shown = pd.DataFrame(
+        {
+            "r": table.r_label,
+            "exponent": table.meaning,
+            "measured (solver's P(x))": table.measured.map(lambda value: f"{value:.6f}"),
+            "predicted": table.predicted.map(lambda value: f"{value:.6f}"),
+            "difference": table.difference.map(lambda value: f"{value:+.1e}"),
+        }
+    )
+    note = (
+        "\nSmall x: local slopes at x ~ 1e-7, with corrections of relative order "
+        "x^((beta - 1)/3) for 1 < beta < 2 and x^(1/3) otherwise (so the differences shrink "
+        "slowly as x -> 0: x^(1/6) = 0.07 at x = 1e-7 and r = 1/3); at r = 1/2 (beta = 1) P(x) ~ -ln x, whose "
+        "local slope goes to 0 only like 1/ln x. Large x: a fit of ln P(x) over the window where "
+        "w(F) is computed (docs/distribution.md).\n"
+    )
+    return shown.to_markdown(index=False, disable_numparse=True) + "\n" + note

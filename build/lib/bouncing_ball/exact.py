@@ -1,0 +1,668 @@
+"""The paper's exact solutions at r = 1/2 and r = 1/3.
+
+eq. (P(0,v)) with the constants of eq. (constants), and P(x) of eq. (P(x)2).
+The time averages <x>, Delta x and the collision rate I of eq. (xandDeltax)
+are computed here from these distributions (not copied from the paper), so
+that a test can compare them with the paper's closed forms.
+
+Every function takes r as a float or an exact fraction string ("1/2", "1/3") and refuses any
+other r with a ``ValueError``.
+"""
+
+import functools
+import math
+from fractions import Fraction
+
+import numpy as np
+import pandas as pd
+from scipy import integrate, special
+
+from .distribution import check_force_integral_point
+from .restitution import EXACT_RESTITUTIONS, parse_restitution
+
+__all__ = [
+    "normalization_constant",
+    "outgoing_speed_density",
+    "outgoing_speed_bin_average",
+    "position_density",
+    "position_bin_average",
+    "speed_squared_given_position_bin_average",
+    "position_moments",
+    "weight_function",
+    "distribution_by_force_integral",
+    "distribution_with_error",
+    "distribution",
+    "mean_speed_squared_given_position",
+    "distribution_table",
+]
+
+
+@functools.lru_cache(maxsize=64)  # called per point by the scalar integrands below
+def _which(restitution) -> Fraction:
+    """r (a float, or a fraction string such as "1/3") as 1/2 or 1/3; ValueError otherwise."""
+    given = parse_restitution(restitution, "restitution")
+    value = given.limit_denominator(1000)
+    if value not in EXACT_RESTITUTIONS or abs(float(value) - float(given)) > 1e-12:
+        raise ValueError(f"exact solutions exist only for r = 1/2 and 1/3, not r = {restitution}")
+    return value
+
+
+def normalization_constant(restitution) -> float:
+    """The normalization constant A of P(0, v), eq. (constants).
+
+    Parameters
+    ----------
+    restitution : float or str
+        r = 1/2 or 1/3, a float or a fraction string ("1/2", "1/3").
+
+    Returns
+    -------
+    float
+        A_{1/2} = 1/3 and A_{1/3} = (27 / (32 pi))^(1/2).
+
+    Raises
+    ------
+    ValueError
+        If r is not 1/2 or 1/3.
+
+    Examples
+    --------
+    >>> from bouncing_ball.exact import normalization_constant
+    >>> print(round(normalization_constant("1/2"), 12), round(normalization_constant(1 / 3), 12))
+    0.333333333333 0.518241224207
+    """
+    if _which(restitution) == Fraction(1, 2):
+        return 1.0 / 3.0
+    return np.sqrt(27.0 / (32.0 * np.pi))
+
+
+def outgoing_speed_density(v, restitution):
+    """P(0, v) for v > 0 (outgoing side), eq. (P(0,v)); the incoming side is eq. (bc).
+
+    Parameters
+    ----------
+    v : array_like
+        Outgoing speeds, v >= 0 (P(0, 0) is infinite).
+    restitution : float or str
+        r = 1/2 or 1/3, a float or a fraction string ("1/2", "1/3").
+
+    Returns
+    -------
+    numpy.ndarray
+        P(0, v) = A e^(-v) / v at r = 1/2, A v^(-3/2) e^(-3 v / 2) at r = 1/3, with A of
+        eq. (constants); the shape of ``v``.
+
+    Raises
+    ------
+    ValueError
+        If a v is negative or NaN (the incoming side is r^2 P(0, -r v), eq. (bc)), or r is not
+        1/2 or 1/3.
+
+    Examples
+    --------
+    >>> from bouncing_ball.exact import outgoing_speed_density
+    >>> print(outgoing_speed_density([0.5, 1.0, 2.0], "1/2").round(8))
+    [0.40435377 0.12262648 0.02255588]
+    """
+    v = np.asarray(v, dtype=float)
+    if np.any(~(v >= 0.0)):
+        raise ValueError(
+            "v: P(0, v) is the density of outgoing speeds, v >= 0; "
+            "the incoming side is r^2 P(0, r |v|), eq. (bc)"
+        )
+    a = normalization_constant(restitution)
+    if _which(restitution) == Fraction(1, 2):
+        return a * np.exp(-v) / v
+    return a * v**-1.5 * np.exp(-1.5 * v)
+
+
+def outgoing_speed_bin_average(lo, hi, restitution):
+    """int_lo^hi v P(0,v) dv / int_lo^hi v dv, the quantity a simulation bin measures.
+
+    P(0, v) of eq. (P(0,v)), averaged over a bin with the weight v of the flux through the
+    floor (the tally counts collisions).
+
+    Parameters
+    ----------
+    lo, hi : array_like
+        The bins' lower and upper edges, 0 <= lo < hi; they broadcast.
+    restitution : float or str
+        r = 1/2 or 1/3, a float or a fraction string ("1/2", "1/3").
+
+    Returns
+    -------
+    numpy.ndarray
+        The average of P(0, v) over each bin, weighted by v.
+
+    Raises
+    ------
+    ValueError
+        If r is not 1/2 or 1/3.
+
+    Examples
+    --------
+    >>> from bouncing_ball.exact import outgoing_speed_bin_average
+    >>> print(round(float(outgoing_speed_bin_average(1.0, 2.0, "1/2")), 10))
+    0.0516764795
+    """
+    lo = np.asarray(lo, dtype=float)
+    hi = np.asarray(hi, dtype=float)
+    a = normalization_constant(restitution)
+    if _which(restitution) == Fraction(1, 2):
+        rate = (
+            a * np.exp(-lo) * -np.expm1(lo - hi)
+        )  # int v^0 e^{-v}, no cancellation in narrow bins
+    else:
+        # int v^{-1/2} e^{-3v/2} dv = Gamma(1/2) (3/2)^{-1/2} [P(1/2, 3v/2)]
+        # (the upper functions Q in the tail, where P -> 1 would cancel)
+        scale = special.gamma(0.5) / np.sqrt(1.5)
+        tail = 1.5 * lo > 0.5
+        lower = special.gammainc(0.5, 1.5 * hi) - special.gammainc(0.5, 1.5 * lo)
+        upper = special.gammaincc(0.5, 1.5 * lo) - special.gammaincc(0.5, 1.5 * hi)
+        rate = a * scale * np.where(tail, upper, lower)
+    return rate / (0.5 * (hi**2 - lo**2))
+
+
+def position_density(x, restitution):
+    """P(x), the density of the height x, eq. (P(x)2).
+
+    Parameters
+    ----------
+    x : array_like
+        Heights, x >= 0 (P(0) is infinite at r = 1/2).
+    restitution : float or str
+        r = 1/2 or 1/3, a float or a fraction string ("1/2", "1/3").
+
+    Returns
+    -------
+    numpy.ndarray
+        P(x) = K_0((2 x / 3)^(1/2)) / 3 at r = 1/2; at r = 1/3 the integral over F of
+        eq. (P(x)2), by quadrature.  The shape of ``x``.
+
+    Raises
+    ------
+    ValueError
+        If r is not 1/2 or 1/3.
+
+    Examples
+    --------
+    >>> from bouncing_ball.exact import position_density
+    >>> print(position_density([1.5, 6.0], "1/2").round(8))
+    [0.14034148 0.03796462]
+    """
+    x = np.asarray(x, dtype=float)
+    if _which(restitution) == Fraction(1, 2):
+        return special.k0(np.sqrt(2.0 * x / 3.0)) / 3.0
+    return np.vectorize(_position_density_third)(x)
+
+
+def _position_density_third(x):
+    # (1/4 pi) int dF F^-1 K_{1/6}(z) e^{-z - F x}, z = 1/(12 F); in ln F
+    def integrand(log_f):
+        f = np.exp(log_f)
+        z = 1.0 / (12.0 * f)
+        return special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z - f * x)
+
+    # e^{-2z} cuts off small F; e^{-F x} (or, at x = 0, nothing) large F
+    upper = np.log(60.0 / x) if x > 0.0 else np.inf
+    value, _ = integrate.quad(integrand, -8.0, max(upper, 8.0), limit=400, epsabs=0.0, epsrel=1e-11)
+    return value / (4.0 * np.pi)
+
+
+def position_bin_average(lo, hi, restitution):
+    """int_lo^hi P(x) dx / (hi - lo): P(x) of eq. (P(x)2) averaged over a bin.
+
+    Parameters
+    ----------
+    lo, hi : array_like
+        The bins' lower and upper edges, 0 <= lo < hi, of the same shape.
+    restitution : float or str
+        r = 1/2 or 1/3, a float or a fraction string ("1/2", "1/3").
+
+    Returns
+    -------
+    numpy.ndarray
+        The mean of P(x) over each bin (in closed form at r = 1/2, by quadrature at r = 1/3).
+
+    Raises
+    ------
+    ValueError
+        If r is not 1/2 or 1/3.
+
+    Examples
+    --------
+    >>> from bouncing_ball.exact import position_bin_average
+    >>> print(round(float(position_bin_average(0.0, 1.5, "1/2")), 10))
+    0.2653951799
+    """
+    lo = np.asarray(lo, dtype=float)
+    hi = np.asarray(hi, dtype=float)
+    if _which(restitution) == Fraction(1, 2):
+        # int (1/3) K0(sqrt(2x/3)) dx = -u K1(u), u = sqrt(2x/3)
+        def primitive(x):
+            u = np.sqrt(2.0 * x / 3.0)
+            return np.where(u > 0, -u * special.k1(np.where(u > 0, u, 1.0)), -1.0)
+
+        return (primitive(hi) - primitive(lo)) / (hi - lo)
+    averages = [
+        integrate.quad(_position_density_third, a, b, epsrel=1e-10)[0] / (b - a)
+        for a, b in zip(np.atleast_1d(lo), np.atleast_1d(hi))
+    ]
+    return np.asarray(averages).reshape(np.shape(lo))
+
+
+def speed_squared_given_position_bin_average(lo, hi, restitution):
+    """<v^2>_x of eq. (moment2) averaged over [lo, hi) with weight P(x).
+
+    That is int_bin dx int_x^inf P(x') dx' / int_bin P(x) dx, the quantity a
+    simulation bin measures.  For r = 1/2, int_x^inf P = u K1(u) with
+    u = sqrt(2x/3), and int u K1(u) dx = -3 u^2 K2(u).  For r = 1/3 both
+    integrals over x are done under the integral over F of eq. (P(x)2):
+    int_lo^hi dx int_x^inf e^{-F x'} dx' = (e^{-F lo} - e^{-F hi}) / F^2.
+
+    Parameters
+    ----------
+    lo, hi : array_like
+        The bins' lower and upper edges, 0 <= lo < hi, of the same shape.
+    restitution : float or str
+        r = 1/2 or 1/3, a float or a fraction string ("1/2", "1/3").
+
+    Returns
+    -------
+    numpy.ndarray
+        The P(x)-weighted mean of <v^2>_x over each bin.
+
+    Raises
+    ------
+    ValueError
+        If r is not 1/2 or 1/3.
+
+    Examples
+    --------
+    >>> from bouncing_ball.exact import speed_squared_given_position_bin_average
+    >>> print(round(float(speed_squared_given_position_bin_average(0.0, 1.5, "1/2")), 10))
+    2.8271885085
+    """
+    lo = np.asarray(lo, dtype=float)
+    hi = np.asarray(hi, dtype=float)
+    if _which(restitution) == Fraction(1, 2):
+
+        def primitive(x):
+            u = np.sqrt(2.0 * x / 3.0)
+            safe = np.where(u > 0, u, 1.0)
+            return np.where(u > 0, -3.0 * safe**2 * special.kn(2, safe), -6.0)
+
+        numerator = primitive(hi) - primitive(lo)
+    else:
+        numerator = np.asarray(
+            [_tail_integral_third(a, b) for a, b in zip(np.atleast_1d(lo), np.atleast_1d(hi))]
+        ).reshape(np.shape(lo))
+    return numerator / (position_bin_average(lo, hi, restitution) * (hi - lo))
+
+
+def _tail_integral_third(lo, hi):
+    # int_lo^hi dx int_x^inf P(x') dx' at r = 1/3: (1/4 pi) int dF F^-1 K_{1/6}(z) e^{-z}
+    # (e^{-F lo} - e^{-F hi}) / F^2, z = 1/(12 F), in ln F as in _position_density_third
+    def integrand(log_f):
+        f = np.exp(log_f)
+        z = 1.0 / (12.0 * f)
+        difference = np.exp(-f * lo) * -np.expm1(-f * (hi - lo))
+        return special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z) * difference / (f * f)
+
+    # e^{-F lo} cuts off large F; at lo = 0 the integrand decays only as F^{-5/6} in ln F
+    upper = np.log(60.0 / lo) if lo > 0.0 else np.log(1.0e16 / hi)
+    value, _ = integrate.quad(integrand, -8.0, max(upper, 8.0), limit=400, epsabs=0.0, epsrel=1e-11)
+    return value / (4.0 * np.pi)
+
+
+def position_moments(restitution) -> dict:
+    """<x>, Delta x (eq. (xandDeltax)) from P(x), and I from eq. (collrate).
+
+    The moments of P(x) of eq. (P(x)2) by quadrature, and I = int_0^inf v P(0, v) dv with
+    P(0, v) of eq. (P(0,v)), so that they can be checked against the paper's closed forms.
+
+    Parameters
+    ----------
+    restitution : float or str
+        r = 1/2 or 1/3, a float or a fraction string ("1/2", "1/3").
+
+    Returns
+    -------
+    dict
+        ``normalization`` (int P(x) dx, 1 up to quadrature error), ``mean_x`` (<x>),
+        ``delta_x`` (Delta x) and ``collision_rate`` (I).
+
+    Raises
+    ------
+    ValueError
+        If r is not 1/2 or 1/3.
+
+    Examples
+    --------
+    At r = 1/2, <x> = 6, Delta x = 6 3^(1/2) and I = 1/3:
+
+    >>> from bouncing_ball.exact import position_moments
+    >>> moments = position_moments("1/2")
+    >>> print({name: round(float(value), 8) for name, value in moments.items()})
+    {'normalization': 1.0, 'mean_x': 6.0, 'delta_x': 10.39230485, 'collision_rate': 0.33333333}
+    """
+    moments = []
+    for k in (0, 1, 2):
+        # x = 3 u^2 / 2 makes the decay exp(-u) for both r
+        def integrand(u, k=k):
+            x = 1.5 * u * u
+            return x**k * float(position_density(x, restitution)) * 3.0 * u
+
+        value, _ = integrate.quad(integrand, 0.0, np.inf, limit=400, epsrel=1e-12)
+        moments.append(value)
+    norm, first, second = moments
+    mean_x = first / norm
+    a = normalization_constant(restitution)
+    # r = 1/2: int_0^inf v * v^-1 e^-v dv
+    rate = a if _which(restitution) == Fraction(1, 2) else a * special.gamma(0.5) / np.sqrt(1.5)
+    return {
+        "normalization": norm,
+        "mean_x": mean_x,
+        "delta_x": np.sqrt(second / norm - mean_x**2),
+        "collision_rate": rate,
+    }
+
+
+def weight_function(force, restitution):
+    """The weight function w(F) of eq. (weightfunc2) with the constants of eq. (constants).
+
+    Parameters
+    ----------
+    force : array_like
+        Values of F > 0.
+    restitution : float or str
+        r = 1/2 or 1/3, a float or a fraction string ("1/2", "1/3").
+
+    Returns
+    -------
+    numpy.ndarray
+        w(F), the shape of ``force``.
+
+    Raises
+    ------
+    ValueError
+        If r is not 1/2 or 1/3.
+
+    Examples
+    --------
+    >>> from bouncing_ball.exact import weight_function
+    >>> print(weight_function([0.1, 1.0], "1/2").round(8))
+    [0.22905337 0.15334074]
+    """
+    force = np.asarray(force, dtype=float)
+    a = normalization_constant(restitution)
+    z = 1.0 / (12.0 * force)
+    if _which(restitution) == Fraction(1, 2):
+        return 0.5 * a * force**-0.5 * np.exp(-z)
+    return np.sqrt(2.0 / (27.0 * np.pi)) * a * force**-0.5 * special.kve(1.0 / 6.0, z) * np.exp(-z)
+
+
+def _scalar_weight_function(restitution):
+    """``weight_function`` for one float F at a time, its constants computed once (quad calls
+    the integrand below hundreds of times per point of P(x, v))."""
+    a = normalization_constant(restitution)
+    if _which(restitution) == Fraction(1, 2):
+        c = 0.5 * a
+
+        def weight(force):
+            return c * force**-0.5 * math.exp(-1.0 / (12.0 * force))
+
+        return weight
+    c = math.sqrt(2.0 / (27.0 * math.pi)) * a
+    kve = special.kve
+
+    def weight(force):
+        z = 1.0 / (12.0 * force)
+        return c * force**-0.5 * float(kve(1.0 / 6.0, z)) * math.exp(-z)
+
+    return weight
+
+
+def _distribution_integrand(log_force, x, v, weight):
+    # e^{-v/2} w(F) e^{-F x} psi_{1/4,F}(-v) F, eqs. (fpsol), (psi); dF = F d(ln F);
+    # ``weight``: _scalar_weight_function
+    f = math.exp(log_force)
+    argument = -(f ** (1.0 / 3.0)) * v + 0.25 * f ** (-2.0 / 3.0)
+    airy = float(special.airy(argument)[0])
+    return math.exp(-0.5 * v - f * x) * weight(f) * f ** (-1.0 / 6.0) * airy * f
+
+
+def distribution_by_force_integral(x, v, restitution):
+    """P(x, v) of eqs. (fpsol), (psi), (weightfunc2) by integration over F, and its error.
+
+    Converges absolutely for x > 0, and for x = 0 on the incoming side v < 0
+    (there the Airy function decays); at x = 0, v > 0 only conditionally.
+
+    Parameters
+    ----------
+    x : float
+        The height, x >= 0.
+    v : float
+        The velocity; v < 0 if x = 0.
+    restitution : float or str
+        r = 1/2 or 1/3, a float or a fraction string ("1/2", "1/3").
+
+    Returns
+    -------
+    value : float
+        P(x, v).
+    error : float
+        quad's estimate of the absolute error of ``value``.
+
+    Raises
+    ------
+    ValueError
+        If x < 0, or x = 0 with v >= 0 (``distribution.check_force_integral_point``), or r is
+        not 1/2 or 1/3.
+
+    Examples
+    --------
+    At x = 0 on the incoming side the integral gives eq. (bc), r^2 P(0, -r v) = e^(-1/2) / 6
+    at r = 1/2, v = -1:
+
+    >>> import math
+    >>> from bouncing_ball.exact import distribution_by_force_integral
+    >>> value, error = distribution_by_force_integral(0.0, -1.0, "1/2")
+    >>> print(round(value, 8), round(math.exp(-0.5) / 6.0, 8), error < 1e-9)
+    0.10108844 0.10108844 True
+    """
+    xi, vi = float(x), float(v)
+    check_force_integral_point(xi, vi)
+    # w(F) vanishes like e^{-1/(6F)} at small F; e^{-F x} cuts large F (at x = 0, v < 0 the
+    # Airy factor ~ exp(-(2/3) F^(1/2) |v|^(3/2)) does)
+    upper = np.log(60.0 / xi) if xi > 0.0 else np.log((90.0 / abs(vi) ** 1.5) ** 2 + 1.0)
+    value, error, *_ = integrate.quad(
+        _distribution_integrand,
+        -6.0,
+        upper,
+        args=(xi, vi, _scalar_weight_function(restitution)),
+        limit=2000,
+        epsabs=0.0,
+        epsrel=1e-10,
+        full_output=1,
+    )
+    return value, error
+
+
+def distribution_with_error(x, v, restitution):
+    """P(x, v) and an estimate of its absolute error, for broadcast arrays x >= 0 and v.
+
+    At x = 0 the outgoing side is eq. (P(0,v)) and the incoming side the
+    boundary condition eq. (bc), P(0, -v) = r^2 P(0, r v) (the F integral
+    converges only conditionally there); P(0, 0) diverges and is NaN.  Elsewhere P(x, v) is
+    ``distribution_by_force_integral``, eqs. (fpsol), (psi), (weightfunc2).
+
+    Parameters
+    ----------
+    x : array_like
+        Heights, x >= 0.
+    v : array_like
+        Velocities; broadcast against ``x``.
+    restitution : float or str
+        r = 1/2 or 1/3, a float or a fraction string ("1/2", "1/3").
+
+    Returns
+    -------
+    values : numpy.ndarray
+        P(x, v), the broadcast shape.
+    errors : numpy.ndarray
+        quad's estimate of the absolute error of each value (0 at x = 0, where the values are
+        in closed form).
+
+    Raises
+    ------
+    ValueError
+        If an x is negative, or r is not 1/2 or 1/3.
+
+    Examples
+    --------
+    >>> from bouncing_ball.exact import distribution_with_error
+    >>> values, errors = distribution_with_error([0.0, 0.0, 1.0], [1.0, -2.0, 0.5], "1/2")
+    >>> print(values.round(8), bool(errors.max() < 1e-9))
+    [0.12262648 0.03065662 0.0471541 ] True
+    """
+    x, v = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(v, dtype=float))
+    for index in np.ndindex(x.shape):
+        if x[index] != 0.0:
+            check_force_integral_point(float(x[index]), float(v[index]))
+    values, errors = np.empty(x.shape), np.zeros(x.shape)
+    r = float(_which(restitution))
+    for index in np.ndindex(x.shape):
+        xi, vi = float(x[index]), float(v[index])
+        if xi == 0.0:
+            if vi > 0.0:
+                values[index] = outgoing_speed_density(vi, restitution)
+            elif vi < 0.0:
+                values[index] = r * r * outgoing_speed_density(-r * vi, restitution)
+            else:
+                values[index] = np.nan
+            continue
+        values[index], errors[index] = distribution_by_force_integral(xi, vi, restitution)
+    return values, errors
+
+
+def distribution(x, v, restitution):
+    """P(x, v), eqs. (fpsol), (psi), (weightfunc2); see ``distribution_with_error``.
+
+    Parameters
+    ----------
+    x : array_like
+        Heights, x >= 0.
+    v : array_like
+        Velocities; broadcast against ``x``.
+    restitution : float or str
+        r = 1/2 or 1/3, a float or a fraction string ("1/2", "1/3").
+
+    Returns
+    -------
+    numpy.ndarray
+        P(x, v), the broadcast shape (NaN at x = v = 0, where it diverges).
+
+    Raises
+    ------
+    ValueError
+        If an x is negative, or r is not 1/2 or 1/3.
+
+    Examples
+    --------
+    >>> from bouncing_ball.exact import distribution
+    >>> print(distribution(1.0, [0.5, -0.5], "1/2").round(8))
+    [0.0471541  0.03578642]
+    """
+    return distribution_with_error(x, v, restitution)[0]
+
+
+def mean_speed_squared_given_position(x, restitution):
+    """<v^2>_x = P(x)^-1 int_x^inf P(x') dx', eq. (moment2).
+
+    Parameters
+    ----------
+    x : array_like
+        Heights, x > 0.
+    restitution : float or str
+        r = 1/2 or 1/3, a float or a fraction string ("1/2", "1/3").
+
+    Returns
+    -------
+    numpy.ndarray
+        <v^2>_x with P(x) of eq. (P(x)2), the shape of ``x``.
+
+    Raises
+    ------
+    ValueError
+        If r is not 1/2 or 1/3.
+
+    Examples
+    --------
+    >>> from bouncing_ball.exact import mean_speed_squared_given_position
+    >>> print(mean_speed_squared_given_position([1.5, 6.0], "1/2").round(8))
+    [4.28887619 7.36822158]
+    """
+    x = np.asarray(x, dtype=float)
+    if _which(restitution) == Fraction(1, 2):
+        u = np.sqrt(2.0 * x / 3.0)
+        return u * special.k1(u) / (special.k0(u) / 3.0)
+
+    return np.vectorize(_position_tail_third)(x) / position_density(x, restitution)
+
+
+def _position_tail_third(x):
+    # int_x^inf P(x') dx' at r = 1/3, under the F integral of eq. (P(x)2):
+    # int_x^inf e^{-F x'} dx' = e^{-F x} / F, in ln F as in _position_density_third
+    def integrand(log_f):
+        f = np.exp(log_f)
+        z = 1.0 / (12.0 * f)
+        return special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z - f * x) / f
+
+    # at x = 0 the integrand decays only as F^(-5/6) in ln F
+    upper = np.log(60.0 / x) if x > 0.0 else np.log(1.0e16)
+    value, _ = integrate.quad(integrand, -8.0, max(upper, 8.0), limit=400, epsabs=0.0, epsrel=1e-11)
+    return value / (4.0 * np.pi)
+
+
+def distribution_table(positions, speeds, restitution):
+    """P(x, v) on a grid, eqs. (fpsol), (psi), (weightfunc2), and its largest relative error.
+
+    Parameters
+    ----------
+    positions : array_like
+        The heights x >= 0.
+    speeds : array_like
+        The velocities v.
+    restitution : float or str
+        r = 1/2 or 1/3, a float or a fraction string ("1/2", "1/3").
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        P(x, v) for every x in ``positions`` and v in ``speeds``, in long format: columns
+        ``x``, ``v``, ``pxv``, x varying slowest.
+    worst : float
+        The largest relative error quad estimates for a positive finite P(x, v).
+
+    Raises
+    ------
+    ValueError
+        If r is not 1/2 or 1/3.
+
+    Examples
+    --------
+    >>> from bouncing_ball.exact import distribution_table
+    >>> table, worst = distribution_table([0.0, 1.0], [-1.0, 1.0], "1/2")
+    >>> print(table.round(6).to_string(index=False), worst < 1e-9)
+      x    v      pxv
+    0.0 -1.0 0.101088
+    0.0  1.0 0.122626
+    1.0 -1.0 0.027950
+    1.0  1.0 0.045491 True
+    """
+    x, v = np.meshgrid(np.asarray(positions, dtype=float), speeds, indexing="ij")
+    pxv, error = distribution_with_error(x, v, restitution)
+    finite = np.isfinite(pxv) & (pxv > 0.0)
+    worst = float(np.max(error[finite] / pxv[finite])) if finite.any() else 0.0
+    return pd.DataFrame({"x": x.ravel(), "v": v.ravel(), "pxv": pxv.ravel()}), worst

@@ -1,0 +1,714 @@
+"""From summed shard tallies to P(0,v), P(x), <v^2>_x, P(x,v), the flights and the moments.
+
+Every estimate is a function of the shards' summed tallies (``tallies.ShardTallies``); its
+standard error comes from the scatter between shards by the delete-one jackknife
+(``jackknife``: for a ratio of sums over shards of equal time it is the standard error of the
+mean of the per-shard estimates).  ``control_variate_adjusted`` lowers the variance of any such
+estimate with the shards' martingale control variates (``control_variate_rate``: of a rate);
+the tables keep both estimates, plain and ``*_controlled``.
+
+Examples
+--------
+Two shards of time 2 on one speed bin per decade, built by hand (``tallies``): 4 and 2
+collisions, so I = 6 / 4 = 1.5 collisions per unit time, and the jackknife error is the
+standard error of the mean of the shards' rates 2 and 1:
+
+>>> from bouncing_ball.bins import LinearBins, LogBins
+>>> from bouncing_ball.settings import ShardSettings
+>>> from bouncing_ball.tallies import SCALAR_INDEX, ShardTallies
+>>> from bouncing_ball.histograms import outgoing_speed_histogram, position_moments_summary
+>>> settings = ShardSettings(
+...     shard_time=2.0, equilibration_time=0.0, criterion_c=5, min_step_divisor=10,
+...     max_steps=100, speed_bins=LogBins(0.1, 10.0, 1), position_bins=LogBins(0.1, 10.0, 1),
+...     velocity_bins=LinearBins(-1.0, 1.0, 1.0), flight_time_bins=LogBins(0.1, 10.0, 1),
+... )
+>>> def shard(speed_counts, int_x, int_x2):
+...     arrays = ShardTallies.loop_arrays(settings)
+...     arrays["speed_counts"][:] = speed_counts
+...     for name, value in (("time", 2.0), ("collisions", sum(speed_counts)),
+...                         ("int_x", int_x), ("int_x2", int_x2)):
+...         arrays["scalars"][SCALAR_INDEX[name]] = value
+...     return ShardTallies.from_loop(settings, arrays)
+>>> shards = [shard([0, 1, 3, 0], 1.0, 1.0), shard([0, 1, 1, 0], 2.0, 3.0)]
+>>> summary = position_moments_summary(shards, restitution=0.5)
+>>> print(summary[["collision_rate", "collision_rate_err", "mean_x", "mean_x_err"]].to_string())
+   collision_rate  collision_rate_err  mean_x  mean_x_err
+0             1.5                 0.5    0.75        0.25
+
+Two shards are too few for the control variates: the ``*_controlled`` columns are NaN.
+
+>>> print(summary["collision_rate_controlled"].isna().all())
+True
+>>> p0v = outgoing_speed_histogram(shards)
+>>> print(p0v[["v_lo", "v_hi", "p0v", "count"]].round(6).to_string())
+   v_lo  v_hi       p0v  count
+0   0.0   0.1  0.000000      0
+1   0.1   1.0  1.010101      2
+2   1.0  10.0  0.020202      4
+3  10.0   inf       NaN      0
+"""
+
+import numpy as np
+import pandas as pd
+
+from .tallies import (
+    MOMENT_CONTROLS,
+    RATE_CONTROLS,
+    SHARDS_PER_CONTROL,
+    ShardTallies,
+    merge_shards,
+)
+
+__all__ = [
+    "CONTROLLED_MOMENTS",
+    "jackknife",
+    "shard_controls",
+    "moment_controls",
+    "outgoing_speed_density",
+    "outgoing_speed_histogram",
+    "position_histogram",
+    "distribution_histogram",
+    "flight_time_histogram",
+    "return_speed_table",
+    "position_moments_summary",
+    "control_variate_rate",
+    "control_variate_adjusted",
+]
+
+
+def jackknife(estimator, *per_shard):
+    """Value and delete-one jackknife standard error of a function of summed tallies.
+
+    The estimator is evaluated on the sums over all shards and on the sums leaving out each
+    shard k in turn; the error is sqrt((n - 1) / n * sum_k (estimate_{-k} - mean)^2) over the
+    n shards.
+
+    Parameters
+    ----------
+    estimator : callable
+        A function of the sums over shards, one argument per array of ``per_shard``,
+        vectorised over their remaining axes.
+    *per_shard : array_like
+        The shards' tallies, each with the shard index as its first axis.
+
+    Returns
+    -------
+    value : numpy.ndarray or float
+        ``estimator`` of the sums over all shards.
+    error : numpy.ndarray or float
+        Its jackknife standard error, of the shape of ``value``; NaN with one shard.
+
+    Examples
+    --------
+    For a ratio of sums over shards of equal time, the error is the standard error of the
+    mean of the per-shard ratios (here 2 and 1):
+
+    >>> from bouncing_ball.histograms import jackknife
+    >>> value, error = jackknife(lambda c, t: c / t, [4.0, 2.0], [2.0, 2.0])
+    >>> print(value, error)
+    1.5 0.5
+    """
+    per_shard = [np.asarray(a, dtype=float) for a in per_shard]
+    totals = [a.sum(axis=0) for a in per_shard]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        value = estimator(*totals)
+        n = per_shard[0].shape[0]
+        if n < 2:
+            return value, np.full_like(np.asarray(value, dtype=float), np.nan)
+        leave_one_out = np.stack(
+            [estimator(*[t - a[k] for t, a in zip(totals, per_shard)]) for k in range(n)]
+        )
+    spread = leave_one_out - leave_one_out.mean(axis=0)
+    return value, np.sqrt((n - 1) / n * (spread**2).sum(axis=0))
+
+
+def shard_controls(shards, names):
+    """The control sums ``names`` of each shard, if the shards are enough to fit their slopes.
+
+    With p controls fitted to n shards the jackknife error of the corrected estimate is too
+    small by a factor that grows with p / n (about 1.05 at p / n = 1/3, 1.3 at 3/4, on shards
+    with Student-t controls), so at least ``tallies.SHARDS_PER_CONTROL`` shards per control
+    are asked for.
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards.
+    names : sequence of str
+        The control sums, fields of ``ShardTallies`` (e.g. ``tallies.RATE_CONTROLS``).
+
+    Returns
+    -------
+    numpy.ndarray or None
+        The sums, shape (shards, p) with p = ``len(names)``; None with fewer than
+        ``SHARDS_PER_CONTROL * p`` shards.
+
+    Examples
+    --------
+    See the module's example: two shards are too few for any control.
+    """
+    if len(shards) < SHARDS_PER_CONTROL * len(names):
+        return None
+    return np.array([[getattr(s, name) for name in names] for s in shards], dtype=float)
+
+
+def moment_controls(shards):
+    """The control sums of the summary's moments, as many as the shards can fit.
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards.
+
+    Returns
+    -------
+    numpy.ndarray or None
+        ``shard_controls`` of ``tallies.MOMENT_CONTROLS`` where the shards are enough to fit
+        their slopes, else of the fewer ``tallies.RATE_CONTROLS``, else None.
+
+    Examples
+    --------
+    See the module's example: two shards are too few for any control.
+    """
+    controls = shard_controls(shards, MOMENT_CONTROLS)
+    return controls if controls is not None else shard_controls(shards, RATE_CONTROLS)
+
+
+def _controlled(estimator, controls, times, adjusted, fixed=()):
+    """Value and jackknife error of ``estimator`` of the sums over shards of ``adjusted``, each
+    first adjusted by the control variates (``control_variate_adjusted``; ``times`` are the
+    shards' times), and of ``fixed`` as they are; NaN where ``controls`` is None."""
+    if controls is None:
+        sums = [np.asarray(a, dtype=float).sum(axis=0) for a in (*adjusted, *fixed)]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            shape = np.shape(estimator(*sums))
+        return np.full(shape, np.nan), np.full(shape, np.nan)
+    arrays = [np.asarray(a, dtype=float) for a in adjusted]
+    n = len(times)
+    # one fit for all: the columns of every array side by side, split again after
+    stacked = np.concatenate([a.reshape(n, -1) for a in arrays], axis=1)
+    corrected = control_variate_adjusted(stacked, times, controls)[0]
+    ends = np.cumsum([a[0].size for a in arrays])[:-1]
+    parts = [c.reshape(a.shape) for c, a in zip(np.split(corrected, ends, axis=1), arrays)]
+    return jackknife(estimator, *parts, *fixed)
+
+
+def outgoing_speed_density(counts, time, lower, upper):
+    """P(0, v) averaged over a bin of outgoing speed, from the rate of collisions in it.
+
+    The rate of collisions with outgoing speed in [lower, upper) is int v P(0, v) dv over the
+    bin, eq. (collrate); the bin average weighted by v is that rate over int v dv.
+
+    Parameters
+    ----------
+    counts : array_like
+        Collisions in each bin.
+    time : float or array_like
+        The time over which they were counted.
+    lower, upper : array_like
+        The bins' edges.
+
+    Returns
+    -------
+    numpy.ndarray or float
+        counts / (time (upper^2 - lower^2) / 2), the bin average of P(0, v) weighted by v.
+
+    Examples
+    --------
+    >>> from bouncing_ball.histograms import outgoing_speed_density
+    >>> print(outgoing_speed_density(6.0, 4.0, 1.0, 2.0))
+    1.0
+    """
+    return counts / (time * 0.5 * (upper**2 - lower**2))
+
+
+def outgoing_speed_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
+    """P(0, v) on the outgoing side, bin averages weighted by v.
+
+    Bin averages mean p0v = int_bin v P(0,v) dv / int_bin v dv (``outgoing_speed_density``,
+    eq. (collrate)).
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards, all on the same speed bins.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per speed bin, under- and overflow included, columns ``v_lo``, ``v_hi``,
+        ``v`` (the geometric centre; the arithmetic one for the underflow bin), ``p0v``,
+        ``p0v_err``, ``count``, ``p0v_controlled``, ``p0v_controlled_err``.  The overflow bin
+        has p0v = NaN; an empty bin has p0v = 0 and p0v_err = NaN (no scatter to measure).
+        ``p0v_controlled`` is the same with each bin's counts corrected by the control
+        variates of ``tallies.RATE_CONTROLS`` (``control_variate_adjusted``: the same
+        expectation, less variance; NaN with fewer than ``SHARDS_PER_CONTROL`` x
+        ``len(RATE_CONTROLS)`` shards).
+
+    Examples
+    --------
+    See the module's example.
+    """
+    bins = shards[0].speed_bins
+    lower, upper = bins.lower, bins.upper
+    counts = np.stack([s.speed_counts for s in shards])
+    times = np.array([s.time for s in shards])[:, None]
+
+    def density(c, t):
+        return outgoing_speed_density(c, t, lower, upper)
+
+    p0v, err = jackknife(density, counts, times)
+    controls = shard_controls(shards, RATE_CONTROLS)
+    controlled, controlled_err = _controlled(density, controls, times[:, 0], [counts], [times])
+    total = counts.sum(axis=0)
+    for value, error in ((p0v, err), (controlled, controlled_err)):
+        value[~np.isfinite(upper)] = np.nan
+        error[~np.isfinite(upper) | (total == 0)] = np.nan
+    return pd.DataFrame(
+        {
+            "v_lo": lower,
+            "v_hi": upper,
+            "v": _bin_centres(lower, upper),
+            "p0v": p0v,
+            "p0v_err": err,
+            "count": total.astype(np.int64),
+            "p0v_controlled": controlled,
+            "p0v_controlled_err": controlled_err,
+        }
+    )
+
+
+def position_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
+    """P(x) (bin averages) and <v^2>_x, eq. (moment2), per bin of x.
+
+    The tally is exact in expectation but in the steps cut by a collision (``simulation``:
+    the mean path corrected by one bridge point a step), so a bin's total can come out
+    slightly negative where the particle hardly goes; the underflow bin (x below the first
+    edge) also holds the bridge points below x = 0.
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards, all on the same position bins.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per position bin, under- and overflow included, columns ``x_lo``, ``x_hi``,
+        ``x`` (as ``v`` of ``outgoing_speed_histogram``), ``px``, ``px_err``,
+        ``v2_given_x``, ``v2_given_x_err``, ``px_controlled``, ``px_controlled_err``,
+        ``v2_given_x_controlled``, ``v2_given_x_controlled_err``.  NaN where a value is
+        undefined: P(x) in the overflow bin, errors and <v^2>_x in bins the particle never
+        visited.  The ``*_controlled`` columns are the same with each bin's time and
+        int v^2 dt corrected by the control variates of ``tallies.RATE_CONTROLS``
+        (``control_variate_adjusted``: the same expectation, less variance; NaN with fewer
+        than ``SHARDS_PER_CONTROL`` x ``len(RATE_CONTROLS)`` shards).
+
+    Examples
+    --------
+    See the module's example.
+    """
+    bins = shards[0].position_bins
+    lower, upper = bins.lower, bins.upper
+    in_bin = np.stack([s.position_time for s in shards])
+    v2 = np.stack([s.position_v2_time for s in shards])
+    times = np.array([s.time for s in shards])[:, None]
+
+    def density(b, t):
+        return b / (t * (upper - lower))
+
+    def given_x(w, b):
+        return w / b
+
+    px, px_err = jackknife(density, in_bin, times)
+    v2x, v2x_err = jackknife(given_x, v2, in_bin)
+    controls = shard_controls(shards, RATE_CONTROLS)
+    px_c, px_c_err = _controlled(density, controls, times[:, 0], [in_bin], [times])
+    v2x_c, v2x_c_err = _controlled(given_x, controls, times[:, 0], [v2, in_bin])
+    empty = in_bin.sum(axis=0) == 0
+    for value, error in ((px, px_err), (px_c, px_c_err)):
+        value[~np.isfinite(upper)] = np.nan
+        error[~np.isfinite(upper) | empty] = np.nan
+    return pd.DataFrame(
+        {
+            "x_lo": lower,
+            "x_hi": upper,
+            "x": _bin_centres(lower, upper),
+            "px": px,
+            "px_err": px_err,
+            "v2_given_x": v2x,
+            "v2_given_x_err": v2x_err,
+            "px_controlled": px_c,
+            "px_controlled_err": px_c_err,
+            "v2_given_x_controlled": v2x_c,
+            "v2_given_x_controlled_err": v2x_c_err,
+        }
+    )
+
+
+def distribution_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
+    """P(x, v) as cell averages: the time in each cell of (x, v) over the total time and its area.
+
+    x is on the position bins, v on the velocity bins.  The x underflow cell [0, x_lo) also
+    holds the rare bridge draws below x = 0 (see ``simulation``).
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards, all on the same position and velocity bins.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per cell, v fastest, columns ``x_lo``, ``x_hi``, ``v_lo``, ``v_hi``,
+        ``pxv``, ``pxv_err``.  pxv is NaN in cells of infinite area (x overflow, v under- and
+        overflow); pxv_err also in cells the particle never visited.
+
+    Examples
+    --------
+    See the module's example.
+    """
+    first = shards[0]
+    x_lower, x_upper = first.position_bins.lower, first.position_bins.upper
+    v_lower, v_upper = first.velocity_bins.lower, first.velocity_bins.upper
+    area = np.outer(x_upper - x_lower, v_upper - v_lower)
+    in_cell = np.stack([s.position_velocity_time for s in shards])
+    times = np.array([s.time for s in shards])[:, None, None]
+    pxv, err = jackknife(lambda b, t: b / (t * area), in_cell, times)
+    infinite = ~np.isfinite(area)
+    pxv[infinite] = np.nan
+    err[infinite | (in_cell.sum(axis=0) == 0)] = np.nan
+    nx, nv = area.shape
+    return pd.DataFrame(
+        {
+            "x_lo": np.repeat(x_lower, nv),
+            "x_hi": np.repeat(x_upper, nv),
+            "v_lo": np.tile(v_lower, nx),
+            "v_hi": np.tile(v_upper, nx),
+            "pxv": pxv.ravel(),
+            "pxv_err": err.ravel(),
+        }
+    )
+
+
+def flight_time_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
+    """The density of the flight time T between consecutive collisions, per unit T and per flight.
+
+    Bin averages: counts / (flights x bin width).
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards, all on the same flight-time bins.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per flight-time bin, under- and overflow included, columns ``t_lo``,
+        ``t_hi``, ``t`` (geometric centre; the arithmetic one for the underflow bin
+        [0, t_lo)), ``density``, ``density_err``.  NaN in the overflow bin; density_err NaN
+        in empty bins.
+
+    Examples
+    --------
+    See the module's example.
+    """
+    bins = shards[0].flight_time_bins
+    lower, upper = bins.lower, bins.upper
+    counts = np.stack([s.flight_time_counts for s in shards])
+    flights = np.array([s.flights for s in shards], dtype=float)[:, None]
+    density, err = jackknife(lambda c, n: c / (n * (upper - lower)), counts, flights)
+    density[~np.isfinite(upper)] = np.nan
+    err[~np.isfinite(upper) | (counts.sum(axis=0) == 0)] = np.nan
+    return pd.DataFrame(
+        {
+            "t_lo": lower,
+            "t_hi": upper,
+            "t": _bin_centres(lower, upper),
+            "density": density,
+            "density_err": err,
+        }
+    )
+
+
+def return_speed_table(shards: list[ShardTallies]) -> pd.DataFrame:
+    """The return speed v at the next collision given the outgoing speed u of a bounce.
+
+    The probability of each v bin given the u bin: counts over the counts of that u row.
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards, all on the same speed bins.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per (u, v) pair of the speed bins, v fastest, columns ``u_lo``, ``u_hi``,
+        ``v_lo``, ``v_hi``, ``probability``, ``probability_err``.  NaN (both) in rows of u
+        with no flight; probability_err NaN where the pair was never seen.
+
+    Examples
+    --------
+    See the module's example.
+    """
+    bins = shards[0].speed_bins
+    lower, upper = bins.lower, bins.upper
+    counts = np.stack([s.return_speed_counts for s in shards])
+    probability, err = jackknife(lambda c: c / c.sum(axis=-1, keepdims=True), counts)
+    total = counts.sum(axis=0)
+    err[total == 0] = np.nan
+    n = lower.shape[0]
+    return pd.DataFrame(
+        {
+            "u_lo": np.repeat(lower, n),
+            "u_hi": np.repeat(upper, n),
+            "v_lo": np.tile(lower, n),
+            "v_hi": np.tile(upper, n),
+            "probability": probability.ravel(),
+            "probability_err": err.ravel(),
+        }
+    )
+
+
+def _mean_x(int_x, time):
+    return int_x / time
+
+
+def _delta_x(int_x, int_x2, time):
+    return np.sqrt(int_x2 / time - (int_x / time) ** 2)
+
+
+#: The moments ``position_moments_summary`` also gives corrected by the control variates of
+#: ``moment_controls`` (its columns ``{name}_controlled``).
+CONTROLLED_MOMENTS = ("mean_x", "delta_x", "mean_flight_time", "flight_time_second_moment")
+
+
+def position_moments_summary(shards: list[ShardTallies], restitution: float) -> pd.DataFrame:
+    """One row of moments: <x>, Delta x, the collision rate I and the flight time's moments.
+
+    <x> and Delta x are eq. (xandDeltax), I eq. (collrate); the flight time T has its mean and
+    second moment per flight.  Each is given twice: plain (the time averages, collisions per
+    time, the flights' averages) and ``*_controlled`` (the moments of
+    ``CONTROLLED_MOMENTS`` and I), the same with each sum (the collisions, int x dt,
+    int x^2 dt, the flights, sum T, sum T^2) corrected by martingale control variates of mean
+    0 before the ratio (``control_variate_adjusted``: the same expectation, less variance),
+    those of ``moment_controls``: ``tallies.MOMENT_CONTROLS`` or the fewer
+    ``tallies.RATE_CONTROLS``, as many as the shards can fit (``shard_controls``), none (NaN)
+    with too few shards.
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards.
+    restitution : float
+        The restitution coefficient r of the shards, written in column ``r``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row: ``r``; ``mean_x``, ``delta_x``, ``collision_rate``, ``mean_flight_time``,
+        ``flight_time_second_moment``, each with ``_err`` and ``_controlled`` and
+        ``_controlled_err``; the totals ``flights``, ``total_time``, ``collisions``,
+        ``steps``, ``shards`` and ``shards_out_of_budget``.
+
+    Examples
+    --------
+    See the module's example.
+    """
+    time = np.array([s.time for s in shards])
+    int_x = np.array([s.int_x for s in shards])
+    int_x2 = np.array([s.int_x2 for s in shards])
+    collisions = np.array([s.collisions for s in shards], dtype=float)
+    mean_x, mean_x_err = jackknife(_mean_x, int_x, time)
+    delta_x, delta_x_err = jackknife(_delta_x, int_x, int_x2, time)
+    rate, rate_err = jackknife(lambda c, t: c / t, collisions, time)
+    controls = moment_controls(shards)
+    controlled, controlled_err = _controlled(
+        lambda c, t: c / t, controls, time, [collisions], [time]
+    )
+    flights = np.array([s.flights for s in shards], dtype=float)
+    flight_time = np.array([s.flight_time_sum for s in shards])
+    flight_time_squared = np.array([s.flight_time_squared_sum for s in shards])
+    mean_t, mean_t_err = jackknife(lambda f, n: f / n, flight_time, flights)
+    second_t, second_t_err = jackknife(lambda f, n: f / n, flight_time_squared, flights)
+    adjusted = (int_x, int_x2, flights, flight_time, flight_time_squared)
+    # each estimator takes the adjusted sums of int x dt, int x^2 dt, the flights, sum T and
+    # sum T^2, and the times
+    controlled_moments = {
+        name: _controlled(estimator, controls, time, adjusted, [time])
+        for name, estimator in (
+            ("mean_x", lambda ix, ix2, n, f, f2, t: _mean_x(ix, t)),
+            ("delta_x", lambda ix, ix2, n, f, f2, t: _delta_x(ix, ix2, t)),
+            ("mean_flight_time", lambda ix, ix2, n, f, f2, t: f / n),
+            ("flight_time_second_moment", lambda ix, ix2, n, f, f2, t: f2 / n),
+        )
+    }
+    controlled_columns = {
+        column: [float(value)]
+        for name, pair in controlled_moments.items()
+        for column, value in zip((f"{name}_controlled", f"{name}_controlled_err"), pair)
+    }
+    total = merge_shards(shards)
+    return pd.DataFrame(
+        {
+            "r": [float(restitution)],
+            "mean_x": [float(mean_x)],
+            "mean_x_err": [float(mean_x_err)],
+            "delta_x": [float(delta_x)],
+            "delta_x_err": [float(delta_x_err)],
+            "collision_rate": [float(rate)],
+            "collision_rate_err": [float(rate_err)],
+            "collision_rate_controlled": [float(controlled)],
+            "collision_rate_controlled_err": [float(controlled_err)],
+            "mean_flight_time": [float(mean_t)],
+            "mean_flight_time_err": [float(mean_t_err)],
+            "flight_time_second_moment": [float(second_t)],
+            "flight_time_second_moment_err": [float(second_t_err)],
+            **controlled_columns,
+            "flights": [int(total.flights)],
+            "total_time": [float(total.time)],
+            "collisions": [int(total.collisions)],
+            "steps": [int(total.steps)],
+            "shards": [len(shards)],
+            "shards_out_of_budget": [int(total.budget_exhausted)],
+        }
+    )
+
+
+def _bin_centres(lower, upper):
+    with np.errstate(invalid="ignore"):
+        centre = np.sqrt(lower * upper)
+    centre[lower == 0.0] = 0.5 * upper[lower == 0.0]
+    return centre
+
+
+def control_variate_rate(tallies, times, controls):
+    """A rate per unit time corrected by martingale control variates, and its standard error.
+
+    The controls are sums over the shard's steps of noise terms whose expectation is exactly
+    0 under the simulated process (``tallies.ShardTallies``: e.g. ``noise_sum``, the sum of
+    the velocity noise sqrt(2 dt) normal_r of eq. (vstep)).  The estimate is::
+
+        sum_k (tallies_k - beta_{-k} . controls_k) / sum_k times_k
+
+    with beta_{-k} the weighted least-squares slope (with intercept, weights times_j) of
+    tallies_j / times_j on controls_j / times_j over the other shards j != k (cross-fitting,
+    ``control_variate_adjusted``).  As controls_k has mean 0 and is independent of
+    beta_{-k}, each correction has mean 0: the estimate has the plain estimator's
+    expectation, with no O(1 / shards) bias from the fitted slope.  The standard error is
+    the delete-one jackknife of the corrected per-shard tallies over the times
+    (``jackknife``), which holds the slope's own scatter (the corrections are made out of
+    sample).
+
+    Parameters
+    ----------
+    tallies : array_like
+        What each shard counted (e.g. its collisions), shape (shards,) or (shards, bins).
+    times : array_like
+        Each shard's recorded time, shape (shards,).
+    controls : array_like
+        Each shard's control sums, shape (shards, p) or (shards,) for p = 1.
+
+    Returns
+    -------
+    value : numpy.ndarray
+        The corrected rate, of the shape of a shard's tallies.
+    error : numpy.ndarray
+        Its jackknife standard error.
+    beta : numpy.ndarray
+        The slope fitted to all shards, (p,) or (p, bins), for reporting.
+
+    Raises
+    ------
+    ValueError
+        With fewer than p + 3 shards.
+
+    Examples
+    --------
+    Tallies that are a rate of 5 plus 3 times a control: the control explains all the
+    scatter, so the corrected rate is 5 with no error.
+
+    >>> import numpy as np
+    >>> from bouncing_ball.histograms import control_variate_rate
+    >>> controls = np.array([1.0, -1.0, 2.0, -2.0, 0.5, -0.5])
+    >>> times = np.full(6, 2.0)
+    >>> value, error, beta = control_variate_rate(5.0 * times + 3.0 * controls, times, controls)
+    >>> print(np.round(value, 12), np.round(error, 12), np.round(beta, 12))
+    5.0 0.0 [3.]
+    """
+    times = np.asarray(times, dtype=float)
+    adjusted, beta = control_variate_adjusted(tallies, times, controls)
+    value, error = jackknife(lambda a, t: a / t, adjusted, times[:, None])
+    shape = np.shape(tallies)[1:]
+    return value.reshape(shape), error.reshape(shape), beta
+
+
+def control_variate_adjusted(tallies, times, controls):
+    """Each shard's tallies less their cross-fitted share of the control variates.
+
+    These are the terms ``tallies_k - beta_{-k} . controls_k`` of ``control_variate_rate``.
+    Each adjusted tally has the plain tally's expectation (controls_k has mean 0 and is
+    independent of beta_{-k}), so any function of their sums is estimated as of the plain
+    ones, with its error by ``jackknife`` (e.g. Delta x from the adjusted int x dt and
+    int x^2 dt).
+
+    Parameters
+    ----------
+    tallies : array_like
+        Each shard's tallies, shape (shards,) or (shards, ...).
+    times : array_like
+        Each shard's recorded time, shape (shards,): the weights of the fit.
+    controls : array_like
+        Each shard's control sums, shape (shards, p) or (shards,) for p = 1.
+
+    Returns
+    -------
+    adjusted : numpy.ndarray
+        The adjusted tallies, of the shape of ``tallies``.
+    beta : numpy.ndarray
+        The slope fitted to all shards, shape (p, ...).
+
+    Raises
+    ------
+    ValueError
+        With fewer than p + 3 shards.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bouncing_ball.histograms import control_variate_adjusted
+    >>> controls = np.array([1.0, -1.0, 2.0, -2.0])
+    >>> adjusted, beta = control_variate_adjusted(10.0 + 3.0 * controls, np.ones(4), controls)
+    >>> print(np.round(adjusted, 12), np.round(beta, 12))
+    [10. 10. 10. 10.] [3.]
+    >>> control_variate_adjusted(np.ones(3), np.ones(3), np.ones(3))
+    Traceback (most recent call last):
+    ...
+    ValueError: 3 shards are too few for 1 control variates (need 4)
+    """
+    tallies = np.asarray(tallies, dtype=float)
+    times = np.asarray(times, dtype=float)
+    controls = np.asarray(controls, dtype=float)
+    if controls.ndim == 1:
+        controls = controls[:, None]
+    n, p = controls.shape
+    if n < p + 3:
+        raise ValueError(f"{n} shards are too few for {p} control variates (need {p + 3})")
+    flat = tallies.reshape(n, -1)
+    y = flat / times[:, None]
+    design = np.column_stack([np.ones(n), controls / times[:, None]]) * np.sqrt(times)[:, None]
+    weighted_y = y * np.sqrt(times)[:, None]
+
+    def slope(keep):
+        fitted, *_ = np.linalg.lstsq(design[keep], weighted_y[keep], rcond=None)
+        return fitted[1:]  # (p, bins)
+
+    adjusted = np.empty_like(flat)
+    everyone = np.ones(n, dtype=bool)
+    for k in range(n):
+        others = everyone.copy()
+        others[k] = False
+        adjusted[k] = flat[k] - controls[k] @ slope(others)
+    shape = tallies.shape[1:]
+    return adjusted.reshape(tallies.shape), slope(everyone).reshape((p, *shape))

@@ -1,0 +1,231 @@
+"""numba for the compiled modules, its cache kept in a folder named after their source.
+
+``cache=True`` checks only the file that holds a compiled function, not the
+files it calls into: after an edit of free_flight.py a cached simulation loop
+would silently keep the old code.  So the cache folder is keyed on the source
+of every module numba compiles (``COMPILED``: an edit of plotting.py
+does not recompile), inside numba's own cache folder or, where the user set
+NUMBA_CACHE_DIR, inside that one.  Only the compiled
+modules import this, so importing the package (as the workflow does to plan a
+run) does not load numba.
+
+Every edit of compiled code makes a new folder; the old ones are pruned here,
+keeping the ``KEEP_CACHES`` most recently used besides the current one (so
+switching between two versions does not recompile) and never one used in the
+last ``PRUNE_AFTER_SECONDS`` (a job of another version may still be running).
+
+Two faults are survived rather than passed on to every job: a checkout that
+cannot be written to (a shared read-only install) caches under the user's
+cache folder instead (``$XDG_CACHE_HOME/bouncing_ball``, else
+``~/.cache/bouncing_ball``), where numba would otherwise recompile in every
+process; and a damaged cache file (a truncated write, a full disk) is a cache
+miss, reported with its folder, removed and recompiled, where numba would raise
+``UnpicklingError`` in every job.
+"""
+
+import contextlib
+import logging
+import os
+import shutil
+import tempfile
+import time
+from pathlib import Path
+
+import numba
+from numba.core.caching import FunctionCache
+
+from . import PACKAGE, source_digest
+
+__all__ = [
+    "njit",
+    "COMPILED",
+    "CACHE",
+    "prune_caches",
+    "user_cache_folder",
+    "writable_cache_base",
+    "RecoveringFunctionCache",
+]
+
+KEEP_CACHES = 3
+PRUNE_AFTER_SECONDS = 3600.0
+
+
+def prune_caches(
+    base: Path, current: Path, keep: int = KEEP_CACHES, older_than: float = PRUNE_AFTER_SECONDS
+):
+    """Remove the ``numba-*`` folders under ``base`` other than ``current``, but the newest.
+
+    Failures (a folder removed by another process at the same time, no permission) are
+    ignored: pruning is tidying.
+
+    Parameters
+    ----------
+    base : pathlib.Path
+        The folder holding the cache folders.
+    current : pathlib.Path
+        The cache folder in use, never removed.
+    keep : int
+        How many of the others are kept, the most recently used.
+    older_than : float
+        Seconds: a folder used more recently than that is kept (a job of another version
+        may still be running).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The folders removed.
+
+    Examples
+    --------
+    >>> import os, tempfile, time
+    >>> from pathlib import Path
+    >>> from bouncing_ball.jit import prune_caches
+    >>> base = Path(tempfile.mkdtemp())
+    >>> for age, name in enumerate(["numba-a", "numba-b", "numba-c"]):
+    ...     (base / name).mkdir()
+    ...     os.utime(base / name, (time.time() - 7200 * (age + 1),) * 2)
+    >>> [path.name for path in prune_caches(base, base / "numba-a", keep=1)]
+    ['numba-c']
+    """
+    try:
+        others = [path for path in base.glob("numba-*") if path.is_dir() and path != current]
+        others.sort(key=lambda path: path.stat().st_mtime, reverse=True)
+    except OSError:
+        return []
+    now = time.time()
+    removed = []
+    for path in others[keep:]:
+        try:
+            if now - path.stat().st_mtime < older_than:
+                continue
+            shutil.rmtree(path)
+            removed.append(path)
+        except OSError:
+            continue
+    return removed
+
+
+def user_cache_folder() -> Path:
+    """Where the cache goes when the checkout cannot be written to.
+
+    Returns
+    -------
+    pathlib.Path
+        ``$XDG_CACHE_HOME/bouncing_ball``, else ``~/.cache/bouncing_ball``.
+    """
+    root = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(root) / "bouncing_ball"
+
+
+def writable_cache_base(preferred: Path, fallback: Path) -> Path:
+    """``preferred`` if a cache folder can be made and written in it, else ``fallback``.
+
+    Parameters
+    ----------
+    preferred, fallback : pathlib.Path
+        The folder wanted, and the one to use where it cannot be written to.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from bouncing_ball.jit import writable_cache_base
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> writable_cache_base(folder / "cache", folder / "other") == folder / "cache"
+    True
+    """
+    try:
+        preferred.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=preferred):
+            pass
+        return preferred
+    except OSError:
+        return fallback
+
+
+class RecoveringFunctionCache(FunctionCache):
+    """numba's cache of one function, with a damaged cache file taken as a cache miss.
+
+    ``njit`` gives every cached function this class.  A damaged index (a truncated write, a
+    full disk) is reported with its folder and removed, and the function recompiled, where
+    numba would raise ``UnpicklingError`` in every job.
+
+    Parameters
+    ----------
+    py_func : function
+        The Python function compiled (as for ``numba.core.caching.FunctionCache``).
+    """
+
+    def load_overload(self, sig, target_context):
+        """The cached overload of ``sig``, or None (a cache miss) where the cache is damaged."""
+        try:
+            return super().load_overload(sig, target_context)
+        except Exception as error:  # a damaged pickle raises almost anything
+            index = Path(self._cache_file._index_path)
+            logging.getLogger(__name__).warning(
+                "numba's cache of %s in %s is damaged (%s: %s): removing its index and "
+                "recompiling (if this repeats, delete that folder)",
+                f"{self._py_func.__module__}.{self._py_func.__qualname__}",
+                self._cache_path,
+                type(error).__name__,
+                error,
+            )
+            index.unlink(missing_ok=True)
+            return None
+
+
+def njit(*args, **options):
+    """``numba.njit`` with IEEE division and a cache that survives a damaged file.
+
+    IEEE division gives inf or NaN instead of a Python ZeroDivisionError check on every
+    division: the compiled code tests its own denominators, as the C reference of the loop
+    does.  The compiled function keeps the Python function's docstring.
+
+    Parameters
+    ----------
+    *args
+        The function, when used as ``@njit`` without options.
+    **options
+        Options of ``numba.njit`` (e.g. ``cache=True``, ``inline="always"``).
+
+    Returns
+    -------
+    numba dispatcher, or a decorator that makes one
+        Compiled on its first call.
+
+    Raises
+    ------
+    TypeError
+        If options are given other than by keyword.
+    """
+
+    def compile_lazily(function):
+        dispatcher = numba.njit(error_model="numpy", **options)(function)
+        if isinstance(getattr(dispatcher, "_cache", None), FunctionCache):
+            dispatcher._cache.__class__ = RecoveringFunctionCache
+        return dispatcher
+
+    if len(args) == 1 and callable(args[0]):
+        return compile_lazily(args[0])
+    if args:
+        raise TypeError("bouncing_ball.jit.njit takes keyword options only")
+    return compile_lazily
+
+
+#: What numba compiles: the modules with compiled functions and what those call into or read
+#: constants from (the key of numba's cache folder); an edit elsewhere does not recompile.
+COMPILED = ("distribution", "free_flight", "jit", "kernel", "pcg64", "simulation", "tallies")
+
+_preferred = Path(numba.config.CACHE_DIR) if numba.config.CACHE_DIR else PACKAGE / "__pycache__"
+_base = writable_cache_base(_preferred, user_cache_folder())
+#: numba's cache folder, named after the source of the modules of ``COMPILED``.
+CACHE = _base / f"numba-{source_digest(COMPILED)}"
+numba.config.CACHE_DIR = str(CACHE)
+with contextlib.suppress(OSError):  # not there yet, or not ours to touch (a read-only cache)
+    os.utime(CACHE)  # in use: the newest to keep
+prune_caches(_base, CACHE)
+prange = numba.prange

@@ -1,0 +1,400 @@
+"""The Monte Carlo simulation of the paper's Sec. IV from Python: ``simulate`` runs shards (in
+this process or on several) and returns a ``SimulationResult`` with the observables of
+``Equilibrium`` and their jackknife errors.
+
+It is the workflow's machinery, called directly: shard k of r draws from
+``simulation.shard_seed_sequence(seed, label of r, k)`` (``batches.simulate_batch``), so a
+shard of ``simulate`` is the workflow's shard k for the same seed and settings, whatever the
+number of processes; the tables are ``histograms``' (the workflow's merge stage).
+"""
+
+import math
+import sys
+import time
+from dataclasses import dataclass, field
+from fractions import Fraction
+from functools import cached_property
+
+import numpy as np
+
+from .restitution import parse_restitution, restitution_label
+
+__all__ = ["simulate", "SimulationResult", "DEFAULT_SETTINGS"]
+
+# the shard settings ``simulate`` uses where it is not told otherwise (the default config's
+# ``simulation`` section holds the workflow's); every bin set is ``ShardSettings``' default
+DEFAULT_SETTINGS = {
+    "equilibration_time": 1.0e3,
+    "criterion_c": 3.0,
+    "min_step_divisor": 500.0,
+    "max_steps": 10**9,
+}
+
+
+def _shard_settings(shard_time, settings):
+    """The ``ShardSettings`` of a call: ``settings`` (a ShardSettings, or a mapping of
+    overrides of DEFAULT_SETTINGS) with ``shard_time``."""
+    from .settings import ShardSettings
+
+    if isinstance(settings, ShardSettings):
+        if shard_time is None:
+            return settings
+        if float(settings.shard_time) != float(shard_time):
+            raise ValueError(
+                f"shard_time = {shard_time!r} and settings.shard_time = {settings.shard_time!r} "
+                "differ; give one of them"
+            )
+        return settings
+    if settings is not None and not isinstance(settings, dict):
+        raise TypeError(
+            f"settings must be a ShardSettings or a dict of shard settings, got {settings!r}"
+        )
+    overrides = dict(settings or {})
+    unknown = sorted(set(overrides) - set(ShardSettings.names()))
+    if unknown:
+        raise ValueError(
+            f"settings: unknown key(s) {', '.join(unknown)}; the shard settings are "
+            f"{', '.join(ShardSettings.names())}"
+        )
+    if "shard_time" in overrides:
+        raise ValueError("settings: give shard_time as simulate's own argument, not in settings")
+    if shard_time is None:
+        raise TypeError("simulate needs shard_time, the simulated time each shard records")
+    _positive_number(shard_time, "shard_time")
+    try:
+        return ShardSettings.from_mapping(
+            {**DEFAULT_SETTINGS, **overrides, "shard_time": shard_time}
+        )
+    except (KeyError, TypeError) as error:
+        raise ValueError(f"settings: {error}") from None
+
+
+def _positive_number(value, name):
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise TypeError(f"{name} must be a number, got {value!r}")
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(f"{name} must be positive and finite, got {value!r}")
+
+
+def _whole_number(value, name, least):
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{name} must be a whole number, got {value!r}")
+    if value < least:
+        raise ValueError(f"{name} must be >= {least}, got {value}")
+    return int(value)
+
+
+def _run_shard(restitution, seed, label, shard, settings):
+    """One shard on its own stream (a module-level function: picklable for spawned workers)."""
+    from .simulation import shard_seed_sequence, simulate_shard  # numba: only where it runs
+
+    return shard, simulate_shard(restitution, shard_seed_sequence(seed, label, shard), settings)
+
+
+class _Progress:
+    """'simulate r=0.6: 3/8 shards, 12 s' on stderr, rewritten in place, on a terminal only."""
+
+    def __init__(self, label, total, enabled):
+        self.label, self.total = label, total
+        self.enabled = bool(enabled) and sys.stderr.isatty()
+        self.started = time.perf_counter()
+
+    def show(self, done):
+        if self.enabled:
+            elapsed = time.perf_counter() - self.started
+            sys.stderr.write(
+                f"\rsimulate r={self.label}: {done}/{self.total} shards, {elapsed:.0f} s"
+            )
+            sys.stderr.flush()
+
+    def close(self):
+        if self.enabled:
+            sys.stderr.write("\n")
+            sys.stderr.flush()
+
+
+def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=1, progress=True):
+    """Simulate the bouncing ball at r (the paper's Sec. IV) in independent shards, and
+    estimate the equilibrium observables with their jackknife errors.
+
+    Parameters
+    ----------
+    r : float or str
+        The coefficient of restitution, eq. (restitution): a decimal or a fraction string such
+        as ``"1/3"``, 0 < r < 1.  Below r_c (eq. (rc)) the collapse needs
+        ``settings={"min_step_floor": ...}``.
+    shards : int
+        Independent shards, >= 2 (every error bar is the scatter between them).
+    shard_time : float
+        Simulated time each shard records, after its equilibration time (may be left out when
+        ``settings`` is a ``ShardSettings``, which holds one).
+    seed : int, optional
+        Root seed of the random streams; shard k draws from
+        ``simulation.shard_seed_sequence(seed, label of r, k)``, as in the workflow.  None
+        draws fresh entropy (``numpy.random.SeedSequence``), recorded in the result's ``seed``.
+    settings : ShardSettings or dict, optional
+        The shard settings (``settings.ShardSettings``), or a dict overriding some of
+        ``DEFAULT_SETTINGS`` and ``ShardSettings``' defaults (equilibration_time, criterion_c,
+        min_step_divisor, max_steps, speed_bins, position_bins, velocity_bins,
+        flight_time_bins, min_step_floor).
+    processes : int, optional
+        Worker processes (spawned); 1 runs the shards in this process.  The numbers do not
+        depend on it.  A script that uses more than one must call ``simulate`` under
+        ``if __name__ == "__main__":``.
+    progress : bool, optional
+        Show the shards done on stderr, when stderr is a terminal.
+
+    Returns
+    -------
+    SimulationResult
+        The merged tables and the observables with their errors.
+
+    Examples
+    --------
+    >>> from bouncing_ball import simulate
+    >>> result = simulate("1/2", shards=4, shard_time=200.0, seed=1,
+    ...                   settings={"equilibration_time": 20.0}, progress=False)
+    >>> result.shards, result.total_time
+    (4, 800.0)
+    >>> sorted(result.summary.columns)[:4]
+    ['collision_rate', 'collision_rate_controlled', 'collision_rate_controlled_err', 'collision_rate_err']
+    """
+    from .asymptotics import CRITICAL_RESTITUTION
+
+    exact = parse_restitution(r, "r")
+    label = restitution_label(exact)
+    shards = _whole_number(shards, "shards", 2)
+    processes = _whole_number(processes, "processes", 1)
+    run_settings = _shard_settings(shard_time, settings)
+    if exact < CRITICAL_RESTITUTION and not run_settings.min_step_floor > 0.0:
+        raise ValueError(
+            f"r = {r!r} is below r_c = {CRITICAL_RESTITUTION:.4f}: the ball collapses onto the "
+            "floor (infinitely many collisions in a finite time); give settings="
+            '{"min_step_floor": 1e-10} (or another positive floor) to regularise it'
+        )
+    if seed is None:
+        seed = int(np.random.SeedSequence().entropy)
+    seed = _whole_number(seed, "seed", 0)
+    progress_line = _Progress(label, shards, progress)
+    tallies = {}
+    progress_line.show(0)
+    try:
+        if processes == 1:
+            for index in range(shards):
+                tallies[index] = _run_shard(float(exact), seed, label, index, run_settings)[1]
+                progress_line.show(len(tallies))
+        else:
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor, as_completed
+
+            context = multiprocessing.get_context("spawn")
+            with ProcessPoolExecutor(max_workers=processes, mp_context=context) as pool:
+                futures = [
+                    pool.submit(_run_shard, float(exact), seed, label, index, run_settings)
+                    for index in range(shards)
+                ]
+                for future in as_completed(futures):
+                    index, shard_tallies = future.result()
+                    tallies[index] = shard_tallies
+                    progress_line.show(len(tallies))
+    finally:
+        progress_line.close()
+    for index, shard_tallies in tallies.items():
+        if not shard_tallies.time > 0.0:
+            raise RuntimeError(
+                f"shard {index} recorded no time: its step budget (max_steps = "
+                f"{run_settings.max_steps}) ran out during equilibration; raise max_steps or "
+                "shorten equilibration_time"
+            )
+    return SimulationResult(
+        restitution=exact,
+        seed=seed,
+        settings=run_settings,
+        tallies=tuple(tallies[index] for index in range(shards)),
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class SimulationResult:
+    """What ``simulate`` returns: the shards' tallies, their merged tables and the observables
+    with their delete-one jackknife errors over the shards (``histograms``).
+
+    Attributes
+    ----------
+    restitution : fractions.Fraction
+        r exactly; ``r`` is it as a float, ``label`` the workflow's label of it.
+    seed : int
+        The root seed (pass it again for the same numbers).
+    settings : settings.ShardSettings
+    tallies : tuple of tallies.ShardTallies
+        Each shard's tallies, in the order of the shards (the raw data).
+    merged : tallies.ShardTallies
+        Their sum.
+    collision_rate, mean_x, delta_x, mean_flight_time, flight_time_second_moment : float
+        I (eq. (collrate)), <x>, Delta x (eq. (xandDeltax)), and <T>, <T^2> per flight; each
+        with its jackknife error ``*_err``.
+    collision_rate_controlled, mean_x_controlled, delta_x_controlled : float
+        I, <x>, Delta x corrected by the martingale control variates (the same expectation,
+        less variance), each with its ``*_err``; and ``mean_flight_time_controlled``,
+        ``flight_time_second_moment_controlled``.  NaN with fewer than 15 shards.
+    p0v : pandas.DataFrame
+        P(0, v) on the speed bins (v_lo, v_hi, v, p0v, p0v_err, count).
+    px, v2_given_x : pandas.DataFrame
+        P(x) and <v^2>_x (eq. (moment2)) on the position bins (x_lo, x_hi, x, and the value
+        with its ``_err``); ``position`` has both.
+    pxv : pandas.DataFrame
+        P(x, v) cell averages (x_lo, x_hi, v_lo, v_hi, pxv, pxv_err).
+    flight_time_density : pandas.DataFrame
+        rho(T) per flight on the flight-time bins (t_lo, t_hi, t, density, density_err).
+    return_speed : pandas.DataFrame
+        The return speed's bin probabilities given the outgoing speed's bin.
+    summary : pandas.DataFrame
+        One row: the scalars, their errors, the counts (as the workflow's summary table).
+
+    Examples
+    --------
+    >>> from bouncing_ball import simulate
+    >>> result = simulate(0.6, shards=2, shard_time=100.0, seed=3,
+    ...                   settings={"equilibration_time": 10.0}, progress=False)
+    >>> list(result.px.columns)
+    ['x_lo', 'x_hi', 'x', 'px', 'px_err']
+    """
+
+    restitution: Fraction
+    seed: int
+    settings: object
+    tallies: tuple = field(repr=False)
+
+    @property
+    def r(self) -> float:
+        return float(self.restitution)
+
+    @property
+    def label(self) -> str:
+        return restitution_label(self.restitution)
+
+    @property
+    def shards(self) -> int:
+        return len(self.tallies)
+
+    @cached_property
+    def merged(self):
+        from .tallies import merge_shards
+
+        return merge_shards(self.tallies)
+
+    @property
+    def total_time(self) -> float:
+        return float(self.merged.time)
+
+    @cached_property
+    def summary(self):
+        from .histograms import position_moments_summary
+
+        return position_moments_summary(list(self.tallies), self.r)
+
+    def _scalar(self, name) -> float:
+        return float(self.summary[name].iloc[0])
+
+    collision_rate = property(lambda self: self._scalar("collision_rate"))
+    collision_rate_err = property(lambda self: self._scalar("collision_rate_err"))
+    collision_rate_controlled = property(lambda self: self._scalar("collision_rate_controlled"))
+    collision_rate_controlled_err = property(
+        lambda self: self._scalar("collision_rate_controlled_err")
+    )
+    mean_x_controlled = property(lambda self: self._scalar("mean_x_controlled"))
+    mean_x_controlled_err = property(lambda self: self._scalar("mean_x_controlled_err"))
+    delta_x_controlled = property(lambda self: self._scalar("delta_x_controlled"))
+    delta_x_controlled_err = property(lambda self: self._scalar("delta_x_controlled_err"))
+    mean_flight_time_controlled = property(lambda self: self._scalar("mean_flight_time_controlled"))
+    mean_flight_time_controlled_err = property(
+        lambda self: self._scalar("mean_flight_time_controlled_err")
+    )
+    flight_time_second_moment_controlled = property(
+        lambda self: self._scalar("flight_time_second_moment_controlled")
+    )
+    flight_time_second_moment_controlled_err = property(
+        lambda self: self._scalar("flight_time_second_moment_controlled_err")
+    )
+    mean_x = property(lambda self: self._scalar("mean_x"))
+    mean_x_err = property(lambda self: self._scalar("mean_x_err"))
+    delta_x = property(lambda self: self._scalar("delta_x"))
+    delta_x_err = property(lambda self: self._scalar("delta_x_err"))
+    mean_flight_time = property(lambda self: self._scalar("mean_flight_time"))
+    mean_flight_time_err = property(lambda self: self._scalar("mean_flight_time_err"))
+    flight_time_second_moment = property(lambda self: self._scalar("flight_time_second_moment"))
+    flight_time_second_moment_err = property(
+        lambda self: self._scalar("flight_time_second_moment_err")
+    )
+
+    @cached_property
+    def p0v(self):
+        from .histograms import outgoing_speed_histogram
+
+        return outgoing_speed_histogram(list(self.tallies))
+
+    @cached_property
+    def position(self):
+        from .histograms import position_histogram
+
+        return position_histogram(list(self.tallies))
+
+    @property
+    def px(self):
+        return self.position[["x_lo", "x_hi", "x", "px", "px_err"]]
+
+    @property
+    def v2_given_x(self):
+        return self.position[["x_lo", "x_hi", "x", "v2_given_x", "v2_given_x_err"]]
+
+    @cached_property
+    def pxv(self):
+        from .histograms import distribution_histogram
+
+        return distribution_histogram(list(self.tallies))
+
+    @cached_property
+    def flight_time_density(self):
+        from .histograms import flight_time_histogram
+
+        return flight_time_histogram(list(self.tallies))
+
+    @cached_property
+    def return_speed(self):
+        from .histograms import return_speed_table
+
+        return return_speed_table(list(self.tallies))
+
+    def batch_frame(self):
+        """The shards as one table in the workflow's batch format (``batches.batch_to_frame``;
+        ``results/simulation/r{r}/shards{first}-{last}.parquet``)."""
+        from .workflow.batches import batch_to_frame
+
+        return batch_to_frame(dict(enumerate(self.tallies)))
+
+    def __repr__(self):
+        row = self.summary.iloc[0]
+
+        def shown(name, symbol):
+            return f"{symbol} = {row[name]:.6g} +- {row[name + '_err']:.2g}"
+
+        return (
+            f"SimulationResult(r={self.restitution}, shards={self.shards}, seed={self.seed}, "
+            f"total time {row.total_time:.6g}, {int(row.collisions)} collisions, "
+            f"{int(row.steps)} steps): "
+            + ", ".join(
+                shown(name, symbol)
+                for name, symbol in (
+                    ("collision_rate", "I"),
+                    ("mean_x", "<x>"),
+                    ("delta_x", "Delta x"),
+                    ("mean_flight_time", "<T>"),
+                    ("flight_time_second_moment", "<T^2>"),
+                )
+            )
+            + (
+                f"; {int(row.shards_out_of_budget)} shards stopped early (max_steps)"
+                if row.shards_out_of_budget
+                else ""
+            )
+        )

@@ -1,0 +1,328 @@
+"""The coefficient of restitution r, eq. (restitution): parsing and labels.
+
+Config gives r as a decimal (0.25) or an exact fraction string ("1/3").  The
+exact value is kept as a ``Fraction`` (a decimal is read as written, so
+0.3 is 3/10).  Output paths use a canonical label: the value with 6
+significant digits, trailing zeros dropped ("0.25", "0.333333").
+"""
+
+from fractions import Fraction
+
+__all__ = [
+    "EXACT_RESTITUTIONS",
+    "SOLVER_RESTITUTION_RANGE",
+    "DISTRIBUTION_RESTITUTION_RANGE",
+    "in_range",
+    "parse_restitution",
+    "check_solver_restitution",
+    "restitution_value",
+    "restitution_label",
+    "restitution_grid",
+    "shared_label_message",
+    "exact_string",
+]
+
+#: The r with an exact solution, eq. (P(0,v)) (bouncing_ball.exact).
+EXACT_RESTITUTIONS = (Fraction(1, 2), Fraction(1, 3))
+
+#: The r for which the solver of eq. (inteq) (bouncing_ball.solver) meets its 1e-8 accuracy
+#: target: below 0.02 P(0, v) ~ exp(-v / (2r)) leaves the range of doubles within the speeds that
+#: matter (the answer is wrong by 2% at 0.015, by 50% at 0.01); above 0.9999 the dense grid,
+#: ~ (1 - r)^(-1/2) nodes, outgrows a job.  The bounds are exact decimals: 0.02 is 1/50.
+SOLVER_RESTITUTION_RANGE = (0.02, 0.9999)
+#: The r for which the whole distribution from P(0, v) (bouncing_ball.distribution: w(F), P(x),
+#: P(x, v)) meets the same target, and so every table of rule solve: the r of a run.  Above, int
+#: P dx drifts from 1 (by 5e-8 at r = 0.93, 3e-6 at 0.95, 1e-4 at 0.99): the weight of P(x)
+#: moves to forces F where w(F) is not computed accurately.
+DISTRIBUTION_RESTITUTION_RANGE = (0.02, 0.9)
+
+
+def in_range(exact, bounds) -> bool:
+    """Whether an exact r lies in a range whose bounds are decimals read as written.
+
+    ``low <= exact <= high`` in exact arithmetic (so that r = 1/50 is inside a range that
+    starts at 0.02, whose float is a little above 1/50).
+
+    Parameters
+    ----------
+    exact : fractions.Fraction or int
+        The exact r.
+    bounds : tuple of float
+        (low, high), such as ``SOLVER_RESTITUTION_RANGE``; each read as its decimal string.
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> from fractions import Fraction
+    >>> from bouncing_ball.restitution import in_range
+    >>> print(in_range(Fraction(1, 50), (0.02, 0.9)), Fraction(0.02) > Fraction(1, 50))
+    True True
+    >>> in_range(Fraction(91, 100), (0.02, 0.9))
+    False
+    """
+    low, high = (Fraction(str(bound)) for bound in bounds)
+    return low <= Fraction(exact) <= high
+
+
+def parse_restitution(value, where: str = "restitution") -> Fraction:
+    """The exact value of r, eq. (restitution), from a config entry or a label.
+
+    A decimal is read as written (0.3 is 3/10, not the binary float nearest 0.3).
+
+    Parameters
+    ----------
+    value : float, int, str or fractions.Fraction
+        r as a decimal (0.25), a fraction string ("1/3") or a ``Fraction``.
+    where : str, optional
+        What ``value`` is (a config key, an argument), named in errors.
+
+    Returns
+    -------
+    fractions.Fraction
+        r, 0 < r < 1.
+
+    Raises
+    ------
+    ValueError
+        If ``value`` is not a number, not in (0, 1), or has a label (``restitution_label``)
+        outside (0, 1); the message names ``where``.
+
+    Examples
+    --------
+    >>> from bouncing_ball.restitution import parse_restitution
+    >>> parse_restitution(0.3), parse_restitution("1/3")
+    (Fraction(3, 10), Fraction(1, 3))
+    >>> parse_restitution(1.5, "r")
+    Traceback (most recent call last):
+    ...
+    ValueError: r: r = 1.5 is outside the allowed range 0 < r < 1
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, float, str, Fraction)):
+        raise ValueError(
+            f'{where}: {value!r} is not a number; give a decimal such as 0.25 or a fraction such as "1/3"'
+        )
+    try:
+        exact = Fraction(str(value).strip()) if not isinstance(value, Fraction) else value
+    except ZeroDivisionError:
+        raise ValueError(f"{where}: {value!r} divides by zero; r must lie in (0, 1)") from None
+    except ValueError:
+        raise ValueError(
+            f'{where}: {value!r} is not a number; give a decimal such as 0.25 or a fraction such as "1/3"'
+        ) from None
+    if not 0 < exact < 1:
+        raise ValueError(f"{where}: r = {value!r} is outside the allowed range 0 < r < 1")
+    label = restitution_label(exact)
+    if not 0 < float(label) < 1:
+        raise ValueError(
+            f"{where}: r = {value!r} rounds to {label} at the 6 significant digits of the "
+            "labels its outputs are filed under, which is not an r in (0, 1); give an r whose "
+            + ("label stays below 1 (at most 0.9999994)" if exact > 0.5 else "label is not 0")
+        )
+    return exact
+
+
+def check_solver_restitution(value, where: str = "restitution") -> Fraction:
+    """r parsed (``parse_restitution``), if rule solve answers it to its accuracy target.
+
+    The target is met for P(0, v) and the whole distribution in
+    ``DISTRIBUTION_RESTITUTION_RANGE``.
+
+    Parameters
+    ----------
+    value : float, int, str or fractions.Fraction
+        r as a decimal, a fraction string or a ``Fraction``.
+    where : str, optional
+        What ``value`` is, named in errors.
+
+    Returns
+    -------
+    fractions.Fraction
+        r.
+
+    Raises
+    ------
+    ValueError
+        If ``value`` is not an r (``parse_restitution``) or is outside
+        ``DISTRIBUTION_RESTITUTION_RANGE``; the message names ``where`` and the range.
+
+    Examples
+    --------
+    >>> from bouncing_ball.restitution import check_solver_restitution
+    >>> check_solver_restitution("1/2")
+    Fraction(1, 2)
+    >>> check_solver_restitution(0.001, "r")
+    Traceback (most recent call last):
+    ...
+    ValueError: r: r = 0.001 is outside the solver's range ...
+    """
+    exact = parse_restitution(value, where)
+    low, high = DISTRIBUTION_RESTITUTION_RANGE
+    if not in_range(exact, DISTRIBUTION_RESTITUTION_RANGE):
+        solver_low, solver_high = SOLVER_RESTITUTION_RANGE
+        raise ValueError(
+            f"{where}: r = {value!r} is outside the solver's range {low} <= r <= {high}, "
+            "where its P(0, v), P(x) and P(x, v) meet the 1e-8 accuracy target "
+            f"(P(0, v) alone, solver.restitution_grid: {solver_low} <= r <= {solver_high}; "
+            "docs/distribution.md#where-it-degrades)"
+        )
+    return exact
+
+
+def restitution_value(value, where: str = "restitution") -> float:
+    """r as a float, read as the pipeline reads it (``parse_restitution``).
+
+    The library's public entry points take r so.
+
+    Parameters
+    ----------
+    value : float, int, str or fractions.Fraction
+        r as a decimal, a fraction string ("1/3") or a ``Fraction``.
+    where : str, optional
+        What ``value`` is, named in errors.
+
+    Returns
+    -------
+    float
+        r, 0 < r < 1.
+
+    Raises
+    ------
+    ValueError
+        As ``parse_restitution``.
+
+    Examples
+    --------
+    >>> from bouncing_ball.restitution import restitution_value
+    >>> restitution_value("1/4")
+    0.25
+    """
+    return float(parse_restitution(value, where))
+
+
+def restitution_label(value) -> str:
+    """The canonical label of r that outputs are filed under.
+
+    Parameters
+    ----------
+    value : float or fractions.Fraction
+        r.
+
+    Returns
+    -------
+    str
+        r to 6 significant digits, trailing zeros dropped.
+
+    Examples
+    --------
+    >>> from fractions import Fraction
+    >>> from bouncing_ball.restitution import restitution_label
+    >>> restitution_label(Fraction(1, 3)), restitution_label(0.250)
+    ('0.333333', '0.25')
+    """
+    return f"{float(value):.6g}"
+
+
+def restitution_grid(values, where: str = "restitution") -> dict[str, Fraction]:
+    """Parse the config list of r values into {label: exact value}.
+
+    Refuses an empty list and repeated values (also 0.5 together with "1/2",
+    or two values that share a label).
+
+    Parameters
+    ----------
+    values : list or tuple
+        The r, each as ``parse_restitution`` takes it.
+    where : str, optional
+        The config key of the list, named in errors (with the index of the entry).
+
+    Returns
+    -------
+    dict of str to fractions.Fraction
+        Each r's label (``restitution_label``) and exact value, in the order given.
+
+    Raises
+    ------
+    ValueError
+        If the list is empty or not a list, an entry is not an r, or two entries are equal
+        or share a label.
+
+    Examples
+    --------
+    >>> from bouncing_ball.restitution import restitution_grid
+    >>> restitution_grid([0.25, "1/3"])
+    {'0.25': Fraction(1, 4), '0.333333': Fraction(1, 3)}
+    >>> restitution_grid([0.5, "1/2"], "r")
+    Traceback (most recent call last):
+    ...
+    ValueError: r[1]: r = '1/2' repeats r = 1/2 (label 0.5); each r may appear once
+    """
+    if not isinstance(values, (list, tuple)) or len(values) == 0:
+        raise ValueError(f"{where}: give a non-empty list of r values in (0, 1), got {values!r}")
+    grid: dict[str, Fraction] = {}
+    for index, value in enumerate(values):
+        exact = parse_restitution(value, f"{where}[{index}]")
+        label = restitution_label(exact)
+        if label in grid and grid[label] == exact:
+            raise ValueError(
+                f"{where}[{index}]: r = {value!r} repeats r = {grid[label]} (label {label}); "
+                "each r may appear once"
+            )
+        if label in grid:
+            raise ValueError(shared_label_message(f"{where}[{index}]", exact, grid[label]))
+        grid[label] = exact
+    return grid
+
+
+def shared_label_message(where: str, value: Fraction, other: Fraction) -> str:
+    """Why two different r cannot both be asked for: their outputs would share a folder.
+
+    Parameters
+    ----------
+    where : str
+        The config entry that asks for ``value``.
+    value, other : fractions.Fraction
+        Two different r with the same label (``restitution_label``).
+
+    Returns
+    -------
+    str
+        The error message.
+
+    Examples
+    --------
+    >>> from fractions import Fraction
+    >>> from bouncing_ball.restitution import shared_label_message
+    >>> print(shared_label_message("r[1]", Fraction(1, 3), Fraction(333333, 1000000)))
+    r[1]: r = 1/3 and r = 333333/1000000 share the label 0.333333 (6 significant digits)
+    under which outputs are filed; keep one of them
+    """
+    return (
+        f"{where}: r = {value} and r = {other} share the label {restitution_label(value)} "
+        "(6 significant digits) under which outputs are filed; keep one of them"
+    )
+
+
+def exact_string(value: Fraction) -> str:
+    """The exact value as a string that ``parse_restitution`` reads back.
+
+    Parameters
+    ----------
+    value : fractions.Fraction
+        r.
+
+    Returns
+    -------
+    str
+        "p/q" ("1/3", "1/4").
+
+    Examples
+    --------
+    >>> from fractions import Fraction
+    >>> from bouncing_ball.restitution import exact_string, parse_restitution
+    >>> exact_string(Fraction(1, 3)), parse_restitution(exact_string(Fraction(1, 3)))
+    ('1/3', Fraction(1, 3))
+    """
+    return str(value)

@@ -1,0 +1,994 @@
+"""Monte Carlo simulation of the inelastically bouncing ball (the paper's Sec. IV).
+
+The particle moves by the exact free-flight update, eqs. (xstep), (vstep),
+with step Delta = D(x, v) + delta: D is the largest step allowed by
+eq. (criterion) and delta a minimum step, reset after every collision so
+that sqrt(2 delta) = v_out / min_step_divisor (the paper uses 500).
+
+Where a collision happens.  When a step ends below x = 0, the collision is
+placed where the bridge mean path (the cubic Hermite interpolant of the two
+ends of the step, see ``free_flight``) first reaches x = 0, and the impact
+speed is that path's slope there.  The rest of the step is discarded, the
+particle restarts from x = 0 with v_out = r v_in, eq. (restitution), and
+the clock advances only to the collision.  Taking the end-of-step velocity
+instead adds the whole step's noise sqrt(2 Delta) >= sqrt(2 delta) to the
+impact speed, which biases P(0, v) upward at speeds comparable to it; the
+interpolated crossing does not.
+
+What a shard records after its equilibration time (integrals over each step
+given both its ends, not left-point sums, which are biased because Delta
+depends on the state):
+
+  * outgoing speeds at collisions, on log bins;
+  * the time, collisions and steps (all after equilibration);
+  * int x dt and int x^2 dt, exact in expectation given the ends (mean path
+    plus bridge variance);
+  * one point of each recorded step's bridge: a time s uniform in [0, tau] and
+    (x(s), v(s)) from the bridge's exact conditional Gaussian given both ends
+    (``free_flight.bridge_sample``), drawn from their own generator
+    (``tally_seed_sequence``), so the trajectory and the tallies that do not use
+    the point are those of a shard without it.  A step from the floor draws two,
+    one in each stratum [0, t_low], [t_low, tau] of ``floor_stratum_end``, each
+    weighing its stratum's length (the weights add up to tau).
+  * the time spent in each cell of (x, v), x on the position bins and v on
+    evenly spaced bins, for P(x, v): the point's weight (tau, or its stratum's
+    length) added to the cell of (x(s), v(s)).  Given the ends, the expectation
+    of what is added to a cell is the expected time in the cell,
+    int Prob[(x(s), v(s)) in cell | ends] ds over the step: unbiased, with no
+    discretisation error.
+  * the time spent in each log bin of x, and int v^2 dt in each bin, which give
+    P(x) and <v^2>_x of eq. (moment2), exact in expectation (but in the steps
+    cut by a collision, below), with nearly the errors of the mean path's
+    integrals alone.  A step's time is first assigned along its
+    mean path, each bin edge crossed at a time estimated by one Halley step
+    (``free_flight.level_time_one_step``), and int v^2 dt integrates E[v^2 |
+    ends] (slope squared plus bridge variance of v).  That assignment alone is
+    biased: it ignores the bridge's spread sigma_x ~ (Delta^3 / 96)^(1/2) about
+    the mean path, which moves about (sigma_x^2 / 2) P''/P of a bin's time,
+    up to 1e-3 where steps are long (measured at r = 0.75: 5-7 sigma of the
+    default run); and a crossing estimate that is off moves time between
+    neighbouring bins.  The bridge correction removes both in expectation: the
+    assignment gives the time s to some bin k_s, the bridge point x(s) lies in
+    bin k_x; when they differ, tau moves from bin k_s to bin k_x, and tau V
+    with it in int v^2 dt, V = E[v(s)^2 | x(s), ends]
+    (``free_flight.bridge_speed_squared_given_position``, whose mean over x(s)
+    is the integrand of the assignment).  In expectation this adds the bridge
+    law's time in each bin minus the assignment's, whatever the assignment, so
+    the sum is exact; it changes nothing when k_s = k_x (most steps), and it
+    raises the errors of P(x) by 1-3 % and those of <v^2>_x by 5-12 % (medians
+    over the bins of the default run; docs/methods.md).
+    A step cut by a collision is left on its mean path, as its collision is
+    (crossings by ``free_flight.level_time``, no correction): past the mean
+    path's zero the free bridge is not the ball's path, and one point of such
+    a step, long and fast near the floor, could move a whole step's tau V into
+    a small bin (heavy-tailed noise for no gain in exactness).
+  * the flights: for each recorded collision that has an earlier collision
+    (in the recording or in equilibration), the time T since that collision
+    (its count on log bins, sum T, sum T^2), and the pair (outgoing speed u
+    of that earlier collision, return speed abs(v) at this one) on the speed
+    bins.  A flight is counted at the collision that ends it, so in a
+    stationary shard the expected sum of f(T) over the recorded flights is
+    I x (recorded time) x E[f(T)] with E the equilibrium average per
+    collision (Palm): unbiased, with no edge effect at either end of the
+    recording (docs/methods.md, 'Flights').
+  * control variates: sums over the recorded steps of the velocity noise
+    xi = sqrt(2 dt) normal_r of eq. (vstep) (noise_sum), of v xi (noise_v_sum),
+    of v xi / (x + v^2/2 + 4 dt) (noise_scaled_sum) and of normal_r
+    (normal_sum), x, v and dt those of the step's start.  dt is fixed before
+    the normals are drawn, so each term has mean 0 given the past, and each sum
+    has expectation exactly 0 under the simulated process (whole xi also in a
+    step cut short by a collision).  Fourteen more (``tallies.MOMENT_CONTROL_SUMS``)
+    weigh xi by x, x v, x^2, v^2, v^3, v^4 and x v^2, xi^2 - 2 dt by 1, v, x and
+    v^2, and the position noise dt^(3/2) normal_s of eq. (xstep) by 1, v and x,
+    the same way.  ``histograms.control_variate_adjusted`` subtracts their
+    fitted share from the tallies: the same expectation, less variance of I,
+    the moments of x and of the flights, and the bins of P(0, v), P(x) and
+    <v^2>_x (docs/methods.md).
+  * the time, collisions, int x dt and int x^2 dt of the steps that start in the
+    early part of the recording (t < EARLY_FRACTION x shard_time, tallies): the
+    shard's own evidence of equilibration, that part against the rest compared by
+    ``equilibration``.  Taken as the running sums when the first step starts past
+    it, so no step is cut there.
+
+A shard's work is bounded: it stops after ``max_steps`` steps (equilibration
+included) even if the simulated time has not been reached, and says so.
+
+Below r_c = exp(-pi / sqrt 3) (inelastic collapse).  The collision rate I
+of eq. (collrate) is infinite there: each collision shrinks the outgoing
+speed by a random factor whose mean logarithm is negative, the speeds go
+to zero geometrically, and infinitely many collisions happen in a finite
+time.  With the paper's rule alone, delta shrinks with v_out and the
+simulation follows the collapse until the step budget runs out or the step falls below
+COLLAPSED_STEP (speeds ~ 1e-37; the shard then stops and says so, as for
+an exhausted budget);
+simulated time stops advancing.  A floor on the minimum step, delta >= min_step_floor,
+is the regularisation: it takes over from the 1/500 rule once v_out
+falls below about min_step_divisor * (2 min_step_floor)^(1/2), and once
+v_out falls below about (2 min_step_floor)^(1/2) a single step's noise
+exceeds the speed and lifts the particle off the floor: the collapse is
+cut off at speeds of order (2 min_step_floor)^(1/2).
+What the regularised process gives above that speed scale, and how I grows
+as the floor goes to zero, is measured, not assumed (docs/methods.md, 'Below r_c').
+
+The loop is numba-compiled: a shard compiles it on its first call (a minute), so the Examples
+that run a shard are not run as doctests; the unit and statistical tests run shards.
+"""
+
+import math
+
+import numpy as np
+
+from .free_flight import (
+    bridge_sample,
+    bridge_speed_squared_given_position,
+    criterion_root,
+    cubic_slope,
+    cubic_value,
+    first_crossing_time,
+    free_flight_step,
+    hermite_cubic,
+    level_time,
+    level_time_one_step,
+    mean_path_integrals,
+    monotone_piece_end,
+    piece_inverse,
+    predicted_start,
+    quintic_antiderivative_value,
+    root_predictor,
+    slope_zeros,
+    speed_squared_coefficients,
+    whole_step_integrals,
+)
+from .jit import njit
+from .pcg64 import next_double, standard_normal, stream_words
+from .settings import ShardSettings
+from .tallies import EARLY_FRACTION, SCALAR_INDEX, ShardTallies, tally_seed_sequence
+
+__all__ = [
+    "MEAN_PATH_INTEGRALS",
+    "POSITION",
+    "JOINT",
+    "FLIGHTS",
+    "CONTROL_VARIATES",
+    "EVERY_TALLY",
+    "FLOOR_STRATUM_HEIGHT",
+    "floor_stratum_end",
+    "shard_seed_sequence",
+    "simulate_shard",
+]
+
+# indices into the scalar tally array of the compiled loop (its layout: tallies.SCALARS)
+_TIME = SCALAR_INDEX["time"]
+_COLLISIONS = SCALAR_INDEX["collisions"]
+_STEPS = SCALAR_INDEX["steps"]
+_INT_X = SCALAR_INDEX["int_x"]
+_INT_X2 = SCALAR_INDEX["int_x2"]
+_EXHAUSTED = SCALAR_INDEX["budget_exhausted"]
+_FLIGHTS = SCALAR_INDEX["flights"]
+_FLIGHT_TIME_SUM = SCALAR_INDEX["flight_time_sum"]
+_FLIGHT_TIME_SQUARED_SUM = SCALAR_INDEX["flight_time_squared_sum"]
+_NOISE_SUM = SCALAR_INDEX["noise_sum"]
+_NOISE_V_SUM = SCALAR_INDEX["noise_v_sum"]
+_NOISE_SCALED_SUM = SCALAR_INDEX["noise_scaled_sum"]
+_NORMAL_SUM = SCALAR_INDEX["normal_sum"]
+_EARLY_TIME = SCALAR_INDEX["early_time"]
+_EARLY_COLLISIONS = SCALAR_INDEX["early_collisions"]
+_EARLY_INT_X = SCALAR_INDEX["early_int_x"]
+_EARLY_INT_X2 = SCALAR_INDEX["early_int_x2"]
+_NOISE_X_SUM = SCALAR_INDEX["noise_x_sum"]
+_NOISE_XV_SUM = SCALAR_INDEX["noise_xv_sum"]
+_NOISE_X2_SUM = SCALAR_INDEX["noise_x2_sum"]
+_NOISE_V2_SUM = SCALAR_INDEX["noise_v2_sum"]
+_NOISE_V3_SUM = SCALAR_INDEX["noise_v3_sum"]
+_NOISE_V4_SUM = SCALAR_INDEX["noise_v4_sum"]
+_NOISE_XV2_SUM = SCALAR_INDEX["noise_xv2_sum"]
+_NOISE_SQUARED_SUM = SCALAR_INDEX["noise_squared_sum"]
+_NOISE_SQUARED_V_SUM = SCALAR_INDEX["noise_squared_v_sum"]
+_NOISE_SQUARED_X_SUM = SCALAR_INDEX["noise_squared_x_sum"]
+_NOISE_SQUARED_V2_SUM = SCALAR_INDEX["noise_squared_v2_sum"]
+_POSITION_NOISE_SUM = SCALAR_INDEX["position_noise_sum"]
+_POSITION_NOISE_V_SUM = SCALAR_INDEX["position_noise_v_sum"]
+_POSITION_NOISE_X_SUM = SCALAR_INDEX["position_noise_x_sum"]
+
+
+def shard_seed_sequence(seed: int, label: str, shard: int) -> np.random.SeedSequence:
+    """The random stream of one (r, shard): independent of job order and cores.
+
+    The r label (see ``restitution.restitution_label``) enters the spawn key as the integer
+    spelled by its ASCII bytes, so different r never share a stream.
+
+    Parameters
+    ----------
+    seed : int
+        The run's seed (the config's ``seed``), >= 0.
+    label : str
+        r as the pipeline names it (``restitution.restitution_label``), ASCII.
+    shard : int
+        The shard's index, >= 0.
+
+    Returns
+    -------
+    numpy.random.SeedSequence
+        The shard's stream: entropy ``seed``, spawn key (the label's integer, ``shard``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bouncing_ball.simulation import shard_seed_sequence
+    >>> stream = shard_seed_sequence(1, "0.5", 3)
+    >>> print(stream.spawn_key, int.from_bytes(b"0.5", "big"))
+    (3157557, 3) 3157557
+    >>> again = shard_seed_sequence(1, "0.5", 3).generate_state(4)
+    >>> print(np.array_equal(stream.generate_state(4), again))
+    True
+    >>> other_shard = shard_seed_sequence(1, "0.5", 4).generate_state(4)
+    >>> print(np.array_equal(again, other_shard))
+    False
+    """
+    r_key = int.from_bytes(label.encode("ascii"), "big")
+    return np.random.SeedSequence(entropy=seed, spawn_key=(r_key, shard))
+
+
+@njit(cache=True)
+def _bin_index(value, log_lo, per_ln, n, edges):
+    """Index of ``value`` in LogBins (0 underflow, n + 1 overflow)."""
+    if value < edges[0]:
+        return 0
+    if value >= edges[n]:
+        return n + 1
+    k = int((math.log(value) - log_lo) * per_ln)
+    if k < 0:
+        k = 0
+    if k > n - 1:
+        k = n - 1
+    # correct a last-digit disagreement between log and the stored edges
+    while k > 0 and value < edges[k]:
+        k -= 1
+    while k < n - 1 and value >= edges[k + 1]:
+        k += 1
+    return k + 1
+
+
+@njit(cache=True)
+def _linear_bin_index(value, lo, per_unit, n, edges):
+    """Index of ``value`` in LinearBins (0 underflow, n + 1 overflow)."""
+    if value < edges[0]:
+        return 0
+    if value >= edges[n]:
+        return n + 1
+    k = int((value - lo) * per_unit)
+    if k < 0:
+        k = 0
+    if k > n - 1:
+        k = n - 1
+    while k > 0 and value < edges[k]:
+        k -= 1
+    while k < n - 1 and value >= edges[k + 1]:
+        k += 1
+    return k + 1
+
+
+@njit(cache=True, inline="always")
+def _walked_bin_index(value, k, bin_lower, bin_upper):
+    """Index of ``value`` in the x bins, walking from bin ``k`` (no logarithm): the same bin
+    as ``_bin_index``, whose answer the edges decide too.  ``bin_lower`` and ``bin_upper``
+    are the ends of each bin, -inf and inf those of the under- and overflow bins, so the
+    walk stops for a finite value (a NaN stays in bin ``k``; +inf, which a finite step
+    cannot draw, would walk off the end)."""
+    while value < bin_lower[k]:
+        k -= 1
+    while value >= bin_upper[k]:
+        k += 1
+    return k
+
+
+@njit(cache=True, inline="always")
+def _tally_position(
+    a,
+    sq,
+    t_a,
+    t_b,
+    x_a,
+    x_b,
+    d_a,
+    d_b,
+    k,
+    s,
+    k_s,
+    s_second,
+    k_second,
+    exact_crossings,
+    edges,
+    time_in,
+    v2_in,
+):
+    """Add the time and int v^2 dt of the monotone piece [t_a, t_b] of the mean path to the
+    x bins, each edge crossing placed by ``level_time_one_step`` (no iteration), or by
+    ``level_time`` (to ~1e-9 of the piece) where ``exact_crossings`` (a step cut by a
+    collision, which the bridge correction leaves alone).
+
+    ``a`` are the mean path's coefficients, ``sq`` those of S(t) (see
+    ``speed_squared_coefficients``), x_a, x_b and d_a, d_b the path and its slope at the
+    piece's ends and ``k`` the bin of x_a.  The walk crosses one bin edge at a time (no
+    logarithms); each crossing's estimate is clipped to [previous crossing, t_b], so the
+    piece is cut into consecutive intervals, one per bin.  Returns the bin of x_b and the
+    bins of the intervals holding the times ``s`` and ``s_second`` (``k_s``, ``k_second`` if
+    before the piece).
+    """
+    a0, a1, a2, a3 = a
+    s1, s2, s3, s4, s5 = sq
+    n = edges.shape[0] - 1
+    t_prev = t_a
+    s_prev = quintic_antiderivative_value(s1, s2, s3, s4, s5, t_a)
+    inverse = piece_inverse(t_a, t_b, x_a, x_b, d_a, d_b)
+    while True:
+        if k <= n and x_b >= edges[k]:  # leaves bin k through its upper edge
+            level = edges[k]
+            k_next = k + 1
+        elif k >= 1 and x_b < edges[k - 1]:  # through its lower edge
+            level = edges[k - 1]
+            k_next = k - 1
+        else:
+            break
+        if exact_crossings:
+            t_e = level_time(a0, a1, a2, a3, level, inverse)
+        else:  # clipped to [t_prev, t_b]; max and min keep their first argument against a NaN
+            t_e = min(t_b, max(t_prev, level_time_one_step(a0, a1, a2, a3, level, inverse)))
+        s_e = quintic_antiderivative_value(s1, s2, s3, s4, s5, t_e)
+        time_in[k] += t_e - t_prev
+        v2_in[k] += s_e - s_prev
+        k_s = k if s >= t_prev else k_s
+        k_second = k if s_second >= t_prev else k_second
+        t_prev, s_prev = t_e, s_e
+        k = k_next
+    s_b = quintic_antiderivative_value(s1, s2, s3, s4, s5, t_b)
+    time_in[k] += t_b - t_prev
+    v2_in[k] += s_b - s_prev
+    k_s = k if s >= t_prev else k_s
+    k_second = k if s_second >= t_prev else k_second
+    return k, k_s, k_second
+
+
+@njit(cache=True, inline="always")
+def _tally_step(
+    a,
+    dt,
+    tau,
+    x_tau,
+    slope_tau,
+    k,
+    s,
+    s_second,
+    exact_crossings,
+    edges,
+    bin_lower,
+    bin_upper,
+    time_in,
+    v2_in,
+):
+    """Add the time and int v^2 dt over [0, tau] of the step's piecewise assignment (the
+    mean path, its edge crossings estimated) to the x bins.
+
+    ``k`` is the bin of m(0); returns the bin of m(tau) = x_tau, where the slope is
+    slope_tau, and the bins the assignment gives the times ``s`` and ``s_second``. The
+    common case is a step that stays in its bin: the cubic on [0, tau] lies inside the hull
+    of its Bernstein control points m(0), m(0) + m'(0) tau/3, m(tau) - m'(tau) tau/3,
+    m(tau), so when those all lie in bin k the whole step is tallied there at once.
+    Otherwise the path is split at the zeros of m' into monotone pieces (none when the
+    control points of m' share a sign), which are walked edge by edge.
+    """
+    a0, a1, a2, a3 = a
+    sq = speed_squared_coefficients(a1, a2, a3, dt)
+    c1 = a0 + a1 * tau * (1.0 / 3.0)
+    c2 = x_tau - slope_tau * tau * (1.0 / 3.0)
+    lowest = min(min(a0, x_tau), min(c1, c2))
+    highest = max(max(a0, x_tau), max(c1, c2))
+    if bin_lower[k] <= lowest and highest < bin_upper[k]:
+        time_in[k] += tau
+        v2_in[k] += quintic_antiderivative_value(sq[0], sq[1], sq[2], sq[3], sq[4], tau)
+        return k, k, k
+    # m' is a quadratic with Bernstein control points m'(0), m'(0) + a2 tau,
+    # m'(tau): when they share a sign, m is monotone and needs no split
+    slope_mid = a1 + a2 * tau
+    if (a1 > 0.0 and slope_mid > 0.0 and slope_tau > 0.0) or (
+        a1 < 0.0 and slope_mid < 0.0 and slope_tau < 0.0
+    ):
+        n_zero, t1, t2 = 0, tau, tau
+    else:
+        n_zero, t1, t2 = slope_zeros(a1, a2, a3, tau)
+    t_a = 0.0
+    x_a = a0
+    d_a = a1
+    k_s = k_second = k
+    for piece in range(n_zero + 1):
+        t_b = monotone_piece_end(piece, n_zero, t1, t2, tau)
+        if t_b == tau:
+            x_b, d_b = x_tau, slope_tau
+        else:  # a zero of m'
+            x_b, d_b = cubic_value(a0, a1, a2, a3, t_b), 0.0
+        k, k_s, k_second = _tally_position(
+            a,
+            sq,
+            t_a,
+            t_b,
+            x_a,
+            x_b,
+            d_a,
+            d_b,
+            k,
+            s,
+            k_s,
+            s_second,
+            k_second,
+            exact_crossings,
+            edges,
+            time_in,
+            v2_in,
+        )
+        t_a, x_a, d_a = t_b, x_b, d_b
+    return k, k_s, k_second
+
+
+@njit(cache=True, inline="always")
+def _bridge_correction(a1, a2, a3, dt, weight, s, normal_1, k_s, k_x, time_in, v2_in):
+    """The bridge correction of a step's P(x) and <v^2>_x (module docstring): the assignment
+    gave the time s to bin k_s, the bridge point x(s) (drawn with ``normal_1``) is in bin
+    k_x; the point's ``weight`` (the length of the interval s is uniform in: tau, or a
+    stratum of ``floor_stratum_end``) moves from k_s to k_x, and weight E[v(s)^2 | x(s),
+    ends] with it in int v^2 dt.  Called where k_x != k_s, in steps not cut by a
+    collision."""
+    v2_s = weight * bridge_speed_squared_given_position(a1, a2, a3, dt, s, normal_1)
+    time_in[k_x] += weight
+    time_in[k_s] -= weight
+    v2_in[k_x] += v2_s
+    v2_in[k_s] -= v2_s
+
+
+#: A step that starts at the floor (the outgoing step of a collision) draws a second bridge point
+#: while its mean path is still below this height, where the x bins are narrow
+#: (``floor_stratum_end``).
+FLOOR_STRATUM_HEIGHT = 0.1
+
+
+@njit(cache=True, inline="always")
+def floor_stratum_end(tau, x, v):
+    """Where the bridge points of a step of length tau from (x, v) are stratified: t_low.
+
+    t_low = FLOOR_STRATUM_HEIGHT / v in a step that starts at the floor (x = 0, v = v_out) with
+    v tau > FLOOR_STRATUM_HEIGHT, about where its mean path (v t - t^2 / 2 + ...) reaches
+    that height; else tau (one point, no strata).  With t_low < tau the step draws two
+    points, s uniform in [t_low, tau] with weight tau - t_low and s uniform in [0, t_low]
+    with weight t_low: P(x, v) and the bridge correction stay exact in expectation and the
+    weights still add up to tau.  Why: such a step is long (D ~ (v / c)^2 from the floor, up
+    to a few time units, eq. (criterion)) and crosses the narrow bins near the floor in a small
+    part of it; its one uniform point landed there rarely and then moved a whole step's tau
+    (and tau V in <v^2>_x) into one of them, a heavy tail of the shards' <v^2>_x at x < 0.003
+    (excess kurtosis 9-12 over the 64 shards of the default run at r = 1/2 and 3/4).
+
+    Parameters
+    ----------
+    tau : float
+        The step's length in time (up to a collision, if it has one).
+    x, v : float
+        The step's start.
+
+    Returns
+    -------
+    float
+        t_low: FLOOR_STRATUM_HEIGHT / v for a step from the floor that rises past that height
+        on its mean path, else tau.
+
+    Examples
+    --------
+    The Python function (``py_func``: no compile):
+
+    >>> from bouncing_ball.simulation import floor_stratum_end
+    >>> print(floor_stratum_end.py_func(2.0, 0.0, 1.0), floor_stratum_end.py_func(2.0, 0.5, 1.0))
+    0.1 2.0
+    >>> print(floor_stratum_end.py_func(0.05, 0.0, 1.0))
+    0.05
+    """
+    if x == 0.0 and v * tau > FLOOR_STRATUM_HEIGHT:
+        return FLOOR_STRATUM_HEIGHT / v
+    return tau
+
+
+# What the compiled loop records, by bit of its ``parts`` argument: the benchmark leaves
+# them out one at a time to time each (``python -m benchmarks``); a shard records them all.
+# The collisions, their outgoing speeds, the time and the steps are always recorded.
+MEAN_PATH_INTEGRALS = 1  #: Bit of ``parts``: int x dt and int x^2 dt.
+POSITION = 2  #: Bit of ``parts``: P(x) and <v^2>_x (the mean path and its bridge correction).
+JOINT = 4  #: Bit of ``parts``: P(x, v) from the bridge sample.
+FLIGHTS = 8  #: Bit of ``parts``: flight times and (outgoing, return) speed pairs.
+CONTROL_VARIATES = 16  #: Bit of ``parts``: the noise sums of the martingale control variates.
+#: Every bit of ``parts``: what a shard records.
+EVERY_TALLY = MEAN_PATH_INTEGRALS | POSITION | JOINT | FLIGHTS | CONTROL_VARIATES
+
+
+@njit(cache=True)
+def _tally_second_bridge_point(
+    tally_high,
+    tally_low,
+    tally_inc_high,
+    tally_inc_low,
+    a,
+    dt,
+    s,
+    weight,
+    k_s,
+    collided,
+    parts,
+    x_log_lo,
+    x_per_ln,
+    x_edges,
+    x_bin_lower,
+    x_bin_upper,
+    u_lo,
+    u_per_unit,
+    u_edges,
+    position_time,
+    position_v2_time,
+    position_velocity_time,
+):
+    """The second bridge point of a step from the floor (``floor_stratum_end``), at time s
+    in [0, t_low] with ``weight`` t_low, its normals drawn here from the tally stream (whose
+    new state it returns): the bridge correction (with POSITION; k_s is the bin the
+    assignment gives s) and P(x, v) (with JOINT), as the loop does for the first point."""
+    a0, a1, a2, a3 = a
+    tally_high, tally_low, normal_1 = standard_normal(
+        tally_high, tally_low, tally_inc_high, tally_inc_low
+    )
+    tally_high, tally_low, normal_2 = standard_normal(
+        tally_high, tally_low, tally_inc_high, tally_inc_low
+    )
+    x_s, v_s = bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2)
+    if parts & POSITION:
+        x_cell = _walked_bin_index(x_s, k_s, x_bin_lower, x_bin_upper)
+        if x_cell != k_s and not collided:
+            _bridge_correction(
+                a1, a2, a3, dt, weight, s, normal_1, k_s, x_cell, position_time, position_v2_time
+            )
+    else:
+        x_cell = _bin_index(x_s, x_log_lo, x_per_ln, x_edges.shape[0] - 1, x_edges)
+    if parts & JOINT:
+        cell_v = _linear_bin_index(v_s, u_lo, u_per_unit, u_edges.shape[0] - 1, u_edges)
+        position_velocity_time[x_cell, cell_v] += weight
+    return tally_high, tally_low
+
+
+# a step this short only happens in a collapse (v ~ 1e-37); much shorter ones overflow the bridge's
+# cubic coefficients (~ x / dt^2) before the speed underflows to zero
+COLLAPSED_STEP = 1.0e-80
+
+
+@njit(cache=True)
+def _run(
+    stream,
+    tally_stream,
+    restitution,
+    c,
+    min_step_divisor,
+    min_step_floor,
+    equilibration_time,
+    recorded_time,
+    max_steps,
+    v_edges,
+    x_edges,
+    u_edges,
+    f_edges,
+    speed_counts,
+    position_time,
+    position_v2_time,
+    flight_time_counts,
+    position_velocity_time,
+    return_speed_counts,
+    scalars,
+    parts,
+):
+    # v_edges: speeds (log); x_edges: heights (log); u_edges: velocities of P(x, v) (linear);
+    # f_edges: flight times (log); stream, tally_stream: the PCG64 states (pcg64.stream_words)
+    high, low, inc_high, inc_low = stream
+    tally_high, tally_low, tally_inc_high, tally_inc_low = tally_stream
+    nv = v_edges.shape[0] - 1
+    v_log_lo = math.log(v_edges[0])
+    v_per_ln = nv / (math.log(v_edges[nv]) - v_log_lo)
+    nx = x_edges.shape[0] - 1
+    x_log_lo = math.log(x_edges[0])
+    x_per_ln = nx / (math.log(x_edges[nx]) - x_log_lo)
+    nu = u_edges.shape[0] - 1
+    u_lo = u_edges[0]
+    u_per_unit = nu / (u_edges[nu] - u_lo)
+    nf = f_edges.shape[0] - 1
+    f_log_lo = math.log(f_edges[0])
+    f_per_ln = nf / (math.log(f_edges[nf]) - f_log_lo)
+    # the two ends of every x bin, the under- and overflow bins unbounded
+    x_bin_lower = np.empty(nx + 2)
+    x_bin_upper = np.empty(nx + 2)
+    x_bin_lower[0] = -np.inf
+    x_bin_lower[1:] = x_edges
+    x_bin_upper[: nx + 1] = x_edges
+    x_bin_upper[nx + 1] = np.inf
+
+    # start at rest one unit above the floor; equilibration forgets this
+    x = 1.0
+    v = 0.0
+    root, slope_at_root = criterion_root(x, v, c, 0.0)  # s* of eq. (criterion) and f'(s*)
+    x_bin = _bin_index(x, x_log_lo, x_per_ln, nx, x_edges)  # kept while recording
+    min_root_2delta = 1.0 / min_step_divisor
+    delta = max(0.5 * min_root_2delta * min_root_2delta, min_step_floor)
+    recording = equilibration_time <= 0.0
+    t = 0.0
+    t_stop = recorded_time if recording else equilibration_time
+    steps = 0  # all steps, against the budget
+    recorded_steps = 0
+    collisions = 0
+    int_x = 0.0
+    int_x2 = 0.0
+    exhausted = 0
+    flights = 0
+    flight_time_sum = 0.0
+    flight_time_squared_sum = 0.0
+    since_collision = 0.0  # time since the last collision (equilibration included)
+    collided_before = False
+    last_out_bin = 0  # speed bin of the last collision's outgoing speed
+    # the control variates (martingales of mean 0, see the module docstring)
+    noise_sum = 0.0
+    noise_v_sum = 0.0
+    noise_scaled_sum = 0.0
+    normal_sum = 0.0
+    noise_x_sum = 0.0
+    noise_xv_sum = 0.0
+    noise_x2_sum = 0.0
+    noise_v2_sum = 0.0
+    noise_v3_sum = 0.0
+    noise_v4_sum = 0.0
+    noise_xv2_sum = 0.0
+    noise_squared_sum = 0.0
+    noise_squared_v_sum = 0.0
+    noise_squared_x_sum = 0.0
+    noise_squared_v2_sum = 0.0
+    position_noise_sum = 0.0
+    position_noise_v_sum = 0.0
+    position_noise_x_sum = 0.0
+    # the early part of the recording: the running sums when a step first starts past t_early
+    t_early = EARLY_FRACTION * recorded_time if recording else math.inf
+    early_time = 0.0
+    early_collisions = 0
+    early_int_x = 0.0
+    early_int_x2 = 0.0
+
+    while True:
+        if t >= t_stop:
+            if recording:
+                break
+            recording = True
+            x_bin = _bin_index(x, x_log_lo, x_per_ln, nx, x_edges)
+            t = 0.0
+            t_stop = recorded_time
+            t_early = EARLY_FRACTION * recorded_time
+            continue
+        if t >= t_early:
+            early_time = t
+            early_collisions = collisions
+            early_int_x = int_x
+            early_int_x2 = int_x2
+            t_early = math.inf
+        if steps >= max_steps:
+            exhausted = 1
+            break
+        dt = root * root + delta  # eq. (criterion) plus delta
+        if not dt > COLLAPSED_STEP:  # below r_c without a floor on delta: the speed is going to 0
+            exhausted = 1
+            break
+        if t + dt > t_stop:
+            dt = t_stop - t
+        # the next root starts from a first-order prediction off this one
+        predictor = root_predictor(root, slope_at_root, x, v)
+        high, low, normal_r = standard_normal(high, low, inc_high, inc_low)
+        high, low, normal_s = standard_normal(high, low, inc_high, inc_low)
+        x1, v1 = free_flight_step(x, v, dt, normal_r, normal_s)
+        collided = x1 < 0.0
+        # the bridge's mean path, where something uses it (a step with no collision
+        # integrates x and x^2 from its ends alone)
+        if collided or (recording and parts & (POSITION | JOINT)):
+            a = hermite_cubic(x, v, x1, v1, dt)
+        else:
+            a = (x, v, 0.0, 0.0)  # not used
+        a0, a1, a2, a3 = a
+        if collided:  # the step ends where the mean path first reaches 0
+            tau = first_crossing_time(a0, a1, a2, a3, dt, x1)
+            x_tau = 0.0
+            v_tau = cubic_slope(a1, a2, a3, tau)
+        else:
+            tau, x_tau, v_tau = dt, x1, v1
+        steps += 1
+        if recording:
+            recorded_steps += 1
+            if parts & CONTROL_VARIATES:
+                # dt and the state were fixed before the normals were drawn: each term has mean
+                # 0 given the past, whether or not the step is then cut at a collision
+                xi = math.sqrt(2.0 * dt) * normal_r  # the velocity noise of eq. (vstep)
+                noise_sum += xi
+                noise_v_sum += v * xi
+                noise_scaled_sum += v / (x + 0.5 * v * v + 4.0 * dt) * xi
+                normal_sum += normal_r
+                # the moments' control variates: weights polynomial in the start state times
+                # xi, q = xi^2 - 2 dt (mean 0 given the past) and eta = dt^(3/2) normal_s
+                x2 = x * x
+                v2 = v * v
+                noise_x_sum += x * xi
+                noise_xv_sum += x * v * xi
+                noise_x2_sum += x2 * xi
+                noise_v2_sum += v2 * xi
+                noise_v3_sum += v2 * v * xi
+                noise_v4_sum += v2 * v2 * xi
+                noise_xv2_sum += x * v2 * xi
+                q = xi * xi - 2.0 * dt
+                noise_squared_sum += q
+                noise_squared_v_sum += v * q
+                noise_squared_x_sum += x * q
+                noise_squared_v2_sum += v2 * q
+                eta = dt * math.sqrt(dt) * normal_s
+                position_noise_sum += eta
+                position_noise_v_sum += v * eta
+                position_noise_x_sum += x * eta
+            if parts & MEAN_PATH_INTEGRALS:
+                if collided:
+                    ix, ix2 = mean_path_integrals(a0, a1, a2, a3, dt, tau)
+                else:
+                    ix, ix2 = whole_step_integrals(x, v, x1, v1, dt)
+                int_x += ix
+                int_x2 += ix2
+            if parts & (POSITION | JOINT):
+                # the step's bridge points, (x(s), v(s)), from the tally stream: P(x, v), and the
+                # bridge-law correction of P(x), <v^2>_x.  One, s uniform in [0, tau] with weight
+                # tau; two in a step from the floor, one in each stratum of floor_stratum_end
+                t_low = floor_stratum_end(tau, x, v)
+                tally_high, tally_low, u = next_double(
+                    tally_high, tally_low, tally_inc_high, tally_inc_low
+                )
+                tally_high, tally_low, normal_1 = standard_normal(
+                    tally_high, tally_low, tally_inc_high, tally_inc_low
+                )
+                tally_high, tally_low, normal_2 = standard_normal(
+                    tally_high, tally_low, tally_inc_high, tally_inc_low
+                )
+                s = u * tau
+                weight = tau
+                s2 = s
+                if t_low < tau:
+                    s = t_low + u * (tau - t_low)
+                    weight = tau - t_low
+                    tally_high, tally_low, u2 = next_double(
+                        tally_high, tally_low, tally_inc_high, tally_inc_low
+                    )
+                    s2 = u2 * t_low
+            if parts & POSITION:
+                x_bin, k_s, k_s2 = _tally_step(
+                    a,
+                    dt,
+                    tau,
+                    x_tau,
+                    v_tau,
+                    x_bin,
+                    s,
+                    s2,
+                    collided,
+                    x_edges,
+                    x_bin_lower,
+                    x_bin_upper,
+                    position_time,
+                    position_v2_time,
+                )
+            if parts & POSITION:
+                # the point itself after the walk: fewer values live across it (numba then
+                # keeps pace with the C reference)
+                x_s, v_s = bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2)
+                # the assignment gave the time s to bin k_s, the bridge puts x(s) in x_cell: the
+                # bridge correction (module docstring) makes the tally exact in expectation (not
+                # in a step cut by a collision, which keeps the mean path its collision is on)
+                x_cell = _walked_bin_index(x_s, k_s, x_bin_lower, x_bin_upper)
+                if x_cell != k_s and not collided:
+                    _bridge_correction(
+                        a1,
+                        a2,
+                        a3,
+                        dt,
+                        weight,
+                        s,
+                        normal_1,
+                        k_s,
+                        x_cell,
+                        position_time,
+                        position_v2_time,
+                    )
+            if parts & JOINT:
+                # P(x, v): the point's weight to the cell of (x(s), v(s))
+                if not parts & POSITION:
+                    x_s, v_s = bridge_sample(a0, a1, a2, a3, dt, s, normal_1, normal_2)
+                    x_cell = _bin_index(x_s, x_log_lo, x_per_ln, nx, x_edges)
+                position_velocity_time[
+                    x_cell, _linear_bin_index(v_s, u_lo, u_per_unit, nu, u_edges)
+                ] += weight
+            if parts & (POSITION | JOINT) and t_low < tau:
+                # the second point of a step from the floor, in [0, t_low] (rare: its own function)
+                tally_high, tally_low = _tally_second_bridge_point(
+                    tally_high,
+                    tally_low,
+                    tally_inc_high,
+                    tally_inc_low,
+                    a,
+                    dt,
+                    s2,
+                    t_low,
+                    k_s2,
+                    collided,
+                    parts,
+                    x_log_lo,
+                    x_per_ln,
+                    x_edges,
+                    x_bin_lower,
+                    x_bin_upper,
+                    u_lo,
+                    u_per_unit,
+                    u_edges,
+                    position_time,
+                    position_v2_time,
+                    position_velocity_time,
+                )
+        t += tau
+        since_collision += tau
+        if collided:
+            v_in = abs(v_tau)
+            v_out = restitution * v_in  # eq. (restitution)
+            out_bin = _bin_index(v_out, v_log_lo, v_per_ln, nv, v_edges)
+            if recording:
+                collisions += 1
+                speed_counts[out_bin] += 1
+                if collided_before and parts & FLIGHTS:  # the flight that ends here
+                    flights += 1
+                    flight_time_sum += since_collision
+                    flight_time_squared_sum += since_collision * since_collision
+                    flight_time_counts[
+                        _bin_index(since_collision, f_log_lo, f_per_ln, nf, f_edges)
+                    ] += 1
+                    return_speed_counts[
+                        last_out_bin, _bin_index(v_in, v_log_lo, v_per_ln, nv, v_edges)
+                    ] += 1
+            collided_before = True
+            since_collision = 0.0
+            last_out_bin = out_bin
+            x = 0.0
+            x_bin = 0
+            v = v_out
+            root_2delta = v_out * min_root_2delta
+            delta = max(0.5 * root_2delta * root_2delta, min_step_floor)  # below r_c: regularises
+            root, slope_at_root = criterion_root(x, v, c, 0.0)  # closed form at x = 0
+        else:
+            x = x1
+            v = v1
+            start = predicted_start(predictor, root, x1, v1)
+            root, slope_at_root = criterion_root(x, v, c, start)
+
+    scalars[_TIME] = t if recording else 0.0
+    scalars[_COLLISIONS] = collisions
+    scalars[_STEPS] = recorded_steps
+    scalars[_INT_X] = int_x
+    scalars[_INT_X2] = int_x2
+    scalars[_EXHAUSTED] = exhausted
+    scalars[_FLIGHTS] = flights
+    scalars[_FLIGHT_TIME_SUM] = flight_time_sum
+    scalars[_FLIGHT_TIME_SQUARED_SUM] = flight_time_squared_sum
+    scalars[_NOISE_SUM] = noise_sum
+    scalars[_NOISE_V_SUM] = noise_v_sum
+    scalars[_NOISE_SCALED_SUM] = noise_scaled_sum
+    scalars[_NORMAL_SUM] = normal_sum
+    scalars[_EARLY_TIME] = early_time
+    scalars[_EARLY_COLLISIONS] = early_collisions
+    scalars[_EARLY_INT_X] = early_int_x
+    scalars[_EARLY_INT_X2] = early_int_x2
+    scalars[_NOISE_X_SUM] = noise_x_sum
+    scalars[_NOISE_XV_SUM] = noise_xv_sum
+    scalars[_NOISE_X2_SUM] = noise_x2_sum
+    scalars[_NOISE_V2_SUM] = noise_v2_sum
+    scalars[_NOISE_V3_SUM] = noise_v3_sum
+    scalars[_NOISE_V4_SUM] = noise_v4_sum
+    scalars[_NOISE_XV2_SUM] = noise_xv2_sum
+    scalars[_NOISE_SQUARED_SUM] = noise_squared_sum
+    scalars[_NOISE_SQUARED_V_SUM] = noise_squared_v_sum
+    scalars[_NOISE_SQUARED_X_SUM] = noise_squared_x_sum
+    scalars[_NOISE_SQUARED_V2_SUM] = noise_squared_v2_sum
+    scalars[_POSITION_NOISE_SUM] = position_noise_sum
+    scalars[_POSITION_NOISE_V_SUM] = position_noise_v_sum
+    scalars[_POSITION_NOISE_X_SUM] = position_noise_x_sum
+
+
+def simulate_shard(
+    restitution: float,
+    seed_sequence: np.random.SeedSequence,
+    settings: ShardSettings,
+    parts: int = EVERY_TALLY,
+) -> ShardTallies:
+    """Run one shard of r = ``restitution`` and return its tallies (pure: no I/O).
+
+    The particle moves by eqs. (xstep), (vstep) with the step of eq. (criterion) and collides
+    by eq. (restitution) (the module's account of the method).  It runs
+    ``settings.equilibration_time`` first, then records ``settings.shard_time``, or stops
+    after ``settings.max_steps`` steps (equilibration included) and says so
+    (``budget_exhausted``).  ``settings.min_step_floor`` is a lower bound on delta (0: the
+    paper's rule alone); below r_c it is what keeps the simulation going (module docstring).
+
+    Parameters
+    ----------
+    restitution : float
+        r, 0 < r < 1.
+    seed_sequence : numpy.random.SeedSequence
+        The shard's stream (``shard_seed_sequence``); the bridge points draw from its first
+        child (``tallies.tally_seed_sequence``).
+    settings : settings.ShardSettings
+        The shard's parameters: shard_time, equilibration_time, criterion_c (c of
+        eq. (criterion)), min_step_divisor, min_step_floor and max_steps, and the bins
+        speed_bins, position_bins, velocity_bins and flight_time_bins.
+    parts : int, optional
+        The bits of what to record (``EVERY_TALLY``, a shard records them all; the benchmark's
+        breakdown leaves ``MEAN_PATH_INTEGRALS``, ``POSITION``, ``JOINT``, ``FLIGHTS`` or
+        ``CONTROL_VARIATES`` out); the collisions, their outgoing speeds, the time and the
+        steps are always recorded.
+
+    Returns
+    -------
+    tallies.ShardTallies
+        The shard's tallies, on the settings' bins.
+
+    Raises
+    ------
+    ValueError
+        If r is not in (0, 1).
+
+    Examples
+    --------
+    Compiles the loop on its first call (a minute), so not run as a doctest.  Same stream,
+    same numbers:
+
+    >>> from bouncing_ball.settings import ShardSettings
+    >>> from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
+    >>> settings = ShardSettings(
+    ...     shard_time=100.0, equilibration_time=10.0, criterion_c=5, min_step_divisor=10,
+    ...     max_steps=10**7,
+    ... )
+    >>> shard = simulate_shard(0.5, shard_seed_sequence(1, "0.5", 0), settings)  # doctest: +SKIP
+    >>> print(shard.time, shard.budget_exhausted, shard.collisions > 0)  # doctest: +SKIP
+    100.0 0 True
+    >>> again = simulate_shard(0.5, shard_seed_sequence(1, "0.5", 0), settings)  # doctest: +SKIP
+    >>> print(again.collisions == shard.collisions, again.int_x == shard.int_x)  # doctest: +SKIP
+    True True
+    """
+    if not 0.0 < restitution < 1.0:
+        raise ValueError(f"restitution must lie in (0, 1), got {restitution}")
+    rng = np.random.Generator(np.random.PCG64(seed_sequence))
+    rng_tally = np.random.Generator(np.random.PCG64(tally_seed_sequence(seed_sequence)))
+    arrays = ShardTallies.loop_arrays(settings)
+    _run(
+        stream_words(rng),
+        stream_words(rng_tally),
+        float(restitution),
+        settings.criterion_c,
+        settings.min_step_divisor,
+        settings.min_step_floor,
+        settings.equilibration_time,
+        settings.shard_time,
+        settings.max_steps,
+        settings.speed_bins.edges,
+        settings.position_bins.edges,
+        settings.velocity_bins.edges,
+        settings.flight_time_bins.edges,
+        arrays["speed_counts"],
+        arrays["position_time"],
+        arrays["position_v2_time"],
+        arrays["flight_time_counts"],
+        arrays["position_velocity_time"],
+        arrays["return_speed_counts"],
+        arrays["scalars"],
+        parts,
+    )
+    return ShardTallies.from_loop(settings, arrays)

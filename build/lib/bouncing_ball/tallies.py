@@ -1,0 +1,511 @@
+"""What one simulation shard records, and merging shards (a sum).
+
+A shard is stored as one long table, a row per tally entry::
+
+    tally                   lo     hi     lo2    hi2    value
+    outgoing_speed          v_lo   v_hi   NaN    NaN    collisions with v_out in [v_lo, v_hi)
+    position_time           x_lo   x_hi   NaN    NaN    time spent with x in [x_lo, x_hi)
+    position_v2_time        x_lo   x_hi   NaN    NaN    int v^2 dt over that time
+    flight_time             t_lo   t_hi   NaN    NaN    flights with duration in [t_lo, t_hi)
+    position_velocity_time  x_lo   x_hi   v_lo   v_hi   time spent in that cell of (x, v)
+    return_speed            u_lo   u_hi   v_lo   v_hi   flights leaving the floor at speed u
+                                                        and returning at speed v in the cell
+    time, collisions, steps, int_x, int_x2, budget_exhausted,
+    flights, flight_time_sum, flight_time_squared_sum,
+    noise_sum, noise_v_sum, noise_scaled_sum, normal_sum,
+    early_time, early_collisions, early_int_x, early_int_x2,
+    noise_x_sum, ..., position_noise_x_sum (MOMENT_CONTROL_SUMS)
+                            NaN    NaN    NaN    NaN    the scalar
+
+A 2-D tally's rows run over its second variable fastest (row-major, the first
+variable's bins on the outer loop), each variable with its under- and
+overflow bins.  Every entry is additive over shards, so merging is a sum.
+
+``SCALARS`` is the one definition of the scalars' layout: their order in the table, in
+the array a compiled shard loop fills (``SCALAR_INDEX``: the numba loop's indices, and
+the C reference's, which ``benchmarks/reference_loop.py`` passes to the compiler, with
+``EARLY_FRACTION``).  ``HISTOGRAMS`` and ``HISTOGRAMS_2D`` name the histograms and their
+bins, ``BINS`` the four bins a shard is recorded on, ``CONTROL_VARIATE_SUMS`` the martingale
+sums of mean 0 that correct the collision rate I, and ``EARLY_SUMS`` the sums over the first
+``EARLY_FRACTION`` of the recording (the shard's own evidence of equilibration).
+
+Examples
+--------
+A shard's tallies round-trip through its table; two shards merge to their sum:
+
+>>> from bouncing_ball.bins import LinearBins, LogBins
+>>> from bouncing_ball.settings import ShardSettings
+>>> from bouncing_ball.tallies import ShardTallies, merge_shards, SCALAR_INDEX
+>>> from bouncing_ball.tallies import tallies_from_frame, tallies_to_frame
+>>> settings = ShardSettings(
+...     shard_time=1.0, equilibration_time=0.0, criterion_c=5, min_step_divisor=10,
+...     max_steps=100, speed_bins=LogBins(0.1, 10.0, 1), position_bins=LogBins(0.1, 10.0, 1),
+...     velocity_bins=LinearBins(-1.0, 1.0, 1.0), flight_time_bins=LogBins(0.1, 10.0, 1),
+... )
+>>> arrays = ShardTallies.loop_arrays(settings)
+>>> arrays["speed_counts"][1] = 3
+>>> arrays["scalars"][SCALAR_INDEX["collisions"]] = 3
+>>> shard = ShardTallies.from_loop(settings, arrays)
+>>> total = merge_shards([shard, shard])
+>>> print(total.collisions, total.speed_counts)
+6 [0 6 0 0]
+>>> back = tallies_from_frame(tallies_to_frame(total), settings)
+>>> print(back.collisions, back.speed_counts)
+6 [0 6 0 0]
+"""
+
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+import pandas as pd
+
+from .bins import LinearBins, LogBins
+
+__all__ = [
+    "HISTOGRAMS",
+    "HISTOGRAMS_2D",
+    "CONTROL_VARIATE_SUMS",
+    "MOMENT_CONTROL_SUMS",
+    "MOMENT_CONTROLS",
+    "RATE_CONTROLS",
+    "SHARDS_PER_CONTROL",
+    "EARLY_FRACTION",
+    "EARLY_SUMS",
+    "SCALARS",
+    "SCALAR_INDEX",
+    "BINS",
+    "tally_seed_sequence",
+    "ShardTallies",
+    "merge_shards",
+    "tallies_to_frame",
+    "tallies_from_frame",
+]
+
+#: The 1-D histograms, name in the table: (the bins' attribute, the values' attribute,
+#: integer counts?).
+HISTOGRAMS = {
+    "outgoing_speed": ("speed_bins", "speed_counts", True),
+    "position_time": ("position_bins", "position_time", False),
+    "position_v2_time": ("position_bins", "position_v2_time", False),
+    "flight_time": ("flight_time_bins", "flight_time_counts", True),
+}
+#: The 2-D histograms, name in the table: ((the bins of the first and of the second variable),
+#: values, integer?).
+HISTOGRAMS_2D = {
+    "position_velocity_time": (("position_bins", "velocity_bins"), "position_velocity_time", False),
+    "return_speed": (("speed_bins", "speed_bins"), "return_speed_counts", True),
+}
+#: The martingale sums of mean 0 in the velocity noise xi_n = sqrt(2 dt_n) normal_r of
+#: eq. (vstep): of xi_n, v_n xi_n, v_n xi_n / (x_n + v_n^2 / 2 + 4 dt_n) and normal_r, at the
+#: step's start state; in every set of control variates (``RATE_CONTROLS``, ``MOMENT_CONTROLS``).
+CONTROL_VARIATE_SUMS = ("noise_sum", "noise_v_sum", "noise_scaled_sum", "normal_sum")
+#: More such sums, with weights polynomial in the step's start state, that correct the moments
+#: of x and the flights (``histograms.position_moments_summary``); xi_n = sqrt(2 dt_n) normal_r,
+#: q_n = xi_n^2 - 2 dt_n and eta_n = dt_n^(3/2) normal_s, the noises of eqs. (xstep), (vstep).
+MOMENT_CONTROL_SUMS = (
+    "noise_x_sum",
+    "noise_xv_sum",
+    "noise_x2_sum",
+    "noise_v2_sum",
+    "noise_v3_sum",
+    "noise_v4_sum",
+    "noise_xv2_sum",
+    "noise_squared_sum",
+    "noise_squared_v_sum",
+    "noise_squared_x_sum",
+    "noise_squared_v2_sum",
+    "position_noise_sum",
+    "position_noise_v_sum",
+    "position_noise_x_sum",
+)
+#: The control variates of the summary's moments (I, <x>, Delta x, the flights' moments):
+#: all the sums of mean 0 (``histograms.moment_controls``).
+MOMENT_CONTROLS = (*CONTROL_VARIATE_SUMS, *MOMENT_CONTROL_SUMS)
+#: The fewer control variates of the summary's moments with few shards, and those of the bins
+#: of P(0, v), P(x) and <v^2>_x.
+RATE_CONTROLS = (*CONTROL_VARIATE_SUMS, "noise_squared_sum")
+#: The shards per control variate that a correction needs: with fewer, the cross-fitted
+#: slopes' noise makes the jackknife error too small (``histograms.shard_controls``).
+SHARDS_PER_CONTROL = 3
+#: The fraction of the recording whose steps ``EARLY_SUMS`` sum over: those that start before
+#: ``EARLY_FRACTION`` x shard_time.
+EARLY_FRACTION = 0.125
+#: The time, collisions, int x dt and int x^2 dt over the early part of the recording
+#: (``EARLY_FRACTION``): the shard's own evidence of equilibration (``equilibration``).
+EARLY_SUMS = ("early_time", "early_collisions", "early_int_x", "early_int_x2")
+#: The scalars of a shard, in their order in its table and in the array a compiled shard loop
+#: fills: the totals, then ``CONTROL_VARIATE_SUMS``, ``EARLY_SUMS`` and ``MOMENT_CONTROL_SUMS``.
+SCALARS = (
+    "time",
+    "collisions",
+    "steps",
+    "int_x",
+    "int_x2",
+    "budget_exhausted",
+    "flights",
+    "flight_time_sum",
+    "flight_time_squared_sum",
+    *CONTROL_VARIATE_SUMS,
+    *EARLY_SUMS,
+    *MOMENT_CONTROL_SUMS,
+)
+#: Where each scalar of ``SCALARS`` sits in the array a compiled shard loop fills.
+SCALAR_INDEX = {name: index for index, name in enumerate(SCALARS)}
+_INTEGER = ("collisions", "steps", "budget_exhausted", "flights", "early_collisions")
+#: The four bins a shard is recorded on, fields of ``ShardTallies`` and of
+#: ``settings.ShardSettings``.
+BINS = ("speed_bins", "position_bins", "velocity_bins", "flight_time_bins")
+
+
+def tally_seed_sequence(seed_sequence: np.random.SeedSequence) -> np.random.SeedSequence:
+    """The stream of a shard's bridge points, the first child of the shard's stream.
+
+    The bridge points (``simulation.simulate_shard``) sample P(x, v) and correct P(x) and
+    <v^2>_x.  The child is made without ``spawn`` (which would change the parent's state).
+
+    Parameters
+    ----------
+    seed_sequence : numpy.random.SeedSequence
+        The shard's stream.
+
+    Returns
+    -------
+    numpy.random.SeedSequence
+        Its child with spawn key ``(*seed_sequence.spawn_key, 0)``, as ``spawn`` would make
+        first.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bouncing_ball.tallies import tally_seed_sequence
+    >>> shard = np.random.SeedSequence(12345, spawn_key=(7,))
+    >>> child = tally_seed_sequence(shard)
+    >>> child.spawn_key, child.entropy
+    ((7, 0), 12345)
+    >>> bool((child.generate_state(2) == shard.spawn(1)[0].generate_state(2)).all())
+    True
+    """
+    return np.random.SeedSequence(
+        entropy=seed_sequence.entropy,
+        spawn_key=(*seed_sequence.spawn_key, 0),
+        pool_size=seed_sequence.pool_size,
+    )
+
+
+@dataclass(frozen=True)
+class ShardTallies:
+    """The tallies of one shard, or of several merged (``+``, ``merge_shards``).
+
+    Every field but the bins is additive over shards.
+
+    Parameters
+    ----------
+    speed_bins, position_bins, flight_time_bins : LogBins
+        The bins of outgoing speeds, heights and flight times (``BINS``).
+    velocity_bins : LinearBins
+        The velocity bins of P(x, v).
+    speed_counts, flight_time_counts : numpy.ndarray of int64
+        Collisions by outgoing speed (P(0, v)), flights by duration; each with its under- and
+        overflow bins.
+    position_time, position_v2_time : numpy.ndarray
+        Time spent in each height bin (P(x)) and int v^2 dt over it (<v^2>_x, eq. (moment2)).
+    position_velocity_time : numpy.ndarray
+        Time spent in each (x, v) cell, shape (x bins, v bins): P(x, v).
+    return_speed_counts : numpy.ndarray of int64
+        Flights by outgoing speed u and return speed v, shape (u bins, v bins).
+    time, collisions, steps, int_x, int_x2 : float or int
+        Scalars of ``SCALARS``: recorded time, collisions, steps, int x dt and int x^2 dt.
+    budget_exhausted, flights, flight_time_sum, flight_time_squared_sum : int or float
+        Scalars of ``SCALARS``: shards that ran out of their step budget, flights recorded (one
+        per recorded collision with an earlier collision) and the sums of their T and T^2.
+    **control_variates : float
+        One field per name of ``CONTROL_VARIATE_SUMS`` (the velocity noise of eq. (vstep))
+        and of ``MOMENT_CONTROL_SUMS`` (the noises of eqs. (xstep), (vstep) with weights
+        polynomial in the step's start state): sums of mean 0 over the recorded steps, the
+        martingale control variates, all of them ``MOMENT_CONTROLS``, the fewer
+        ``RATE_CONTROLS``.
+    early_time, early_collisions, early_int_x, early_int_x2 : float or int
+        ``EARLY_SUMS``: time, collisions, int x dt and int x^2 dt over the first
+        ``EARLY_FRACTION`` of the recording.
+
+    Raises
+    ------
+    ValueError
+        On ``+`` of shards recorded on different bins.
+
+    Examples
+    --------
+    See the module's example.
+    """
+
+    speed_bins: LogBins
+    position_bins: LogBins
+    velocity_bins: LinearBins
+    flight_time_bins: LogBins
+    speed_counts: np.ndarray  # outgoing speeds of the recorded collisions
+    position_time: np.ndarray  # time per x bin (the mean path, bridge-corrected)
+    position_v2_time: np.ndarray  # int v^2 dt per x bin
+    flight_time_counts: np.ndarray  # durations of the recorded flights
+    position_velocity_time: np.ndarray  # (x bins, v bins): time per cell (sampled on the bridge)
+    return_speed_counts: np.ndarray  # (u bins, v bins): outgoing speed u, return speed v
+    time: float
+    collisions: int
+    steps: int
+    int_x: float
+    int_x2: float
+    budget_exhausted: int  # number of shards that ran out of their step budget
+    flights: int  # flights recorded: one per recorded collision with an earlier collision
+    flight_time_sum: float  # sum of their durations T
+    flight_time_squared_sum: float  # sum of T^2
+    # control variates: sums over the recorded steps n (state x_n, v_n and step dt_n at the
+    # step's start, velocity noise xi_n = sqrt(2 dt_n) normal_n of eq. (vstep)), each of mean 0
+    noise_sum: float  # sum xi_n
+    noise_v_sum: float  # sum v_n xi_n
+    noise_scaled_sum: float  # sum v_n xi_n / (x_n + v_n^2 / 2 + 4 dt_n)
+    normal_sum: float  # sum normal_n
+    # the steps that start in the early part of the recording (t < EARLY_FRACTION shard_time):
+    # their time, collisions, int x dt and int x^2 dt (all 0 if the shard stopped before)
+    early_time: float
+    early_collisions: int
+    early_int_x: float
+    early_int_x2: float
+    # sums over the recorded steps of mean 0 (MOMENT_CONTROL_SUMS)
+    noise_x_sum: float  # sum x xi
+    noise_xv_sum: float  # sum x v xi
+    noise_x2_sum: float  # sum x^2 xi
+    noise_v2_sum: float  # sum v^2 xi
+    noise_v3_sum: float  # sum v^3 xi
+    noise_v4_sum: float  # sum v^4 xi
+    noise_xv2_sum: float  # sum x v^2 xi
+    noise_squared_sum: float  # sum q
+    noise_squared_v_sum: float  # sum v q
+    noise_squared_x_sum: float  # sum x q
+    noise_squared_v2_sum: float  # sum v^2 q
+    position_noise_sum: float  # sum eta
+    position_noise_v_sum: float  # sum v eta
+    position_noise_x_sum: float  # sum x eta
+
+    @staticmethod
+    def loop_arrays(settings) -> dict:
+        """Zeroed arrays a compiled shard loop fills.
+
+        Parameters
+        ----------
+        settings : settings.ShardSettings
+            Anything with the four bins of ``BINS``.
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            By field name, each histogram with under- and overflow bins, and ``scalars`` in
+            the order of ``SCALARS``.
+        """
+        arrays = {}
+        for bins_attr, values_attr, integer in HISTOGRAMS.values():
+            arrays[values_attr] = np.zeros(
+                getattr(settings, bins_attr).n + 2, dtype=np.int64 if integer else np.float64
+            )
+        for (first, second), values_attr, integer in HISTOGRAMS_2D.values():
+            shape = (getattr(settings, first).n + 2, getattr(settings, second).n + 2)
+            arrays[values_attr] = np.zeros(shape, dtype=np.int64 if integer else np.float64)
+        arrays["scalars"] = np.zeros(len(SCALARS))
+        return arrays
+
+    @classmethod
+    def from_loop(cls, settings, arrays: dict) -> "ShardTallies":
+        """The tallies of a compiled shard loop.
+
+        Parameters
+        ----------
+        settings : settings.ShardSettings
+            Anything with the four bins of ``BINS``: the bins the loop recorded on.
+        arrays : dict of str to numpy.ndarray
+            The arrays of ``loop_arrays`` after the loop (the numba loop and its C reference
+            both fill them so).
+
+        Returns
+        -------
+        ShardTallies
+        """
+        values = {
+            name: int(value) if name in _INTEGER else float(value)
+            for name, value in zip(SCALARS, arrays["scalars"])
+        }
+        histograms = {name: array for name, array in arrays.items() if name != "scalars"}
+        return cls(
+            **{name: getattr(settings, name) for name in BINS},
+            **histograms,
+            **values,
+        )
+
+    def __add__(self, other: "ShardTallies") -> "ShardTallies":
+        if any(getattr(self, name) != getattr(other, name) for name in BINS):
+            raise ValueError("cannot merge shards recorded on different bins")
+        summed = {
+            f.name: getattr(self, f.name) + getattr(other, f.name)
+            for f in fields(self)
+            if f.name not in BINS
+        }
+        return replace(self, **summed)
+
+
+def merge_shards(shards) -> ShardTallies:
+    """Sum the tallies of several shards (order does not matter).
+
+    Parameters
+    ----------
+    shards : iterable of ShardTallies
+        At least one, all recorded on the same bins.
+
+    Returns
+    -------
+    ShardTallies
+        Their sum.
+
+    Raises
+    ------
+    ValueError
+        If there are no shards, or their bins differ.
+
+    Examples
+    --------
+    See the module's example.
+    """
+    shards = list(shards)
+    if not shards:
+        raise ValueError("no shards to merge")
+    total = shards[0]
+    for shard in shards[1:]:
+        total = total + shard
+    return total
+
+
+def tallies_to_frame(tallies: ShardTallies) -> pd.DataFrame:
+    """A shard's tallies as its long table, the layout of the module's docstring.
+
+    Parameters
+    ----------
+    tallies : ShardTallies
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``tally``, ``lo``, ``hi``, ``lo2``, ``hi2``, ``value``: a row per bin of each
+        histogram (a 2-D one's second variable fastest), then a row per scalar of
+        ``SCALARS``.
+
+    Examples
+    --------
+    See the module's example.
+    """
+    parts = []
+    for name, (bins_attr, values_attr, _) in HISTOGRAMS.items():
+        bins = getattr(tallies, bins_attr)
+        parts.append(
+            pd.DataFrame(
+                {
+                    "tally": name,
+                    "lo": bins.lower,
+                    "hi": bins.upper,
+                    "lo2": np.nan,
+                    "hi2": np.nan,
+                    "value": np.asarray(getattr(tallies, values_attr), dtype=float),
+                }
+            )
+        )
+    for name, ((first, second), values_attr, _) in HISTOGRAMS_2D.items():
+        outer, inner = getattr(tallies, first), getattr(tallies, second)
+        n_inner = inner.n + 2
+        parts.append(
+            pd.DataFrame(
+                {
+                    "tally": name,
+                    "lo": np.repeat(outer.lower, n_inner),
+                    "hi": np.repeat(outer.upper, n_inner),
+                    "lo2": np.tile(inner.lower, outer.n + 2),
+                    "hi2": np.tile(inner.upper, outer.n + 2),
+                    "value": np.asarray(getattr(tallies, values_attr), dtype=float).ravel(),
+                }
+            )
+        )
+    parts.append(
+        pd.DataFrame(
+            {
+                "tally": list(SCALARS),
+                "lo": np.nan,
+                "hi": np.nan,
+                "lo2": np.nan,
+                "hi2": np.nan,
+                "value": [float(getattr(tallies, s)) for s in SCALARS],
+            }
+        )
+    )
+    return pd.concat(parts, ignore_index=True)
+
+
+def _on_bins(rows, column, expected):
+    values = rows[column].to_numpy()
+    return len(values) == len(expected) and np.allclose(values, expected, equal_nan=True)
+
+
+def tallies_from_frame(frame: pd.DataFrame, settings, source: str = "shard") -> ShardTallies:
+    """A shard's tallies from its table: the inverse of ``tallies_to_frame``.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        The table of ``tallies_to_frame``.
+    settings : settings.ShardSettings
+        Anything with the four bins of ``BINS``; the table's bins must be these.
+    source : str, optional
+        Where the table comes from (a file), named in errors.
+
+    Returns
+    -------
+    ShardTallies
+
+    Raises
+    ------
+    ValueError
+        Naming ``source``, if a column is missing, a tally is not on the bins of ``settings``,
+        or a scalar is missing or repeated.
+
+    Examples
+    --------
+    See the module's example.
+    """
+    missing = {"tally", "lo", "hi", "lo2", "hi2", "value"} - set(frame.columns)
+    if missing:
+        raise ValueError(f"{source}: missing columns {sorted(missing)}")
+    values = {name: getattr(settings, name) for name in BINS}
+    for name, (bins_attr, values_attr, integer) in HISTOGRAMS.items():
+        rows = frame[frame["tally"] == name]
+        bins = getattr(settings, bins_attr)
+        if not _on_bins(rows, "lo", bins.lower):
+            raise ValueError(
+                f"{source}: tally '{name}' is not on the configured bins "
+                f"({len(rows)} rows, expected {bins.n + 2}); re-run the shard"
+            )
+        column = rows["value"].to_numpy()
+        values[values_attr] = column.astype(np.int64) if integer else column
+    for name, ((first, second), values_attr, integer) in HISTOGRAMS_2D.items():
+        rows = frame[frame["tally"] == name]
+        outer, inner = getattr(settings, first), getattr(settings, second)
+        shape = (outer.n + 2, inner.n + 2)
+        if not (
+            _on_bins(rows, "lo", np.repeat(outer.lower, shape[1]))
+            and _on_bins(rows, "lo2", np.tile(inner.lower, shape[0]))
+        ):
+            raise ValueError(
+                f"{source}: tally '{name}' is not on the configured bins "
+                f"({len(rows)} rows, expected {shape[0] * shape[1]}); re-run the shard"
+            )
+        column = rows["value"].to_numpy().reshape(shape)
+        values[values_attr] = column.astype(np.int64) if integer else column
+    for name in SCALARS:
+        rows = frame.loc[frame["tally"] == name, "value"]
+        if len(rows) != 1:
+            raise ValueError(f"{source}: expected one '{name}' row, found {len(rows)}")
+        value = float(rows.iloc[0])
+        values[name] = int(value) if name in _INTEGER else value
+    return ShardTallies(**values)

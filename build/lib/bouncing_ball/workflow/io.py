@@ -1,0 +1,283 @@
+"""Parquet tables with provenance, written atomically, read with clear errors.
+
+Provenance (r, the rule's parameters, seed, package version) is stored as
+JSON under the key ``bouncing_ball`` of the Parquet key-value metadata.
+"""
+
+import json
+import os
+import tempfile
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from .. import __version__
+from ..restitution import parse_restitution
+
+METADATA_KEY = b"bouncing_ball"
+
+
+class UnreadableFileError(RuntimeError):
+    """An input file is missing, truncated or not what it should be."""
+
+
+@contextmanager
+def atomic_paths(*paths):
+    """Temporary names next to ``paths`` to write to; all are renamed to ``paths`` only
+    if the block finishes, all removed otherwise: a reader never sees a half-written
+    file, and a rule's outputs appear together or not at all."""
+    paths = [Path(path) for path in paths]
+    temporaries = []
+    try:
+        for path in paths:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            for stale in path.parent.glob(f".{path.stem}.*{path.suffix}"):
+                # left by a writer that was killed (SIGKILL skips the cleanup below)
+                stale.unlink(missing_ok=True)
+            handle, temporary = tempfile.mkstemp(
+                prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent
+            )
+            os.close(handle)
+            temporaries.append(temporary)
+            # mkstemp makes the file private (0600); a result gets the mode the user's
+            # umask gives any new file (0644 under umask 022), so colleagues can read it
+            os.chmod(temporary, 0o666 & ~_umask())
+        yield temporaries
+    except BaseException:
+        for temporary in temporaries:
+            Path(temporary).unlink(missing_ok=True)
+        raise
+    renamed = []
+    try:
+        for temporary, path in zip(temporaries, paths, strict=True):
+            os.replace(temporary, path)
+            renamed.append(path)
+    except BaseException:
+        # a rename failed (e.g. a directory where a file should go): take back the new
+        # files already in place, so that none of the set is left without the others
+        for path in renamed:
+            path.unlink(missing_ok=True)
+        for temporary in temporaries:
+            Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+def _umask() -> int:
+    """The process's umask (reading it means setting it; set straight back)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _with_provenance(frame: pd.DataFrame, provenance: dict) -> pa.Table:
+    table = pa.Table.from_pandas(frame, preserve_index=False)
+    metadata = dict(table.schema.metadata or {})
+    metadata[METADATA_KEY] = json.dumps(
+        {"package_version": __version__, **provenance}, sort_keys=True, default=str
+    ).encode()
+    return table.replace_schema_metadata(metadata)
+
+
+def write_tables(frames: dict, provenance: dict) -> None:
+    """Write each frame of ``{path: frame}`` with ``provenance``; all or none of them
+    appear (``atomic_paths``), as a rule's outputs should."""
+    tables = [_with_provenance(frame, provenance) for frame in frames.values()]
+    with atomic_paths(*frames) as temporaries:
+        for table, temporary in zip(tables, temporaries, strict=True):
+            pq.write_table(table, temporary)
+
+
+def write_table(frame: pd.DataFrame, path, provenance: dict) -> None:
+    """Write ``frame`` to ``path`` with ``provenance``; atomic (temp file, then rename)."""
+    write_tables({path: frame}, provenance)
+
+
+@dataclass(frozen=True)
+class TableKind:
+    """A kind of table the workflow writes: the rule that writes it and its columns
+    (docs/outputs.md); a reader names the kind it expects (``read_table``)."""
+
+    name: str
+    rule: str
+    columns: tuple[str, ...]
+
+
+_SUMMARY = ("r", "mean_x", "delta_x", "collision_rate")
+SIMULATED_P0V = TableKind(
+    "simulated P(0,v)", "merge_shards", ("v_lo", "v_hi", "v", "p0v", "p0v_err", "count")
+)
+SIMULATED_POSITION = TableKind(
+    "simulated P(x)",
+    "merge_shards",
+    ("x_lo", "x_hi", "x", "px", "px_err", "v2_given_x", "v2_given_x_err"),
+)
+SIMULATED_SUMMARY = TableKind(
+    "simulated summary",
+    "merge_shards",
+    (*_SUMMARY, "mean_x_err", "delta_x_err", "collision_rate_err"),
+)
+SIMULATED_DISTRIBUTION = TableKind(
+    "simulated P(x,v)", "merge_shards", ("x_lo", "x_hi", "v_lo", "v_hi", "pxv", "pxv_err")
+)
+SIMULATED_FLIGHT_TIME = TableKind(
+    "simulated flight-time", "merge_shards", ("t_lo", "t_hi", "t", "density", "density_err")
+)
+SIMULATED_RETURN_SPEED = TableKind(
+    "simulated return-speed",
+    "merge_shards",
+    ("u_lo", "u_hi", "v_lo", "v_hi", "probability", "probability_err"),
+)
+SOLVER_P0V = TableKind("solver P(0,v)", "solve", ("v", "p0v"))
+SOLVER_POSITION = TableKind("solver P(x)", "solve", ("x", "px", "v2_given_x"))
+SOLVER_DISTRIBUTION = TableKind("solver P(x,v)", "solve", ("x", "v", "pxv"))
+SOLVER_FLIGHT_TIME = TableKind(
+    "solver flight-time",
+    "solve",
+    ("t", "density", "rate_density", "short_time_form", "long_time_form"),
+)
+SOLVER_RETURN_SPEED = TableKind(
+    "solver return-speed", "solve", ("u_lo", "u_hi", "v_lo", "v_hi", "probability")
+)
+EXACT_POSITION = TableKind("exact P(x)", "exact_solution", ("x", "px", "v2_given_x"))
+SOLVER_SUMMARY = TableKind("solver summary", "solve", (*_SUMMARY, "small_speed_exponent"))
+TIME_AVERAGES = TableKind("solver time averages", "solve_grid", _SUMMARY)
+EXACT_P0V = TableKind("exact P(0,v)", "exact_solution", ("v", "p0v"))
+EXACT_DISTRIBUTION = TableKind("exact P(x,v)", "exact_solution", ("x", "v", "pxv"))
+EXACT_SUMMARY = TableKind("exact summary", "exact_solution", _SUMMARY)
+EXPONENTS = TableKind("exponents", "theory", ("r", "beta", "m", "q"))
+FITS = TableKind(
+    "fits",
+    "fit",
+    (
+        "source",
+        "window",
+        "fit",
+        "parameter",
+        "value",
+        "error",
+        "theory",
+        "joint_p_value",
+        "chi2_per_dof",
+        "dof",
+        "v_min",
+        "v_max",
+    ),
+)
+
+
+def _unreadable(path, error) -> UnreadableFileError:
+    return UnreadableFileError(
+        f"{path}: not a readable Parquet file ({error}). It is probably truncated or "
+        f"corrupt: make it again with  snakemake --cores 2 --forcerun {path}  (plus your targets)"
+    )
+
+
+def _provenance(path, schema) -> dict:
+    raw = (schema.metadata or {}).get(METADATA_KEY)
+    if raw is None:
+        raise UnreadableFileError(
+            f"{path}: no '{METADATA_KEY.decode()}' provenance metadata: not written by this workflow; "
+            f"make it again with  snakemake --cores 2 --forcerun {path}"
+        )
+    return json.loads(raw)
+
+
+def _read_parquet(read, path: Path):
+    """``read(path)`` (pyarrow's ``read_table`` or ``read_schema``), its failures an
+    ``UnreadableFileError`` naming the file."""
+    try:
+        return read(path)
+    except FileNotFoundError:
+        raise UnreadableFileError(f"{path}: file not found") from None
+    except (pa.ArrowException, OSError) as error:
+        raise _unreadable(path, error) from None
+
+
+def read_provenance(path) -> dict:
+    """The provenance of a table written by ``write_table``, without reading its data."""
+    path = Path(path)
+    return _provenance(path, _read_parquet(pq.read_schema, path))
+
+
+def read_table(
+    path, kind: TableKind | None = None, label: str | None = None
+) -> tuple[pd.DataFrame, dict]:
+    """The frame and provenance of a table written by ``write_table``; with ``kind``,
+    refused (naming the file) unless that kind's rule wrote it with its columns; with
+    ``label``, unless it was made for the r of that label (``restitution_label``)."""
+    path = Path(path)
+    table = _read_parquet(pq.read_table, path)
+    frame, provenance = table.to_pandas(), _provenance(path, table.schema)
+    if kind is not None:
+        if provenance.get("rule") != kind.rule:
+            raise UnreadableFileError(
+                f"{path}: not a {kind.name} table: written by rule {provenance.get('rule')}, "
+                f"not {kind.rule}"
+            )
+        require_columns(frame, path, kind.columns)
+    if label is not None and provenance.get("r_label") != label:
+        raise UnreadableFileError(
+            f"{path}: made for r = {provenance.get('r_label')}, not r = {label}"
+        )
+    return frame, provenance
+
+
+def require_columns(frame: pd.DataFrame, path, columns) -> pd.DataFrame:
+    """``frame`` if it has ``columns``; otherwise an error naming the file and what is missing."""
+    missing = [column for column in columns if column not in frame.columns]
+    if missing:
+        raise UnreadableFileError(
+            f"{path}: not the expected table, it lacks the columns {', '.join(missing)}"
+        )
+    return frame
+
+
+def read_tables_of_one_restitution(*paths, kinds=None) -> list[tuple[pd.DataFrame, dict]]:
+    """``read_table`` of each path (with its kind of ``kinds``), refused unless all were
+    made for the same r (e.g. the simulation, solver and fits one figure panel compares)."""
+    kinds = [None] * len(paths) if kinds is None else kinds
+    tables = [read_table(path, kind) for path, kind in zip(paths, kinds, strict=True)]
+    values = [provenance.get("r") for _, provenance in tables]
+    if len(set(values)) > 1:
+        which = ", ".join(
+            f"{path} (r = {value})" for path, value in zip(paths, values, strict=True)
+        )
+        raise UnreadableFileError(f"not the same r: {which}")
+    return tables
+
+
+def comparison_panels(solver_paths, simulation_paths, exact_paths, kinds) -> list[dict]:
+    """One dict per r of a figure that compares the solver with the simulation, and with the
+    exact solution where r has one: ``restitution`` (the exact r), ``solver``, ``simulated`` and ``exact`` (None where r has no exact solution).
+    ``kinds``: the (solver, simulated, exact) ``TableKind``; each solver table is paired with
+    the simulation table of the same position and refused unless both are of one r."""
+    solver_kind, simulated_kind, exact_kind = kinds
+    exact = {}
+    for path in exact_paths:
+        table, provenance = read_table(path, exact_kind)
+        exact[provenance["r"]] = table
+    panels = []
+    for paths in zip(solver_paths, simulation_paths, strict=True):
+        (solved, provenance), (simulated, _) = read_tables_of_one_restitution(
+            *paths, kinds=(solver_kind, simulated_kind)
+        )
+        panels.append(
+            {
+                "restitution": parse_restitution(provenance["r"]),
+                "solver": solved,
+                "simulated": simulated,
+                "exact": exact.get(provenance["r"]),
+            }
+        )
+    return panels
+
+
+def write_csv_and_markdown(table: pd.DataFrame, csv_path, markdown_path, markdown: str) -> None:
+    """A results table as CSV (12 significant digits) and its Markdown rendering, each atomic."""
+    with atomic_paths(csv_path, markdown_path) as (csv_temporary, markdown_temporary):
+        table.to_csv(csv_temporary, index=False, float_format="%.12g")
+        Path(markdown_temporary).write_text(markdown)

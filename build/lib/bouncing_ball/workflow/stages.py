@@ -1,0 +1,57 @@
+"""The library modules behind each stage of the workflow.
+
+A digest of their source is a parameter of the stage's rules, so an edit of
+that code re-runs the stage and nothing else (``bouncing_ball.source_digest``).
+Kept apart from the modules so that the workflow can plan a run without
+importing numba, scipy or matplotlib.
+"""
+
+# "bins" also builds the config's grids; "restitution" parses r and makes the labels
+# that key the random streams; "jit" is how the compiled modules are compiled
+# "workflow.batches" is how a job's shards are run and stored (one file per job)
+SIMULATION = (
+    "workflow.batches",
+    "bins",
+    "free_flight",
+    "jit",
+    "pcg64",
+    "restitution",
+    "settings",
+    "simulation",
+    "tallies",
+)
+# reading a job's batch files back and merging their shards (workflow.shards checks each file's
+# provenance against the config with workflow.audit)
+READ_SHARDS = (
+    "bins",
+    "histograms",
+    "restitution",
+    "settings",
+    "tallies",
+    "workflow.audit",
+    "workflow.batches",
+    "workflow.io",
+    "workflow.shards",
+)
+MERGE = (*READ_SHARDS, "equilibration")
+SOLVER = (
+    "asymptotics",
+    "bins",
+    "distribution",
+    "equilibrium",
+    "flight_time",
+    "jit",
+    "kernel",
+    "restitution",
+    "solver",
+)
+EXACT = ("bins", "exact")
+THEORY = ("asymptotics", "bins")
+FITS = (*READ_SHARDS, "asymptotics", "fits")
+PLOTTING = ("workflow.io", "workflow.plotting", "restitution")
+COMPARISON = ("comparison", "fits", "workflow.io", "restitution")
+# the studies' reports (workflow/rules/studies.smk); their shards are SIMULATION's
+STUDIES = (*READ_SHARDS, "comparison", "exact", "fits", "workflow.studies")
+# results/tables/validation: the comparison, the exact bin averages, the solver curve's bin
+# averages, and the shards read back for the sign-flip p-values
+VALIDATION = (*READ_SHARDS, "comparison", "exact", "fits")
