@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bouncing_ball.settings import ShardSettings
+from bouncing_ball.settings import RETURN_LAW_SPEED_BINS, ShardSettings
 from bouncing_ball.tallies import (
     BINS,
     EARLY_FRACTION,
@@ -159,12 +159,15 @@ def _load(library: str):
         ctypes.c_int64,  # nu
         _double_array,  # f_edges (flight times)
         ctypes.c_int64,  # nf
+        _double_array,  # w_edges (outgoing speeds, fine)
+        ctypes.c_int64,  # nw
         _int64_array,  # speed_counts
         _double_array,  # position_time
         _double_array,  # position_v2_time
         _int64_array,  # flight_time_counts
         _double_array,  # position_velocity_time, row-major
         _int64_array,  # return_speed_counts, row-major
+        _int64_array,  # return_law_speed_counts
         _double_array,  # scalars
     ]
     return function
@@ -206,12 +209,15 @@ def reference_shard(
         settings.velocity_bins.n,
         edges["flight_time_bins"],
         settings.flight_time_bins.n,
+        np.ascontiguousarray(RETURN_LAW_SPEED_BINS.edges, dtype=np.float64),
+        RETURN_LAW_SPEED_BINS.n,
         arrays["speed_counts"],
         arrays["position_time"],
         arrays["position_v2_time"],
         arrays["flight_time_counts"],
         arrays["position_velocity_time"].ravel(),  # C-contiguous: a view
         arrays["return_speed_counts"].ravel(),
+        arrays["return_law_speed_counts"],
         arrays["scalars"],
     )
     if status != 0:

@@ -19,6 +19,7 @@ __all__ = [
     "DEFAULT_POSITION_BINS",
     "DEFAULT_VELOCITY_BINS",
     "DEFAULT_FLIGHT_TIME_BINS",
+    "RETURN_LAW_SPEED_BINS",
 ]
 
 #: The largest step budget: far beyond any shard (10^15 steps are years of CPU), far inside
@@ -35,6 +36,10 @@ DEFAULT_POSITION_BINS = LogBins(1.0e-3, 1.0e3, 5)
 DEFAULT_VELOCITY_BINS = LinearBins(-24.0, 20.0, 0.25)
 #: Times between collisions: 1e-12 to 1000, 5 bins per decade.
 DEFAULT_FLIGHT_TIME_BINS = LogBins(1.0e-12, 1.0e3, 5)
+#: Outgoing speeds again, 1e-10 to 1000 at 100 bins per decade: fine enough that the
+#: return-speed law of eq. (kernel3) hardly varies within a bin, for the return-law control
+#: of P(0, v) (``histograms.return_law_prediction``).  Not a setting: every shard records it.
+RETURN_LAW_SPEED_BINS = LogBins(1.0e-10, 1.0e3, 100)
 
 
 @dataclass(frozen=True)

@@ -141,7 +141,7 @@ from .free_flight import (
 )
 from .jit import njit
 from .pcg64 import next_double, standard_normal, stream_words
-from .settings import ShardSettings
+from .settings import RETURN_LAW_SPEED_BINS, ShardSettings
 from .tallies import EARLY_FRACTION, SCALAR_INDEX, ShardTallies, tally_seed_sequence
 
 __all__ = [
@@ -576,17 +576,20 @@ def _run(
     x_edges,
     u_edges,
     f_edges,
+    w_edges,
     speed_counts,
     position_time,
     position_v2_time,
     flight_time_counts,
     position_velocity_time,
     return_speed_counts,
+    return_law_speed_counts,
     scalars,
     parts,
 ):
     # v_edges: speeds (log); x_edges: heights (log); u_edges: velocities of P(x, v) (linear);
-    # f_edges: flight times (log); stream, tally_stream: the PCG64 states (pcg64.stream_words)
+    # f_edges: flight times (log); w_edges: outgoing speeds, fine (log, RETURN_LAW_SPEED_BINS);
+    # stream, tally_stream: the PCG64 states (pcg64.stream_words)
     high, low, inc_high, inc_low = stream
     tally_high, tally_low, tally_inc_high, tally_inc_low = tally_stream
     nv = v_edges.shape[0] - 1
@@ -601,6 +604,9 @@ def _run(
     nf = f_edges.shape[0] - 1
     f_log_lo = math.log(f_edges[0])
     f_per_ln = nf / (math.log(f_edges[nf]) - f_log_lo)
+    nw = w_edges.shape[0] - 1
+    w_log_lo = math.log(w_edges[0])
+    w_per_ln = nw / (math.log(w_edges[nw]) - w_log_lo)
     # the two ends of every x bin, the under- and overflow bins unbounded
     x_bin_lower = np.empty(nx + 2)
     x_bin_upper = np.empty(nx + 2)
@@ -845,6 +851,7 @@ def _run(
             if recording:
                 collisions += 1
                 speed_counts[out_bin] += 1
+                return_law_speed_counts[_bin_index(v_out, w_log_lo, w_per_ln, nw, w_edges)] += 1
                 if collided_before and parts & FLIGHTS:  # the flight that ends here
                     flights += 1
                     flight_time_sum += since_collision
@@ -982,12 +989,14 @@ def simulate_shard(
         settings.position_bins.edges,
         settings.velocity_bins.edges,
         settings.flight_time_bins.edges,
+        RETURN_LAW_SPEED_BINS.edges,
         arrays["speed_counts"],
         arrays["position_time"],
         arrays["position_v2_time"],
         arrays["flight_time_counts"],
         arrays["position_velocity_time"],
         arrays["return_speed_counts"],
+        arrays["return_law_speed_counts"],
         arrays["scalars"],
         parts,
     )

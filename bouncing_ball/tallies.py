@@ -4,6 +4,7 @@ A shard is stored as one long table, a row per tally entry::
 
     tally                   lo     hi     lo2    hi2    value
     outgoing_speed          v_lo   v_hi   NaN    NaN    collisions with v_out in [v_lo, v_hi)
+    outgoing_speed_fine     v_lo   v_hi   NaN    NaN    the same on RETURN_LAW_SPEED_BINS
     position_time           x_lo   x_hi   NaN    NaN    time spent with x in [x_lo, x_hi)
     position_v2_time        x_lo   x_hi   NaN    NaN    int v^2 dt over that time
     flight_time             t_lo   t_hi   NaN    NaN    flights with duration in [t_lo, t_hi)
@@ -60,6 +61,7 @@ import numpy as np
 import pandas as pd
 
 from .bins import LinearBins, LogBins
+from .settings import RETURN_LAW_SPEED_BINS
 
 __all__ = [
     "HISTOGRAMS",
@@ -82,9 +84,11 @@ __all__ = [
 ]
 
 #: The 1-D histograms, name in the table: (the bins' attribute, the values' attribute,
-#: integer counts?).
+#: integer counts?).  ``return_law_speed_bins`` is ``settings.RETURN_LAW_SPEED_BINS``, the same
+#: for every shard.
 HISTOGRAMS = {
     "outgoing_speed": ("speed_bins", "speed_counts", True),
+    "outgoing_speed_fine": ("return_law_speed_bins", "return_law_speed_counts", True),
     "position_time": ("position_bins", "position_time", False),
     "position_v2_time": ("position_bins", "position_v2_time", False),
     "flight_time": ("flight_time_bins", "flight_time_counts", True),
@@ -157,6 +161,13 @@ _INTEGER = ("collisions", "steps", "budget_exhausted", "flights", "early_collisi
 BINS = ("speed_bins", "position_bins", "velocity_bins", "flight_time_bins")
 
 
+def _bins(holder, attribute):
+    """The bins ``attribute`` of a shard's settings or tallies (``HISTOGRAMS``)."""
+    if attribute == "return_law_speed_bins":
+        return RETURN_LAW_SPEED_BINS
+    return getattr(holder, attribute)
+
+
 def tally_seed_sequence(seed_sequence: np.random.SeedSequence) -> np.random.SeedSequence:
     """The stream of a shard's bridge points, the first child of the shard's stream.
 
@@ -207,6 +218,9 @@ class ShardTallies:
     speed_counts, flight_time_counts : numpy.ndarray of int64
         Collisions by outgoing speed (P(0, v)), flights by duration; each with its under- and
         overflow bins.
+    return_law_speed_counts : numpy.ndarray of int64
+        Collisions by outgoing speed on the fine ``settings.RETURN_LAW_SPEED_BINS``, for the
+        return-law control of P(0, v) (``histograms.return_law_prediction``).
     position_time, position_v2_time : numpy.ndarray
         Time spent in each height bin (P(x)) and int v^2 dt over it (<v^2>_x, eq. (moment2)).
     position_velocity_time : numpy.ndarray
@@ -248,6 +262,7 @@ class ShardTallies:
     flight_time_counts: np.ndarray  # durations of the recorded flights
     position_velocity_time: np.ndarray  # (x bins, v bins): time per cell (sampled on the bridge)
     return_speed_counts: np.ndarray  # (u bins, v bins): outgoing speed u, return speed v
+    return_law_speed_counts: np.ndarray  # outgoing speeds again, on RETURN_LAW_SPEED_BINS
     time: float
     collisions: int
     steps: int
@@ -303,7 +318,7 @@ class ShardTallies:
         arrays = {}
         for bins_attr, values_attr, integer in HISTOGRAMS.values():
             arrays[values_attr] = np.zeros(
-                getattr(settings, bins_attr).n + 2, dtype=np.int64 if integer else np.float64
+                _bins(settings, bins_attr).n + 2, dtype=np.int64 if integer else np.float64
             )
         for (first, second), values_attr, integer in HISTOGRAMS_2D.values():
             shape = (getattr(settings, first).n + 2, getattr(settings, second).n + 2)
@@ -400,7 +415,7 @@ def tallies_to_frame(tallies: ShardTallies) -> pd.DataFrame:
     """
     parts = []
     for name, (bins_attr, values_attr, _) in HISTOGRAMS.items():
-        bins = getattr(tallies, bins_attr)
+        bins = _bins(tallies, bins_attr)
         parts.append(
             pd.DataFrame(
                 {
@@ -480,7 +495,7 @@ def tallies_from_frame(frame: pd.DataFrame, settings, source: str = "shard") -> 
     values = {name: getattr(settings, name) for name in BINS}
     for name, (bins_attr, values_attr, integer) in HISTOGRAMS.items():
         rows = frame[frame["tally"] == name]
-        bins = getattr(settings, bins_attr)
+        bins = _bins(settings, bins_attr)
         if not _on_bins(rows, "lo", bins.lower):
             raise ValueError(
                 f"{source}: tally '{name}' is not on the configured bins "

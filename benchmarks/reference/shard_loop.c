@@ -634,8 +634,9 @@ static inline int64_t tally_step(double a0, double a1, double a2, double a3, dou
 
 /*
  * _run.  v_edges (speeds) has nv + 1 entries, x_edges nx + 1, u_edges (velocities of
- * P(x, v)) nu + 1, f_edges (flight times) nf + 1; speed_counts, position_time,
- * position_v2_time and flight_time_counts have nv + 2, nx + 2, nx + 2 and nf + 2 entries,
+ * P(x, v)) nu + 1, f_edges (flight times) nf + 1, w_edges (outgoing speeds, fine) nw + 1;
+ * speed_counts, position_time, position_v2_time, flight_time_counts and
+ * return_law_speed_counts have nv + 2, nx + 2, nx + 2, nf + 2 and nw + 2 entries,
  * position_velocity_time (nx + 2) x (nu + 2) and return_speed_counts (nv + 2) x (nv + 2),
  * row-major (all zeroed by the caller); scalars has 13.  Returns 0, or -1 if the two small
  * bin-bound arrays cannot be allocated.
@@ -645,9 +646,10 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
                              double equilibration_time, double recorded_time, int64_t max_steps,
                              const double *v_edges, int64_t nv, const double *x_edges, int64_t nx,
                              const double *u_edges, int64_t nu, const double *f_edges, int64_t nf,
-                             int64_t *speed_counts, double *position_time,
-                             double *position_v2_time, int64_t *flight_time_counts,
-                             double *position_velocity_time, int64_t *return_speed_counts,
+                             const double *w_edges, int64_t nw, int64_t *speed_counts,
+                             double *position_time, double *position_v2_time,
+                             int64_t *flight_time_counts, double *position_velocity_time,
+                             int64_t *return_speed_counts, int64_t *return_law_speed_counts,
                              double *scalars)
 {
     double v_log_lo = log(v_edges[0]);
@@ -658,6 +660,8 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
     double u_per_unit = (double)nu / (u_edges[nu] - u_lo);
     double f_log_lo = log(f_edges[0]);
     double f_per_ln = (double)nf / (log(f_edges[nf]) - f_log_lo);
+    double w_log_lo = log(w_edges[0]);
+    double w_per_ln = (double)nw / (log(w_edges[nw]) - w_log_lo);
     /* the two ends of every x bin, the under- and overflow bins unbounded */
     double *x_bin_lower = malloc((size_t)(nx + 2) * sizeof(double));
     double *x_bin_upper = malloc((size_t)(nx + 2) * sizeof(double));
@@ -862,6 +866,7 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
             if (recording) {
                 collisions += 1;
                 speed_counts[out_bin] += 1;
+                return_law_speed_counts[bin_index(v_out, w_log_lo, w_per_ln, nw, w_edges)] += 1;
                 if (collided_before) { /* the flight that ends here (parts & FLIGHTS: always) */
                     flights += 1;
                     flight_time_sum += since_collision;

@@ -30,7 +30,12 @@ from ..restitution import (
     restitution_label,
     shared_label_message,
 )
-from ..settings import DEFAULT_FLIGHT_TIME_BINS, DEFAULT_VELOCITY_BINS, ShardSettings
+from ..settings import (
+    DEFAULT_FLIGHT_TIME_BINS,
+    DEFAULT_VELOCITY_BINS,
+    RETURN_LAW_SPEED_BINS,
+    ShardSettings,
+)
 from ..tallies import HISTOGRAMS, HISTOGRAMS_2D
 
 # the config's schema, in the repository that holds this package
@@ -278,6 +283,7 @@ def tally_cells(simulation: dict) -> dict[str, int]:
         "flight_time_bins": log_bins(simulation["flight_time_bins"])
         if simulation.get("flight_time_bins")
         else DEFAULT_FLIGHT_TIME_BINS,
+        "return_law_speed_bins": RETURN_LAW_SPEED_BINS,
     }
     cells = {name: bins[spec].n + 2 for name, (spec, _, _) in HISTOGRAMS.items()}
     for name, ((first, second), _, _) in HISTOGRAMS_2D.items():
@@ -288,6 +294,7 @@ def tally_cells(simulation: dict) -> dict[str, int]:
 # the settings behind each tally's cells, as the config names them
 TALLY_KEYS = {
     "outgoing_speed": "simulation.speed_bins",
+    "outgoing_speed_fine": "the fixed settings.RETURN_LAW_SPEED_BINS",
     "position_time": "simulation.position_bins",
     "position_v2_time": "simulation.position_bins",
     "flight_time": "simulation.flight_time_bins",
