@@ -66,17 +66,19 @@ def _median_relative_squared_error(table, name, keep, controlled):
     return float(np.median((error[keep] / value[keep]) ** 2))
 
 
-def distribution_relative_squared_errors(shards, controlled):
+def distribution_relative_squared_errors(shards, controlled, r=None, return_law=None):
     """{observable: median over the bins inside SPEEDS and POSITIONS of (relative standard
     error)^2} of P(0, v), P(x), <v^2>_x and P(x, v) (v within +-SPEEDS[1] for P(x, v)):
-    plain, or (``controlled``) the tables' ``*_controlled`` estimates where they have one."""
+    plain, or (``controlled``) the tables' ``*_controlled`` estimates where they have one,
+    P(0, v)'s with the return-law control of r (``return_law``: the shards' prediction,
+    ``histograms.return_law_prediction``, if at hand)."""
     from bouncing_ball.histograms import (
         distribution_histogram,
         outgoing_speed_histogram,
         position_histogram,
     )
 
-    speeds = outgoing_speed_histogram(shards)
+    speeds = outgoing_speed_histogram(shards, r if controlled else None, return_law)
     positions = position_histogram(shards)
     cells = distribution_histogram(shards)
     in_speeds = (speeds.v_lo >= SPEEDS[0]) & (speeds.v_hi <= SPEEDS[1])
@@ -97,21 +99,34 @@ def distribution_relative_squared_errors(shards, controlled):
     }
 
 
-def relative_squared_errors(shards, r, controlled):
+def relative_squared_errors(shards, r, controlled, return_law=None):
     """{observable: (relative standard error)^2} of every observable of ``OBSERVABLES``."""
     return {
         **moment_relative_squared_errors(shards, r, controlled),
-        **distribution_relative_squared_errors(shards, controlled),
+        **distribution_relative_squared_errors(shards, controlled, r, return_law),
     }
 
 
 def with_error_of_error(shards, r, controlled):
     """{observable: (relative squared error, its delete-one jackknife standard error)}: the
     estimate of ``relative_squared_errors`` from all shards, and repeated without each."""
-    full = relative_squared_errors(shards, r, controlled)
+    from bouncing_ball.histograms import return_law_prediction
+    from bouncing_ball.solver import solve_outgoing_speed_density
+
+    law = None
+    if controlled:  # a row per shard: the same rows without shard k
+        density = solve_outgoing_speed_density(r).outgoing_speed_density
+        law = return_law_prediction(shards, r, density)
+    full = relative_squared_errors(shards, r, controlled, law)
     n = len(shards)
     leave_one_out = [
-        relative_squared_errors(shards[:k] + shards[k + 1 :], r, controlled) for k in range(n)
+        relative_squared_errors(
+            shards[:k] + shards[k + 1 :],
+            r,
+            controlled,
+            None if law is None else np.delete(law, k, axis=0),
+        )
+        for k in range(n)
     ]
     result = {}
     for observable, value in full.items():

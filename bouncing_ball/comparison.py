@@ -316,6 +316,11 @@ VALIDATION_CHECKS = {
     "p0v_chi2_per_bin": "P(0,v): chi^2/n",
     "p0v_worst_bin": "P(0,v): worst bin, z",
     "p0v_largest_relative_error": "P(0,v): largest relative error, 0.01 <= v <= 5",
+    "p0v_controlled_chi2_per_bin": "P(0,v) controlled: chi^2/n",
+    "p0v_controlled_worst_bin": "P(0,v) controlled: worst bin, z",
+    "p0v_controlled_largest_relative_error": (
+        "P(0,v) controlled: largest relative error, 0.01 <= v <= 5"
+    ),
     "px_chi2_per_bin": "P(x): chi^2/n",
     "px_worst_bin": "P(x): worst bin, z",
     "v2_given_x_chi2_per_bin": "<v^2>_x: chi^2/n",
@@ -547,7 +552,8 @@ def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None, per
         z = (simulation - reference) / p0v_err over the bins with an error (not the under-
         and overflow bins, nor bins beyond the solver's grid), and the largest relative error
         p0v_err / p0v over the bins with 0.01 <= v <= 5 (an empty bin there counts as an
-        infinite relative error).
+        infinite relative error); the same of ``p0v_controlled`` (``p0v_controlled_*`` rows,
+        with no p_sign_flip) where the table has it.
 
     Raises
     ------
@@ -555,6 +561,19 @@ def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None, per
         Where r is not 1/2 or 1/3 and no solver curve is given, or ``per_shard`` holds
         another number of shards.
     """
+    rows = _outgoing_speed_rows("p0v", simulated, restitution, shards, solver_curve, per_shard)
+    if "p0v_controlled" in simulated and np.isfinite(simulated.p0v_controlled).any():
+        controlled = simulated.assign(
+            p0v=simulated.p0v_controlled, p0v_err=simulated.p0v_controlled_err
+        )
+        rows += _outgoing_speed_rows(
+            "p0v_controlled", controlled, restitution, shards, solver_curve, None
+        )
+    return rows
+
+
+def _outgoing_speed_rows(quantity, simulated, restitution, shards, solver_curve, per_shard):
+    """The rows of ``outgoing_speed_checks`` of the table's p0v, p0v_err, named ``quantity``."""
     if Fraction(restitution) in exact.EXACT_RESTITUTIONS:
         reference = "exact"
         residuals = exact_outgoing_speed_residuals(simulated, restitution)
@@ -567,7 +586,7 @@ def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None, per
     deviations = _shard_deviations(
         per_shard, "p0v", residuals.bin.to_numpy(), residuals.reference.to_numpy(), shards
     )
-    rows = _z_rows("p0v", reference, where, z, shards, "v", deviations)
+    rows = _z_rows(quantity, reference, where, z, shards, "v", deviations)
     low, high = QUALITY_SPEEDS
     quality = simulated[(simulated.v >= low) & (simulated.v <= high)]
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -583,7 +602,7 @@ def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None, per
         largest, at = np.nan, np.nan
     rows.append(
         {
-            "check": "p0v_largest_relative_error",
+            "check": f"{quantity}_largest_relative_error",
             "reference": "none",
             "bins": len(relative),
             "value": largest,

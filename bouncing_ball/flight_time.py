@@ -1240,13 +1240,17 @@ def return_speed_table(solution, speed_bins):
     )
 
 
-def _log_gauss(lower, upper):
-    """16-point Gauss-Legendre in ln x on each finite bin: nodes (bins x 16) and weights for dx."""
+def _log_gauss(lower, upper, points=16):
+    """Gauss-Legendre in ln x on each finite bin, 16 points unless ``points`` says otherwise:
+    nodes (bins x points) and weights for dx."""
     lower = np.asarray(lower, dtype=float)[:, None]
     upper = np.asarray(upper, dtype=float)[:, None]
     half = 0.5 * np.log(upper / lower)
-    x = np.exp(half * _BIN_NODES[None, :] + 0.5 * np.log(upper * lower))
-    return x, half * x * _BIN_WEIGHTS[None, :]
+    nodes, weights = (
+        (_BIN_NODES, _BIN_WEIGHTS) if points == 16 else np.polynomial.legendre.leggauss(points)
+    )
+    x = np.exp(half * nodes[None, :] + 0.5 * np.log(upper * lower))
+    return x, half * x * weights[None, :]
 
 
 def flight_rate_bin_integrals(solution, lower, upper):
@@ -1327,7 +1331,9 @@ def _speed_sub_bins(lower, upper, panels=10, efolds=40.0):
     return np.array(lo), np.array(hi), np.array(owner, dtype=int)
 
 
-def return_speed_bin_probabilities(outgoing_density, u_lower, u_upper, v_lower, v_upper):
+def return_speed_bin_probabilities(
+    outgoing_density, u_lower, u_upper, v_lower, v_upper, outgoing_points=16
+):
     """The return-speed law v G_g(v, u) of eq. (kernel3) between bins of u and of v.
 
     Matrix [i, j]: probability that the return speed lies in v-bin j, given an outgoing speed in
@@ -1347,13 +1353,15 @@ def return_speed_bin_probabilities(outgoing_density, u_lower, u_upper, v_lower, 
         The finite u-bins' edges.
     v_lower, v_upper : array_like
         The v-bins' edges.
+    outgoing_points : int, optional
+        Gauss-Legendre points in ln u per u-bin (16; fewer suffice for narrow u-bins).
 
     Returns
     -------
     numpy.ndarray, shape (u-bins, v-bins)
         Each row sums to 1 where the v-bins cover [0, inf).
     """
-    u, u_weights = _log_gauss(u_lower, u_upper)
+    u, u_weights = _log_gauss(u_lower, u_upper, outgoing_points)
     flux = u * outgoing_density(u) * u_weights  # (n_u, 16)
     v_lower, v_upper = np.asarray(v_lower, dtype=float), np.asarray(v_upper, dtype=float)
     lo, hi, owner = _speed_sub_bins(v_lower, v_upper)

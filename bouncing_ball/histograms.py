@@ -51,6 +51,10 @@ True
 import numpy as np
 import pandas as pd
 
+from .flight_time import return_speed_bin_probabilities
+from .restitution import SOLVER_RESTITUTION_RANGE, in_range, parse_restitution
+from .settings import RETURN_LAW_SPEED_BINS
+from .solver import solve_outgoing_speed_density
 from .tallies import (
     MOMENT_CONTROLS,
     RATE_CONTROLS,
@@ -65,6 +69,8 @@ __all__ = [
     "shard_controls",
     "moment_controls",
     "outgoing_speed_density",
+    "RETURN_LAW_POINTS",
+    "return_law_prediction",
     "outgoing_speed_histogram",
     "position_histogram",
     "distribution_histogram",
@@ -222,7 +228,92 @@ def outgoing_speed_density(counts, time, lower, upper):
     return counts / (time * 0.5 * (upper**2 - lower**2))
 
 
-def outgoing_speed_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
+#: Gauss-Legendre points in ln u per fine bin of ``settings.RETURN_LAW_SPEED_BINS`` (2.3 %
+#: wide) in ``return_law_prediction``.
+RETURN_LAW_POINTS = 4
+
+
+def return_law_prediction(shards: list[ShardTallies], restitution: float, outgoing_density):
+    """Each shard's expected collisions per speed bin, given the outgoing speeds it recorded.
+
+    A ball leaving the floor at speed u comes back at speed v with the return-speed law
+    v G_g(v, u) of eq. (kernel3) and leaves again at r v, eq. (restitution).  So the n-th
+    collision's outgoing speed falls in bin j with probability M_j(u_(n-1)), the law's
+    probability of v in bin j / r, and in equilibrium (the balance eq. (inteq) expresses)
+
+        E[collisions in bin j] = E[sum_n M_j(u_n)]
+
+    over the collisions of a shard, up to one collision at the ends of its recording.  This
+    is the shard's ``return_law_speed_counts`` (outgoing speeds on the fine
+    ``settings.RETURN_LAW_SPEED_BINS``) times M_j averaged over each fine bin with weight
+    u P(0, u) (``flight_time.return_speed_bin_probabilities``; the solver's P(0, u) only
+    weighs u inside a 2.3 % wide bin).  Counts minus prediction is the return-law control
+    variate of ``outgoing_speed_histogram``: mean 0 for the process of eq. (kernel3); in a
+    rare bin of P(0, v) it removes most of the counting noise, as the prediction spreads
+    each collision over every bin it can reach next.
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards, all on the same speed bins.
+    restitution : float
+        r.
+    outgoing_density : callable
+        P(0, u) of an array of u > 0 (the solver's; its normalisation does not matter).
+
+    Returns
+    -------
+    numpy.ndarray, shape (shards, speed bins)
+        The prediction for each shard and bin of ``speed_bins`` (under- and overflow
+        included).
+
+    Examples
+    --------
+    At r = 1/2 a shard whose collisions all left at u = 1 (a fine bin near 1) expects its
+    next collisions mostly between 0.1 and 10:
+
+    >>> import numpy as np
+    >>> from bouncing_ball.bins import LinearBins, LogBins
+    >>> from bouncing_ball.exact import outgoing_speed_density
+    >>> from bouncing_ball.settings import RETURN_LAW_SPEED_BINS, ShardSettings
+    >>> from bouncing_ball.tallies import ShardTallies
+    >>> from bouncing_ball.histograms import return_law_prediction
+    >>> settings = ShardSettings(
+    ...     shard_time=1.0, equilibration_time=0.0, criterion_c=5, min_step_divisor=10,
+    ...     max_steps=100, speed_bins=LogBins(0.1, 10.0, 1),
+    ... )
+    >>> arrays = ShardTallies.loop_arrays(settings)
+    >>> arrays["return_law_speed_counts"][1 + 1000] = 100  # u in [1, 1.023)
+    >>> shard = ShardTallies.from_loop(settings, arrays)
+    >>> density = lambda u: outgoing_speed_density(u, "1/2")
+    >>> prediction = return_law_prediction([shard], 0.5, density)
+    >>> print(np.round(prediction, 1), round(float(prediction.sum()), 9))
+    [[ 0.4 58.5 41.1  0. ]] 100.0
+    """
+    fine = RETURN_LAW_SPEED_BINS
+    counts = np.stack([s.return_law_speed_counts for s in shards]).astype(float)
+    occupied = np.flatnonzero(counts.sum(axis=0))
+    bins = shards[0].speed_bins
+    if occupied.size == 0:
+        return np.zeros((len(shards), bins.n + 2))
+    # the fine under- and overflow bins as the decade beyond each end
+    lower = np.maximum(fine.lower[occupied], 0.1 * fine.lo)
+    upper = np.minimum(fine.upper[occupied], 10.0 * fine.hi)
+    r = float(restitution)
+    law = return_speed_bin_probabilities(
+        outgoing_density, lower, upper, bins.lower / r, bins.upper / r, RETURN_LAW_POINTS
+    )
+    lost = ~np.all(np.isfinite(law), axis=1)  # P(0, u) of 0 all over a bin: weigh ln u evenly
+    if np.any(lost):
+        law[lost] = return_speed_bin_probabilities(
+            lambda u: u**-2.0, lower[lost], upper[lost], bins.lower / r, bins.upper / r
+        )
+    return counts[:, occupied] @ law
+
+
+def outgoing_speed_histogram(
+    shards: list[ShardTallies], restitution=None, return_law=None
+) -> pd.DataFrame:
     """P(0, v) on the outgoing side, bin averages weighted by v.
 
     Bin averages mean p0v = int_bin v P(0,v) dv / int_bin v dv (``outgoing_speed_density``,
@@ -232,6 +323,14 @@ def outgoing_speed_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
     ----------
     shards : list of ShardTallies
         The shards, all on the same speed bins.
+    restitution : float, str or fractions.Fraction, optional
+        The shards' r.  Given, and inside the solver's range
+        (``restitution.SOLVER_RESTITUTION_RANGE``), each bin's counts are also corrected by
+        its return-law control variate, counts minus ``return_law_prediction`` with the
+        solver's P(0, u) of eq. (inteq).
+    return_law : numpy.ndarray, optional
+        ``return_law_prediction`` of these shards, if already at hand (a row per shard): used
+        instead of computing it from ``restitution``.
 
     Returns
     -------
@@ -241,9 +340,10 @@ def outgoing_speed_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
         ``p0v_err``, ``count``, ``p0v_controlled``, ``p0v_controlled_err``.  The overflow bin
         has p0v = NaN; an empty bin has p0v = 0 and p0v_err = NaN (no scatter to measure).
         ``p0v_controlled`` is the same with each bin's counts corrected by the control
-        variates of ``tallies.RATE_CONTROLS`` (``control_variate_adjusted``: the same
-        expectation, less variance; NaN with fewer than ``SHARDS_PER_CONTROL`` x
-        ``len(RATE_CONTROLS)`` shards).
+        variates of ``tallies.RATE_CONTROLS`` and, given ``restitution``, the bin's
+        return-law control (``control_variate_adjusted``: the same expectation, less
+        variance; NaN with fewer than ``SHARDS_PER_CONTROL`` x the controls' number of
+        shards).
 
     Examples
     --------
@@ -258,8 +358,20 @@ def outgoing_speed_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
         return outgoing_speed_density(c, t, lower, upper)
 
     p0v, err = jackknife(density, counts, times)
-    controls = shard_controls(shards, RATE_CONTROLS)
-    controlled, controlled_err = _controlled(density, controls, times[:, 0], [counts], [times])
+    if return_law is None and restitution is not None:
+        exact = parse_restitution(restitution)
+        if in_range(exact, SOLVER_RESTITUTION_RANGE):
+            solution = solve_outgoing_speed_density(exact)
+            return_law = return_law_prediction(
+                shards, float(exact), solution.outgoing_speed_density
+            )
+    if return_law is None:
+        controls = shard_controls(shards, RATE_CONTROLS)
+        controlled, controlled_err = _controlled(density, controls, times[:, 0], [counts], [times])
+    else:
+        controlled, controlled_err = _return_law_controlled(
+            shards, counts, times, return_law, density
+        )
     total = counts.sum(axis=0)
     for value, error in ((p0v, err), (controlled, controlled_err)):
         value[~np.isfinite(upper)] = np.nan
@@ -276,6 +388,26 @@ def outgoing_speed_histogram(shards: list[ShardTallies]) -> pd.DataFrame:
             "p0v_controlled_err": controlled_err,
         }
     )
+
+
+def _return_law_controlled(shards, counts, times, return_law, density):
+    """P(0, v) and its error from counts corrected bin by bin by the return-law control of
+    the bin and, with ``SHARDS_PER_CONTROL`` shards per control for them, those of
+    ``tallies.RATE_CONTROLS`` (NaN with fewer than ``SHARDS_PER_CONTROL`` shards)."""
+    if len(shards) < SHARDS_PER_CONTROL:
+        return _controlled(density, None, times[:, 0], [counts], [times])
+    # the martingale controls too, where the shards are enough for them and the bin's own
+    rate = None
+    if len(shards) >= SHARDS_PER_CONTROL * (len(RATE_CONTROLS) + 1):
+        rate = shard_controls(shards, RATE_CONTROLS)
+    adjusted = counts.astype(float)
+    surprise = counts - return_law
+    for j in range(counts.shape[1]):
+        own = surprise[:, j : j + 1] if np.ptp(surprise[:, j]) > 0 else np.empty((len(shards), 0))
+        controls = own if rate is None else np.column_stack([own, rate])
+        if controls.shape[1]:  # else a bin no shard reached or could reach: as it is
+            adjusted[:, j] = control_variate_adjusted(counts[:, j], times[:, 0], controls)[0]
+    return jackknife(density, adjusted, times)
 
 
 def position_histogram(shards: list[ShardTallies]) -> pd.DataFrame:

@@ -331,7 +331,7 @@ class SimulationResult:
     def p0v(self):
         from .histograms import outgoing_speed_histogram
 
-        return outgoing_speed_histogram(list(self.tallies))
+        return outgoing_speed_histogram(list(self.tallies), self.restitution)
 
     @cached_property
     def position(self):

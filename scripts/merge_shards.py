@@ -55,7 +55,7 @@ with job_log(snakemake.log[0]):
     summary = position_moments_summary(shards, float(exact))
     write_tables(
         {
-            snakemake.output.p0v: outgoing_speed_histogram(shards),
+            snakemake.output.p0v: outgoing_speed_histogram(shards, exact),
             snakemake.output.position: position_histogram(shards),
             snakemake.output.distribution: distribution_histogram(shards),
             snakemake.output.flight_time: flight_time_histogram(shards),

@@ -16,6 +16,7 @@ from shard_statistics import CRITERION_C, outgoing_speed_bins, simulate_shards
 from bouncing_ball import exact
 from bouncing_ball.comparison import sign_flip_test
 from bouncing_ball.histograms import (
+    outgoing_speed_histogram,
     position_histogram,
     position_moments_summary,
 )
@@ -100,6 +101,26 @@ def test_outgoing_speed_density_rejects_a_small_error(shards, r):
     wrong = (1.0 + OUTGOING_SPEED_POWER[r]) * exact.outgoing_speed_bin_average(lower, upper, r)
     _, p_chi2, _ = sign_flip_test(per_shard - wrong)
     assert p_chi2 < 1e-3
+
+
+@pytest.mark.parametrize("r", list(TIME_AVERAGES), ids=str)
+def test_outgoing_speed_density_with_the_return_law_control(shards, r):
+    """P(0, v) corrected by its return-law control (``p0v_controlled``,
+    histograms.return_law_prediction, which uses eq. (kernel3) and the solver's P(0, u) only
+    to weigh u inside a fine bin) against eq. (P(0,v)) in every bin with 0.01 <= v <= 5:
+    every |z| < 5 (with 16 shards z is t-distributed with 15 degrees of freedom: a false
+    alarm in about 0.5% of runs over 27 bins), and the worst relative error at most half
+    the plain estimator's.  Smallest error rejected: 5 times the largest relative error
+    (asserted at most 1%), 5%."""
+    table = outgoing_speed_histogram(shards[r], r)
+    band = table[(table.v >= 0.01) & (table.v <= 5.0)]
+    truth = exact.outgoing_speed_bin_average(band.v_lo.to_numpy(), band.v_hi.to_numpy(), r)
+    relative = (band.p0v_controlled_err / band.p0v_controlled).to_numpy()
+    plain = (band.p0v_err / band.p0v).to_numpy()
+    assert relative.max() <= 0.01, f"run too short for a sharp test: {relative.max():.4f}"
+    assert relative.max() <= 0.5 * plain.max(), (relative.max(), plain.max())
+    z = (band.p0v_controlled.to_numpy() - truth) / band.p0v_controlled_err.to_numpy()
+    assert np.abs(z).max() < 5.0, np.round(z, 2)
 
 
 def _position_bins_up_to_50(table):

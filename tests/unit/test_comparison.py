@@ -146,9 +146,17 @@ def _simulated_bins(restitution, sigma, rng, lo=1e-3, hi=10.0, per_decade=10):
             "p0v": truth + errors * rng.standard_normal(len(truth)),
             "p0v_err": errors,
             "count": 1000,
+            "p0v_controlled": truth + errors / 3 * rng.standard_normal(len(truth)),
+            "p0v_controlled_err": errors / 3,
         }
     )
-    frame.loc[5, ["p0v", "p0v_err", "count"]] = [0.0, np.nan, 0]
+    frame.loc[5, ["p0v", "p0v_err", "count", "p0v_controlled", "p0v_controlled_err"]] = [
+        0.0,
+        np.nan,
+        0,
+        0.0,
+        np.nan,
+    ]
     edge_rows = pd.DataFrame(
         {
             "v_lo": [0.0, hi],
@@ -157,6 +165,8 @@ def _simulated_bins(restitution, sigma, rng, lo=1e-3, hi=10.0, per_decade=10):
             "p0v": [1.0, np.nan],
             "p0v_err": [0.1, np.nan],
             "count": [10, 0],
+            "p0v_controlled": [1.0, np.nan],
+            "p0v_controlled_err": [0.1, np.nan],
         }
     )
     return pd.concat([edge_rows.iloc[:1], frame, edge_rows.iloc[1:]], ignore_index=True), truth
@@ -505,8 +515,8 @@ def _synthetic_shards(restitution, shards, rng, relative_noise=0.04, bias=0.0):
 
 @pytest.mark.parametrize("restitution", exact.EXACT_RESTITUTIONS)
 def test_validation_chi2_rows_get_a_sign_flip_p_value_from_the_shards(restitution):
-    """Shards at the exact solution: every chi^2/n row has a p_sign_flip in (0, 1], not
-    below 1e-3, and the sign flips' chi^2/n of the shards' shares is the table's to first
+    """Shards at the exact solution: every chi^2/n row of a plain estimate has a p_sign_flip
+    in (0, 1], not below 1e-3, and the sign flips' chi^2/n of the shards' shares is the table's to first
     order; the other rows have none.  P(0, v) 5% high (5 standard errors a bin): its p drops
     below 1e-3."""
     rng = np.random.default_rng(25)
@@ -522,8 +532,14 @@ def test_validation_chi2_rows_get_a_sign_flip_p_value_from_the_shards(restitutio
             per_shard=shard_ratios(shards),
         )
     )
-    chi2_rows = [check for check in rows.index if check.endswith("chi2_per_bin")]
+    chi2_rows = [
+        check
+        for check in rows.index
+        if check.endswith("chi2_per_bin") and not check.startswith("p0v_controlled")
+    ]
     assert chi2_rows == ["p0v_chi2_per_bin", "px_chi2_per_bin", "v2_given_x_chi2_per_bin"]
+    # the controlled P(0, v) has no per-shard shares to flip: its rows have no p
+    assert "p0v_controlled_chi2_per_bin" in rows.index
     for check in chi2_rows:
         assert 1e-3 < rows.loc[check, "p_sign_flip"] <= 1.0, check
         assert "sign flips of the 16 shards" in rows.loc[check, "detail"]

@@ -1,0 +1,82 @@
+"""The return-law prediction of P(0, v) (``histograms.return_law_prediction``) against the
+exact solutions: fed the exact equilibrium's outgoing speeds, it gives back the exact
+collisions per speed bin, eq. (inteq) being the balance it rests on."""
+
+import dataclasses
+from fractions import Fraction
+
+import numpy as np
+import pytest
+from scipy import integrate
+
+from bouncing_ball import exact
+from bouncing_ball.histograms import return_law_prediction
+from bouncing_ball.settings import RETURN_LAW_SPEED_BINS, ShardSettings
+from bouncing_ball.tallies import ShardTallies
+
+SETTINGS = ShardSettings(
+    shard_time=1.0, equilibration_time=0.0, criterion_c=3, min_step_divisor=10, max_steps=100
+)
+# the rate of collisions is int u P(0, u) du, eq. (collrate); scaled up to counts
+SCALE = 1e12
+
+
+def _collision_rate(density, lower, upper):
+    """int u P(0, u) du over each bin (an underflow bin from 1e-14, an overflow to 1e4)."""
+    lower, upper = np.maximum(lower, 1e-14), np.minimum(upper, 1e4)
+    nodes, weights = np.polynomial.legendre.leggauss(8)
+    half = 0.5 * np.log(upper / lower)[:, None]
+    u = np.exp(half * nodes + 0.5 * np.log(upper * lower)[:, None])
+    return np.sum(u * u * density(u) * half * weights, axis=1)
+
+
+def _equilibrium_shard(density):
+    """A shard whose fine outgoing-speed counts are the equilibrium's expectation."""
+    fine = RETURN_LAW_SPEED_BINS
+    counts = SCALE * _collision_rate(density, fine.lower, fine.upper)
+    empty = ShardTallies.from_loop(SETTINGS, ShardTallies.loop_arrays(SETTINGS))
+    return dataclasses.replace(empty, return_law_speed_counts=counts)
+
+
+@pytest.mark.parametrize("r", exact.EXACT_RESTITUTIONS, ids=str)
+def test_equilibrium_outgoing_speeds_predict_the_exact_bins(r):
+    """Between v = 1e-3 and 10 every speed bin's prediction is the exact rate of eq. (P(0,v))
+    to 1e-6 relative (the quadratures' accuracy; a wrong r or kernel is off by percents)."""
+
+    def density(u):
+        return exact.outgoing_speed_density(u, r)
+
+    predicted = return_law_prediction([_equilibrium_shard(density)], float(r), density)[0]
+    bins = SETTINGS.speed_bins
+    expected = SCALE * np.array(
+        [
+            integrate.quad(lambda u: u * density(np.array([u]))[0], a, b, epsrel=1e-12)[0]
+            for a, b in zip(bins.lower, np.minimum(bins.upper, 1e4))
+        ]
+    )
+    centre = np.sqrt(bins.lower * bins.upper)
+    inside = (centre > 1e-3) & (centre < 10.0)
+    np.testing.assert_allclose(predicted[inside], expected[inside], rtol=1e-6)
+
+
+def test_another_restitution_predicts_other_bins():
+    """The prediction is sharp: the r = 1/2 equilibrium's speeds pushed through the law with
+    r = 0.45 miss the r = 1/2 bins by more than 1% somewhere in 1e-3 < v < 10."""
+    r = Fraction(1, 2)
+
+    def density(u):
+        return exact.outgoing_speed_density(u, r)
+
+    shard = _equilibrium_shard(density)
+    right = return_law_prediction([shard], 0.5, density)[0]
+    wrong = return_law_prediction([shard], 0.45, density)[0]
+    bins = SETTINGS.speed_bins
+    centre = np.sqrt(bins.lower * bins.upper)
+    inside = (centre > 1e-3) & (centre < 10.0)
+    assert np.max(np.abs(wrong[inside] / right[inside] - 1.0)) > 0.01
+
+
+def test_no_collisions_predict_none():
+    empty = ShardTallies.from_loop(SETTINGS, ShardTallies.loop_arrays(SETTINGS))
+    prediction = return_law_prediction([empty, empty], 0.5, lambda u: np.ones_like(u))
+    assert prediction.shape == (2, SETTINGS.speed_bins.n + 2) and not prediction.any()
