@@ -48,10 +48,17 @@ True
 3  10.0   inf       NaN      0
 """
 
+import functools
+
 import numpy as np
 import pandas as pd
 
-from .flight_time import return_speed_bin_probabilities
+from .flight_time import (
+    _log_gauss,
+    flight_time_second_moment_given_speed,
+    mean_flight_time_given_speed,
+    return_speed_bin_probabilities,
+)
 from .restitution import SOLVER_RESTITUTION_RANGE, in_range, parse_restitution
 from .settings import RETURN_LAW_SPEED_BINS
 from .solver import solve_outgoing_speed_density
@@ -71,6 +78,7 @@ __all__ = [
     "outgoing_speed_density",
     "RETURN_LAW_POINTS",
     "return_law_prediction",
+    "flight_law_prediction",
     "outgoing_speed_histogram",
     "position_histogram",
     "distribution_histogram",
@@ -158,26 +166,43 @@ def shard_controls(shards, names):
     return np.array([[getattr(s, name) for name in names] for s in shards], dtype=float)
 
 
-def moment_controls(shards):
+def moment_controls(shards, flight_law=None):
     """The control sums of the summary's moments, as many as the shards can fit.
 
     Parameters
     ----------
     shards : list of ShardTallies
         The shards.
+    flight_law : numpy.ndarray, optional
+        ``flight_law_prediction`` of the shards: the flight-law controls, each shard's sums
+        of T and T^2 less their prediction, join the martingale sums.
 
     Returns
     -------
     numpy.ndarray or None
-        ``shard_controls`` of ``tallies.MOMENT_CONTROLS`` where the shards are enough to fit
-        their slopes, else of the fewer ``tallies.RATE_CONTROLS``, else None.
+        The first of ``tallies.MOMENT_CONTROLS`` with the flight-law controls,
+        ``MOMENT_CONTROLS``, the fewer ``tallies.RATE_CONTROLS`` with the flight-law
+        controls, ``RATE_CONTROLS``, that the shards are enough to fit
+        (``SHARDS_PER_CONTROL`` per control), else None.
 
     Examples
     --------
     See the module's example: two shards are too few for any control.
     """
-    controls = shard_controls(shards, MOMENT_CONTROLS)
-    return controls if controls is not None else shard_controls(shards, RATE_CONTROLS)
+    extra = None
+    if flight_law is not None:
+        sums = np.array([[s.flight_time_sum, s.flight_time_squared_sum] for s in shards])
+        extra = sums - np.asarray(flight_law, dtype=float)
+    for names in (MOMENT_CONTROLS, RATE_CONTROLS):
+        for with_flights in (True, False):
+            if with_flights and extra is None:
+                continue
+            wanted = len(names) + (extra.shape[1] if with_flights else 0)
+            if len(shards) < SHARDS_PER_CONTROL * wanted:
+                continue
+            controls = shard_controls(shards, names)
+            return np.column_stack([controls, extra]) if with_flights else controls
+    return None
 
 
 def _controlled(estimator, controls, times, adjusted, fixed=()):
@@ -226,6 +251,25 @@ def outgoing_speed_density(counts, time, lower, upper):
     1.0
     """
     return counts / (time * 0.5 * (upper**2 - lower**2))
+
+
+@functools.lru_cache(maxsize=8)
+def _solver_outgoing_density(exact):
+    """The solver's P(0, u) of eq. (inteq) at the exact r, or None outside its range."""
+    if not in_range(exact, SOLVER_RESTITUTION_RANGE):
+        return None
+    return solve_outgoing_speed_density(exact).outgoing_speed_density
+
+
+def _occupied_fine_bins(shards):
+    """The shards' ``return_law_speed_counts`` in the fine bins any shard reached, and those
+    bins' edges (the fine under- and overflow bins as the decade beyond each end)."""
+    fine = RETURN_LAW_SPEED_BINS
+    counts = np.stack([s.return_law_speed_counts for s in shards]).astype(float)
+    occupied = np.flatnonzero(counts.sum(axis=0))
+    lower = np.maximum(fine.lower[occupied], 0.1 * fine.lo)
+    upper = np.minimum(fine.upper[occupied], 10.0 * fine.hi)
+    return counts[:, occupied], lower, upper
 
 
 #: Gauss-Legendre points in ln u per fine bin of ``settings.RETURN_LAW_SPEED_BINS`` (2.3 %
@@ -290,15 +334,10 @@ def return_law_prediction(shards: list[ShardTallies], restitution: float, outgoi
     >>> print(np.round(prediction, 1), round(float(prediction.sum()), 9))
     [[ 0.4 58.5 41.1  0. ]] 100.0
     """
-    fine = RETURN_LAW_SPEED_BINS
-    counts = np.stack([s.return_law_speed_counts for s in shards]).astype(float)
-    occupied = np.flatnonzero(counts.sum(axis=0))
+    counts, lower, upper = _occupied_fine_bins(shards)
     bins = shards[0].speed_bins
-    if occupied.size == 0:
+    if lower.size == 0:
         return np.zeros((len(shards), bins.n + 2))
-    # the fine under- and overflow bins as the decade beyond each end
-    lower = np.maximum(fine.lower[occupied], 0.1 * fine.lo)
-    upper = np.minimum(fine.upper[occupied], 10.0 * fine.hi)
     r = float(restitution)
     law = return_speed_bin_probabilities(
         outgoing_density, lower, upper, bins.lower / r, bins.upper / r, RETURN_LAW_POINTS
@@ -308,7 +347,69 @@ def return_law_prediction(shards: list[ShardTallies], restitution: float, outgoi
         law[lost] = return_speed_bin_probabilities(
             lambda u: u**-2.0, lower[lost], upper[lost], bins.lower / r, bins.upper / r
         )
-    return counts[:, occupied] @ law
+    return counts @ law
+
+
+def flight_law_prediction(shards: list[ShardTallies], outgoing_density) -> np.ndarray:
+    """Each shard's expected sums of the flight times T and T^2, given its outgoing speeds.
+
+    A flight that leaves the floor at speed u lasts T with mean E[T | u], eq. (meanT), and
+    second moment E[T^2 | u], eq. (meanT2).  Summed over a shard's collisions (its
+    ``return_law_speed_counts``, each fine bin's E averaged over it with weight u P(0, u) as
+    in ``return_law_prediction``) they have the expectation of the shard's
+    ``flight_time_sum`` and ``flight_time_squared_sum``, up to one flight at the ends of its
+    recording.  The differences are the flight-law control variates of
+    ``position_moments_summary``.
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards.
+    outgoing_density : callable
+        P(0, u) of an array of u > 0 (the solver's; its normalisation does not matter).
+
+    Returns
+    -------
+    numpy.ndarray, shape (shards, 2)
+        The predicted sum of T and of T^2 of each shard.
+
+    Examples
+    --------
+    100 flights leaving at u in [1, 1.023) last about 100 E[T | 1] = 315 in all:
+
+    >>> import dataclasses
+    >>> import numpy as np
+    >>> from bouncing_ball.exact import outgoing_speed_density
+    >>> from bouncing_ball.settings import ShardSettings
+    >>> from bouncing_ball.tallies import ShardTallies
+    >>> from bouncing_ball.histograms import flight_law_prediction
+    >>> settings = ShardSettings(
+    ...     shard_time=1.0, equilibration_time=0.0, criterion_c=5, min_step_divisor=10,
+    ...     max_steps=100,
+    ... )
+    >>> arrays = ShardTallies.loop_arrays(settings)
+    >>> arrays["return_law_speed_counts"][1 + 1000] = 100  # u in [1, 1.023)
+    >>> shard = ShardTallies.from_loop(settings, arrays)
+    >>> density = lambda u: outgoing_speed_density(u, "1/2")
+    >>> print(np.round(flight_law_prediction([shard], density), 1))
+    [[ 317.8 2294.7]]
+    """
+    counts, lower, upper = _occupied_fine_bins(shards)
+    if lower.size == 0:
+        return np.zeros((len(shards), 2))
+    u, weights = _log_gauss(lower, upper, RETURN_LAW_POINTS)
+    flux = u * outgoing_density(u) * weights
+    lost = ~(np.sum(flux, axis=1) > 0.0)  # P(0, u) of 0 all over a bin: weigh ln u evenly
+    flux[lost] = weights[lost] / u[lost]
+    flux /= flux.sum(axis=1)[:, None]
+    moments = np.stack(
+        [
+            np.sum(flux * mean_flight_time_given_speed(u), axis=1),
+            np.sum(flux * flight_time_second_moment_given_speed(u), axis=1),
+        ],
+        axis=1,
+    )
+    return counts @ moments
 
 
 def outgoing_speed_histogram(
@@ -360,11 +461,9 @@ def outgoing_speed_histogram(
     p0v, err = jackknife(density, counts, times)
     if return_law is None and restitution is not None:
         exact = parse_restitution(restitution)
-        if in_range(exact, SOLVER_RESTITUTION_RANGE):
-            solution = solve_outgoing_speed_density(exact)
-            return_law = return_law_prediction(
-                shards, float(exact), solution.outgoing_speed_density
-            )
+        density = _solver_outgoing_density(exact)
+        if density is not None:
+            return_law = return_law_prediction(shards, float(exact), density)
     if return_law is None:
         controls = shard_controls(shards, RATE_CONTROLS)
         controlled, controlled_err = _controlled(density, controls, times[:, 0], [counts], [times])
@@ -623,18 +722,20 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
     second moment per flight.  Each is given twice: plain (the time averages, collisions per
     time, the flights' averages) and ``*_controlled`` (the moments of
     ``CONTROLLED_MOMENTS`` and I), the same with each sum (the collisions, int x dt,
-    int x^2 dt, the flights, sum T, sum T^2) corrected by martingale control variates of mean
-    0 before the ratio (``control_variate_adjusted``: the same expectation, less variance),
-    those of ``moment_controls``: ``tallies.MOMENT_CONTROLS`` or the fewer
-    ``tallies.RATE_CONTROLS``, as many as the shards can fit (``shard_controls``), none (NaN)
-    with too few shards.
+    int x^2 dt, the flights, sum T, sum T^2) corrected by control variates of mean 0 before
+    the ratio (``control_variate_adjusted``: the same expectation, less variance), those of
+    ``moment_controls``: the martingale sums ``tallies.MOMENT_CONTROLS`` or the fewer
+    ``tallies.RATE_CONTROLS``, and where r is in the solver's range the flight-law controls
+    (``flight_law_prediction``), as many as the shards can fit (``shard_controls``), none
+    (NaN) with too few shards.
 
     Parameters
     ----------
     shards : list of ShardTallies
         The shards.
-    restitution : float
-        The restitution coefficient r of the shards, written in column ``r``.
+    restitution : float, str or fractions.Fraction
+        The restitution coefficient r of the shards, written in column ``r``; the solver's
+        P(0, u) at r weighs the fine bins of the flight-law controls.
 
     Returns
     -------
@@ -655,7 +756,9 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
     mean_x, mean_x_err = jackknife(_mean_x, int_x, time)
     delta_x, delta_x_err = jackknife(_delta_x, int_x, int_x2, time)
     rate, rate_err = jackknife(lambda c, t: c / t, collisions, time)
-    controls = moment_controls(shards)
+    density = _solver_outgoing_density(parse_restitution(restitution))
+    flight_law = None if density is None else flight_law_prediction(shards, density)
+    controls = moment_controls(shards, flight_law)
     controlled, controlled_err = _controlled(
         lambda c, t: c / t, controls, time, [collisions], [time]
     )
