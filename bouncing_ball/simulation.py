@@ -139,7 +139,7 @@ from .free_flight import (
     speed_squared_coefficients,
     whole_step_integrals,
 )
-from .jit import njit
+from .jit import fma, njit
 from .pcg64 import next_double, standard_normal, stream_words
 from .settings import RETURN_LAW_SPEED_BINS, ShardSettings
 from .tallies import EARLY_FRACTION, SCALAR_INDEX, ShardTallies, tally_seed_sequence
@@ -682,7 +682,7 @@ def _run(
         if steps >= max_steps:
             exhausted = 1
             break
-        dt = root * root + delta  # eq. (criterion) plus delta
+        dt = fma(root, root, delta)  # eq. (criterion) plus delta
         if not dt > COLLAPSED_STEP:  # below r_c without a floor on delta: the speed is going to 0
             exhausted = 1
             break

@@ -19,8 +19,10 @@
  * operation is the same as in the Python source and in the same order (same
  * parenthesisation, same constants, ``np.cbrt`` -> cbrt, ``math.log`` -> log,
  * Python's min/max -> py_min/py_max, which keep Python's choice between equal
- * arguments), so with the FMA contraction switched off (numba does not fuse
- * multiply-adds) it gives bit-identical tallies.  Where Python returns a tuple
+ * arguments, ``jit.fma`` -> fma, the correctly rounded fused multiply-add both
+ * give), so with the compiler's own contraction switched off (numba fuses a
+ * multiply-add only where the source calls ``fma``) it gives bit-identical
+ * tallies.  Where Python returns a tuple
  * the C returns a struct (piece_inverse) or the first value with the second
  * through a pointer (tally_position and tally_step, whose (k, k_s, k_s2) are the
  * bin of the step's end and the bins its mean-path assignment gives the bridge
@@ -102,8 +104,9 @@ static inline void free_flight_step(double x, double v, double dt, double normal
                                     double *x_new, double *v_new)
 {
     double root_2dt = sqrt(2.0 * dt);
-    *x_new = x + v * dt - 0.5 * dt * dt + dt * root_2dt * SQRT1_12 * (normal_s + SQRT3 * normal_r);
-    *v_new = v - dt + root_2dt * normal_r;
+    double position_noise = SQRT1_12 * fma(SQRT3, normal_r, normal_s);
+    *x_new = fma(dt, fma(root_2dt, position_noise, fma(-0.5, dt, v)), x);
+    *v_new = fma(root_2dt, normal_r, v - dt);
 }
 
 /* _floor_root: s* at x = 0, the root of s^2 (v - c s - s^2/2), 0 for v <= 0 */
@@ -142,8 +145,8 @@ static inline double criterion_root(double x, double v, double c, double start, 
     int i = 0;
     for (;;) {
         double s2 = s * s;
-        double f = x + s2 * (v - s * (c + 0.5 * s));
-        double f1 = s * (2.0 * v - s * (3.0 * c + 2.0 * s));
+        double f = fma(s2, fma(-s, fma(0.5, s, c), v), x);
+        double f1 = s * fma(-s, fma(2.0, s, 3.0 * c), 2.0 * v);
         if (!(f1 < 0.0) || i == 60) {
             if (fitted) { /* from the fitted start: only on underflow */
                 *slope_out = f1;
@@ -154,13 +157,13 @@ static inline double criterion_root(double x, double v, double c, double start, 
             i = 0;
             continue;
         }
-        double f2 = 2.0 * v - s * (6.0 * c + 6.0 * s);
-        double f3 = -6.0 * c - 12.0 * s;
+        double f2 = fma(-s, fma(6.0, s, 6.0 * c), 2.0 * v);
+        double f3 = fma(-12.0, s, -6.0 * c);
         double f_f2 = f * f2;
-        double f1_squared = f1 * f1;
-        double denominator = f1 * (6.0 * f1_squared - 6.0 * f_f2) + f * f * f3;
+        double six_f1_squared = 6.0 * (f1 * f1);
+        double denominator = fma(f1, fma(-6.0, f_f2, six_f1_squared), f * f * f3);
         /* Householder where its denominator is negative, else Newton */
-        double step = denominator < 0.0 ? f * (6.0 * f1_squared - 3.0 * f_f2) / denominator : f / f1;
+        double step = denominator < 0.0 ? f * fma(-3.0, f_f2, six_f1_squared) / denominator : f / f1;
         i += 1;
         if (!(s - step > 0.0)) { /* overshot past 0: halve instead (f(0) = x > 0) */
             s *= 0.5;
@@ -233,11 +236,11 @@ static inline void mean_path_integrals(double a0, double a1, double a2, double a
 static inline void whole_step_integrals(double x0, double v0, double x1, double v1, double dt,
                                         double *int_x_out, double *int_x2_out)
 {
-    *int_x_out = dt * (0.5 * (x0 + x1) + dt * (1.0 / 12.0) * (v0 - v1));
-    double m0 = (13.0 / 35.0) * (x0 * x0 + x1 * x1) + (9.0 / 35.0) * (x0 * x1);
-    double m1 = (11.0 / 105.0) * (x0 * v0 - x1 * v1) + (13.0 / 210.0) * (x1 * v0 - x0 * v1);
-    double m2 = (1.0 / 105.0) * (v0 * v0 + v1 * v1) - (1.0 / 70.0) * (v0 * v1);
-    *int_x2_out = dt * (m0 + dt * (m1 + dt * (m2 + dt * (1.0 / 210.0))));
+    *int_x_out = dt * fma(dt * (1.0 / 12.0), v0 - v1, 0.5 * (x0 + x1));
+    double m0 = fma(13.0 / 35.0, fma(x0, x0, x1 * x1), (9.0 / 35.0) * (x0 * x1));
+    double m1 = fma(11.0 / 105.0, fma(x0, v0, -(x1 * v1)), (13.0 / 210.0) * fma(x1, v0, -(x0 * v1)));
+    double m2 = fma(1.0 / 105.0, fma(v0, v0, v1 * v1), -(1.0 / 70.0) * (v0 * v1));
+    *int_x2_out = dt * fma(dt, fma(dt, fma(dt, 1.0 / 210.0, m2), m1), m0);
 }
 
 typedef struct {
@@ -748,7 +751,7 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
             exhausted = 1;
             break;
         }
-        double dt = root * root + delta; /* eq. (criterion) plus delta */
+        double dt = fma(root, root, delta); /* eq. (criterion) plus delta */
         if (!(dt > COLLAPSED_STEP)) { /* below r_c without a floor on delta */
             exhausted = 1;
             break;
@@ -760,7 +763,7 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
            = k0 - k1 x1 - k2 v1, with coefficients ready (division included) before the step */
         double k1 = slope_at_root < 0.0 ? 1.0 / slope_at_root : 0.0;
         double k2 = k1 * root * root;
-        double k0 = root + k1 * x + k2 * v;
+        double k0 = fma(k2, v, fma(k1, x, root));
         double normal_r = random_standard_normal(rng);
         double normal_s = random_standard_normal(rng);
         double x1, v1;
@@ -888,7 +891,7 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
         } else {
             x = x1;
             v = v1;
-            double predicted = k0 - k1 * x1 - k2 * v1;
+            double predicted = fma(-k2, v1, fma(-k1, x1, k0));
             root = criterion_root(x, v, c, predicted > 0.0 ? predicted : root, &slope_at_root);
         }
     }
