@@ -254,15 +254,17 @@ def fma(a, b, c):
     (0.0, True)
     """
     a, b, c = float(a), float(b), float(c)
-    if not (math.isfinite(a) and math.isfinite(b) and math.isfinite(c)):
-        return a * b + c  # an infinity or a NaN in: the same infinity or NaN out
+    if not (math.isfinite(a) and math.isfinite(b)):
+        return a * b + c  # the product is an infinity or a NaN: so is a b + c
+    if not math.isfinite(c):
+        return c  # a finite product (however large) added to an infinity or a NaN
     exact = Fraction(a) * Fraction(b) + Fraction(c)
     if exact == 0:
         return a * b + c  # a b = -c exactly: IEEE 754's sign of a zero sum
     try:
         return float(exact)  # int / int: correctly rounded
     except OverflowError:
-        return math.copysign(math.inf, exact)
+        return math.inf if exact > 0 else -math.inf
 
 
 @intrinsic
