@@ -331,7 +331,7 @@ def hermite_cubic(x0, v0, x1, v1, dt):
 
 @njit(cache=True)
 def cubic_value(a0, a1, a2, a3, t):
-    """The mean path m(t) = a0 + a1 t + a2 t^2 + a3 t^3 (Horner).
+    """The mean path m(t) = a0 + a1 t + a2 t^2 + a3 t^3 (Horner, in fused multiply-adds).
 
     Parameters
     ----------
@@ -350,12 +350,13 @@ def cubic_value(a0, a1, a2, a3, t):
     >>> cubic_value.py_func(1.0, 0.0, -0.5, 0.0, 1.0)
     0.5
     """
-    return a0 + t * (a1 + t * (a2 + t * a3))
+    return fma(t, fma(t, fma(t, a3, a2), a1), a0)
 
 
 @njit(cache=True)
 def cubic_slope(a1, a2, a3, t):
-    """The mean path's slope m'(t) = a1 + 2 a2 t + 3 a3 t^2: the mean velocity.
+    """The mean path's slope m'(t) = a1 + 2 a2 t + 3 a3 t^2: the mean velocity (Horner, in
+    fused multiply-adds).
 
     Parameters
     ----------
@@ -368,7 +369,7 @@ def cubic_slope(a1, a2, a3, t):
     -------
     float
     """
-    return a1 + t * (2.0 * a2 + t * 3.0 * a3)
+    return fma(t, fma(3.0 * t, a3, 2.0 * a2), a1)
 
 
 @njit(cache=True)
@@ -610,7 +611,7 @@ def speed_squared_coefficients(a1, a2, a3, dt):
 
 @njit(cache=True)
 def quintic_antiderivative_value(s1, s2, s3, s4, s5, t):
-    """S(t) = t (s1 + t (s2 + t (s3 + t (s4 + t s5)))) (Horner).
+    """S(t) = t (s1 + t (s2 + t (s3 + t (s4 + t s5)))) (Horner, in fused multiply-adds).
 
     Parameters
     ----------
@@ -623,7 +624,7 @@ def quintic_antiderivative_value(s1, s2, s3, s4, s5, t):
     -------
     float
     """
-    return t * (s1 + t * (s2 + t * (s3 + t * (s4 + t * s5))))
+    return t * fma(t, fma(t, fma(t, fma(t, s5, s4), s3), s2), s1)
 
 
 @njit(cache=True, inline="always")

@@ -190,12 +190,12 @@ static inline void hermite_cubic(double x0, double v0, double x1, double v1, dou
 
 static inline double cubic_value(double a0, double a1, double a2, double a3, double t)
 {
-    return a0 + t * (a1 + t * (a2 + t * a3));
+    return fma(t, fma(t, fma(t, a3, a2), a1), a0);
 }
 
 static inline double cubic_slope(double a1, double a2, double a3, double t)
 {
-    return a1 + t * (2.0 * a2 + t * 3.0 * a3);
+    return fma(t, fma(3.0 * t, a3, 2.0 * a2), a1);
 }
 
 static inline void mean_path_integrals(double a0, double a1, double a2, double a3, double dt,
@@ -262,7 +262,7 @@ static inline quintic speed_squared_coefficients(double a1, double a2, double a3
 static inline double quintic_antiderivative_value(double s1, double s2, double s3, double s4,
                                                   double s5, double t)
 {
-    return t * (s1 + t * (s2 + t * (s3 + t * (s4 + t * s5))));
+    return t * fma(t, fma(t, fma(t, fma(t, s5, s4), s3), s2), s1);
 }
 
 /* piece_inverse: what level_time needs of a monotone piece (Python returns the 7-tuple
