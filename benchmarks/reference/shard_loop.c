@@ -11,7 +11,7 @@
  *       level_time_one_step, level_time, cubic_level_time, slope_zeros,
  *       monotone_piece_end, first_crossing_time, bridge_sample,
  *       bridge_speed_squared_given_position
- *   bouncing_ball/simulation.py: _bin_index, _linear_bin_index, _walked_bin_index,
+ *   bouncing_ball/simulation.py: _bin_index, _log_bin_index, _linear_bin_index, _walked_bin_index,
  *       _tally_position, _tally_step, _bridge_correction, floor_stratum_end,
  *       _tally_second_bridge_point, _run
  *
@@ -477,14 +477,15 @@ static inline int64_t linear_bin_index(double value, double lo, double per_unit,
     return k + 1;
 }
 
-static inline int64_t bin_index(double value, double log_lo, double per_ln, int64_t n,
-                                const double *edges)
+/* _log_bin_index: bin_index given log(value), or an estimate of it (the edges decide) */
+static inline int64_t log_bin_index(double value, double log_value, double log_lo, double per_ln,
+                                    int64_t n, const double *edges)
 {
     if (value < edges[0])
         return 0;
     if (value >= edges[n])
         return n + 1;
-    int64_t k = (int64_t)((log(value) - log_lo) * per_ln);
+    int64_t k = (int64_t)((log_value - log_lo) * per_ln);
     if (k < 0)
         k = 0;
     if (k > n - 1)
@@ -495,6 +496,16 @@ static inline int64_t bin_index(double value, double log_lo, double per_ln, int6
     while (k < n - 1 && value >= edges[k + 1])
         k += 1;
     return k + 1;
+}
+
+static inline int64_t bin_index(double value, double log_lo, double per_ln, int64_t n,
+                                const double *edges)
+{
+    if (value < edges[0])
+        return 0;
+    if (value >= edges[n])
+        return n + 1;
+    return log_bin_index(value, log(value), log_lo, per_ln, n, edges);
 }
 
 /* floor_stratum_end: t_low = FLOOR_STRATUM_HEIGHT / v in a step that starts at the floor with
@@ -663,6 +674,7 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
     double u_per_unit = (double)nu / (u_edges[nu] - u_lo);
     double f_log_lo = log(f_edges[0]);
     double f_per_ln = (double)nf / (log(f_edges[nf]) - f_log_lo);
+    double log_restitution = log(restitution);
     double w_log_lo = log(w_edges[0]);
     double w_per_ln = (double)nw / (log(w_edges[nw]) - w_log_lo);
     /* the two ends of every x bin, the under- and overflow bins unbounded */
@@ -865,18 +877,21 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
         if (collided) {
             double v_in = fabs(v_tau);
             double v_out = restitution * v_in; /* eq. (restitution) */
-            int64_t out_bin = bin_index(v_out, v_log_lo, v_per_ln, nv, v_edges);
+            double log_v_out = log(v_out); /* the bins of v_out, and of v_in = v_out / r, from it */
+            int64_t out_bin = log_bin_index(v_out, log_v_out, v_log_lo, v_per_ln, nv, v_edges);
             if (recording) {
                 collisions += 1;
                 speed_counts[out_bin] += 1;
-                return_law_speed_counts[bin_index(v_out, w_log_lo, w_per_ln, nw, w_edges)] += 1;
+                return_law_speed_counts[log_bin_index(v_out, log_v_out, w_log_lo, w_per_ln, nw,
+                                                      w_edges)] += 1;
                 if (collided_before) { /* the flight that ends here (parts & FLIGHTS: always) */
                     flights += 1;
                     flight_time_sum += since_collision;
                     flight_time_squared_sum += since_collision * since_collision;
                     flight_time_counts[bin_index(since_collision, f_log_lo, f_per_ln, nf, f_edges)] += 1;
                     return_speed_counts[last_out_bin * (nv + 2)
-                                        + bin_index(v_in, v_log_lo, v_per_ln, nv, v_edges)] += 1;
+                                        + log_bin_index(v_in, log_v_out - log_restitution,
+                                                        v_log_lo, v_per_ln, nv, v_edges)] += 1;
                 }
             }
             collided_before = 1;
