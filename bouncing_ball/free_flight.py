@@ -355,8 +355,9 @@ def cubic_value(a0, a1, a2, a3, t):
 
 @njit(cache=True)
 def cubic_slope(a1, a2, a3, t):
-    """The mean path's slope m'(t) = a1 + 2 a2 t + 3 a3 t^2: the mean velocity (Horner, in
-    fused multiply-adds).
+    """The mean path's slope m'(t) = a1 + 2 a2 t + 3 a3 t^2: the mean velocity.
+
+    By Horner's rule in fused multiply-adds, as ``cubic_value``.
 
     Parameters
     ----------
