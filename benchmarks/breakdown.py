@@ -27,7 +27,7 @@ from bouncing_ball.free_flight import (
     predicted_start,
     root_predictor,
 )
-from bouncing_ball.jit import njit
+from bouncing_ball.jit import fma, njit
 from bouncing_ball.pcg64 import standard_normal, stream_words
 from bouncing_ball.simulation import (
     CONTROL_VARIATES,
@@ -95,7 +95,7 @@ def _trajectory(rng, steps, r, c, min_step_divisor):
     start = 0.0
     for i in range(steps):
         xs[i], vs[i], starts[i] = x, v, start
-        dt = root * root + delta
+        dt = fma(root, root, delta)
         predictor = root_predictor(root, slope, x, v)
         x1, v1 = free_flight_step(x, v, dt, rng.standard_normal(), rng.standard_normal())
         if x1 < 0.0:

@@ -11,7 +11,8 @@ C loop has no ``parts`` mask).  It is the yardstick of the performance target
 the workflow does not use it.
 
 ``build`` compiles it with gcc (-O3 -march=native, and -ffp-contract=off:
-numba does not fuse multiply-adds, so the C must not either; the scalars' layout of
+numba fuses a multiply-add only where the Python calls ``jit.fma``, and the C calls
+``fma()`` at the same places, so gcc must fuse no other; the scalars' layout of
 ``tallies.SCALARS`` as -D flags, ``scalar_layout_flags``) into a folder
 keyed on the hash of the C source and the whole compiler command, compiling
 only when that folder lacks the library and writing it atomically.  This

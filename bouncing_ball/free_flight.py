@@ -22,7 +22,10 @@ the P(x) and <v^2>_x tally exact in expectation.
 
 Everything here is numba-compiled scalar code (no allocation, no division by
 a constant: those are written as products with the reciprocal, which LLVM
-folds), because it runs once or more per step.  The mean path is carried as
+folds), because it runs once or more per step.  What every step computes (its
+update, the root of eq. (criterion) and its start, the integrals over a whole
+step) is written with fused multiply-adds (``jit.fma``: a b + c rounded once,
+the same double on every machine), where the compiler fuses none of its own.  The mean path is carried as
 its four monomial coefficients ``a0 + a1 t + a2 t^2 + a3 t^3``.
 
 A compiled function compiles on its first call (seconds); its ``py_func`` is the Python
@@ -33,7 +36,7 @@ import math
 
 import numpy as np
 
-from .jit import njit
+from .jit import fma, njit
 
 __all__ = [
     "free_flight_step",
@@ -85,7 +88,9 @@ def free_flight_step(x, v, dt, normal_r, normal_s):
     """One exact free-flight step of eq. (eqmo), eqs. (xstep) and (vstep).
 
     The same ``normal_r`` enters both equations, which gives the correct x-v covariance.
-    The two noise amplitudes share one square root: sqrt(dt^3 / 6) = dt sqrt(2 dt) / sqrt(12).
+    The two noise amplitudes share one square root: sqrt(dt^3 / 6) = dt sqrt(2 dt) / sqrt(12),
+    so x_new = x + dt (v - dt/2 + sqrt(2 dt) (normal_s + sqrt(3) normal_r) / sqrt(12)), in
+    fused multiply-adds (``jit.fma``).
 
     Parameters
     ----------
@@ -110,8 +115,9 @@ def free_flight_step(x, v, dt, normal_r, normal_s):
     1.00495 0.49
     """
     root_2dt = math.sqrt(2.0 * dt)
-    x_new = x + v * dt - 0.5 * dt * dt + dt * root_2dt * SQRT1_12 * (normal_s + SQRT3 * normal_r)
-    v_new = v - dt + root_2dt * normal_r
+    position_noise = SQRT1_12 * fma(SQRT3, normal_r, normal_s)
+    x_new = fma(dt, fma(root_2dt, position_noise, fma(-0.5, dt, v)), x)
+    v_new = fma(root_2dt, normal_r, v - dt)
     return x_new, v_new
 
 
@@ -143,21 +149,22 @@ ROOT_TOLERANCE = 2.0e-3  # a last Householder step below this (relative) leaves 
 
 @njit(cache=True, inline="always")
 def _householder_root(x, v, c, s, iterations):
-    """Householder iterations for ``criterion_root`` from s: (s, f'(s), converged)."""
+    """Householder iterations for ``criterion_root`` from s: (s, f'(s), converged).  f and
+    its derivatives by Horner's rule in fused multiply-adds."""
     f1 = -1.0
     for _ in range(iterations):
         s2 = s * s
-        f = x + s2 * (v - s * (c + 0.5 * s))
-        f1 = s * (2.0 * v - s * (3.0 * c + 2.0 * s))
+        f = fma(s2, fma(-s, fma(0.5, s, c), v), x)
+        f1 = s * fma(-s, fma(2.0, s, 3.0 * c), 2.0 * v)
         if not f1 < 0.0:
             return s, f1, False
-        f2 = 2.0 * v - s * (6.0 * c + 6.0 * s)
-        f3 = -6.0 * c - 12.0 * s
+        f2 = fma(-s, fma(6.0, s, 6.0 * c), 2.0 * v)
+        f3 = fma(-12.0, s, -6.0 * c)
         f_f2 = f * f2
-        f1_squared = f1 * f1
-        denominator = f1 * (6.0 * f1_squared - 6.0 * f_f2) + f * f * f3
+        six_f1_squared = 6.0 * (f1 * f1)
+        denominator = fma(f1, fma(-6.0, f_f2, six_f1_squared), f * f * f3)
         # Householder where its denominator is negative, else Newton
-        step = f * (6.0 * f1_squared - 3.0 * f_f2) / denominator if denominator < 0.0 else f / f1
+        step = f * fma(-3.0, f_f2, six_f1_squared) / denominator if denominator < 0.0 else f / f1
         if not s - step > 0.0:  # overshot past 0: halve instead (f(0) = x > 0)
             s *= 0.5
             continue
@@ -239,7 +246,7 @@ def root_predictor(root, slope_at_root, x, v):
     """
     k1 = 1.0 / slope_at_root if slope_at_root < 0.0 else 0.0
     k2 = k1 * root * root
-    return root + k1 * x + k2 * v, k1, k2
+    return fma(k2, v, fma(k1, x, root)), k1, k2
 
 
 @njit(cache=True, inline="always")
@@ -262,7 +269,7 @@ def predicted_start(predictor, root, x1, v1):
         prediction is not positive.
     """
     k0, k1, k2 = predictor
-    predicted = k0 - k1 * x1 - k2 * v1
+    predicted = fma(-k2, v1, fma(-k1, x1, k0))
     return predicted if predicted > 0.0 else root
 
 
@@ -324,7 +331,7 @@ def hermite_cubic(x0, v0, x1, v1, dt):
 
 @njit(cache=True)
 def cubic_value(a0, a1, a2, a3, t):
-    """The mean path m(t) = a0 + a1 t + a2 t^2 + a3 t^3 (Horner).
+    """The mean path m(t) = a0 + a1 t + a2 t^2 + a3 t^3 (Horner, in fused multiply-adds).
 
     Parameters
     ----------
@@ -343,12 +350,14 @@ def cubic_value(a0, a1, a2, a3, t):
     >>> cubic_value.py_func(1.0, 0.0, -0.5, 0.0, 1.0)
     0.5
     """
-    return a0 + t * (a1 + t * (a2 + t * a3))
+    return fma(t, fma(t, fma(t, a3, a2), a1), a0)
 
 
 @njit(cache=True)
 def cubic_slope(a1, a2, a3, t):
     """The mean path's slope m'(t) = a1 + 2 a2 t + 3 a3 t^2: the mean velocity.
+
+    By Horner's rule in fused multiply-adds, as ``cubic_value``.
 
     Parameters
     ----------
@@ -361,7 +370,7 @@ def cubic_slope(a1, a2, a3, t):
     -------
     float
     """
-    return a1 + t * (2.0 * a2 + t * 3.0 * a3)
+    return fma(t, fma(3.0 * t, a3, 2.0 * a2), a1)
 
 
 @njit(cache=True)
@@ -455,11 +464,11 @@ def whole_step_integrals(x0, v0, x1, v1, dt):
     >>> print(int_x, round((int_x2 - 1.0) * 210, 12))
     1.0 1.0
     """
-    int_x = dt * (0.5 * (x0 + x1) + dt * (1.0 / 12.0) * (v0 - v1))
-    m0 = (13.0 / 35.0) * (x0 * x0 + x1 * x1) + (9.0 / 35.0) * (x0 * x1)
-    m1 = (11.0 / 105.0) * (x0 * v0 - x1 * v1) + (13.0 / 210.0) * (x1 * v0 - x0 * v1)
-    m2 = (1.0 / 105.0) * (v0 * v0 + v1 * v1) - (1.0 / 70.0) * (v0 * v1)
-    return int_x, dt * (m0 + dt * (m1 + dt * (m2 + dt * (1.0 / 210.0))))
+    int_x = dt * fma(dt * (1.0 / 12.0), v0 - v1, 0.5 * (x0 + x1))
+    m0 = fma(13.0 / 35.0, fma(x0, x0, x1 * x1), (9.0 / 35.0) * (x0 * x1))
+    m1 = fma(11.0 / 105.0, fma(x0, v0, -(x1 * v1)), (13.0 / 210.0) * fma(x1, v0, -(x0 * v1)))
+    m2 = fma(1.0 / 105.0, fma(v0, v0, v1 * v1), -(1.0 / 70.0) * (v0 * v1))
+    return int_x, dt * fma(dt, fma(dt, fma(dt, 1.0 / 210.0, m2), m1), m0)
 
 
 def bridge_covariance(dt, t):
@@ -603,7 +612,7 @@ def speed_squared_coefficients(a1, a2, a3, dt):
 
 @njit(cache=True)
 def quintic_antiderivative_value(s1, s2, s3, s4, s5, t):
-    """S(t) = t (s1 + t (s2 + t (s3 + t (s4 + t s5)))) (Horner).
+    """S(t) = t (s1 + t (s2 + t (s3 + t (s4 + t s5)))) (Horner, in fused multiply-adds).
 
     Parameters
     ----------
@@ -616,7 +625,7 @@ def quintic_antiderivative_value(s1, s2, s3, s4, s5, t):
     -------
     float
     """
-    return t * (s1 + t * (s2 + t * (s3 + t * (s4 + t * s5))))
+    return t * fma(t, fma(t, fma(t, fma(t, s5, s4), s3), s2), s1)
 
 
 @njit(cache=True, inline="always")

@@ -1,4 +1,5 @@
-"""numba for the compiled modules, its cache kept in a folder named after their source.
+"""numba for the compiled modules, its cache kept in a folder named after their source, and
+the fused multiply-add they use (``fma``).
 
 ``cache=True`` checks only the file that holds a compiled function, not the
 files it calls into: after an edit of free_flight.py a cached simulation loop
@@ -25,19 +26,24 @@ miss, reported with its folder, removed and recompiled, where numba would raise
 
 import contextlib
 import logging
+import math
 import os
 import shutil
 import tempfile
 import time
+from fractions import Fraction
 from pathlib import Path
 
 import numba
+from numba import types
 from numba.core.caching import FunctionCache
+from numba.extending import intrinsic, overload
 
 from . import PACKAGE, source_digest
 
 __all__ = [
     "njit",
+    "fma",
     "COMPILED",
     "CACHE",
     "prune_caches",
@@ -214,6 +220,71 @@ def njit(*args, **options):
     if args:
         raise TypeError("bouncing_ball.jit.njit takes keyword options only")
     return compile_lazily
+
+
+def fma(a, b, c):
+    """a b + c rounded once: the fused multiply-add of IEEE 754, the same on every machine.
+
+    Compiled code gets LLVM's ``llvm.fma.f64``: the processor's fused multiply-add
+    instruction, or the C library's correctly rounded ``fma`` where it has none.  Being
+    correctly rounded, it gives the same double everywhere, unlike a compiler's choice to
+    contract a b + c (fast-math or ``contract`` flags, never used here): the shard loop
+    writes each fused multiply-add where it wants one, and its C reference calls ``fma()``
+    at the same places.  Called from Python (the ``py_func`` of a compiled function), it
+    rounds the exact rational a b + c once.
+
+    Parameters
+    ----------
+    a, b, c : float
+        The factors and the addend.
+
+    Returns
+    -------
+    float
+        a b + c, rounded to the nearest double (ties to even).
+
+    Examples
+    --------
+    (1 + 2^-52)(1 - 2^-52) = 1 - 2^-104 exactly: the product rounded first is 1, fused it is
+    not.
+
+    >>> from bouncing_ball.jit import fma
+    >>> a, b = 1.0 + 2.0**-52, 1.0 - 2.0**-52
+    >>> a * b - 1.0, fma(a, b, -1.0) == -(2.0**-104)
+    (0.0, True)
+    """
+    a, b, c = float(a), float(b), float(c)
+    if not (math.isfinite(a) and math.isfinite(b)):
+        return a * b + c  # the product is an infinity or a NaN: so is a b + c
+    if not math.isfinite(c):
+        return c  # a finite product (however large) added to an infinity or a NaN
+    exact = Fraction(a) * Fraction(b) + Fraction(c)
+    if exact == 0:
+        return a * b + c  # a b = -c exactly: IEEE 754's sign of a zero sum
+    try:
+        return float(exact)  # int / int: correctly rounded
+    except OverflowError:
+        return math.inf if exact > 0 else -math.inf
+
+
+@intrinsic
+def _llvm_fma(typingctx, a, b, c):
+    """``llvm.fma.f64`` on three doubles."""
+    if not all(isinstance(value, types.Float) and value.bitwidth == 64 for value in (a, b, c)):
+        return None
+    signature = types.float64(types.float64, types.float64, types.float64)
+
+    def codegen(context, builder, sig, args):
+        return builder.fma(*args)
+
+    return signature, codegen
+
+
+@overload(fma, jit_options={"error_model": "numpy"}, inline="always")
+def _fma_compiled(a, b, c):
+    if all(isinstance(value, types.Float) and value.bitwidth == 64 for value in (a, b, c)):
+        return lambda a, b, c: _llvm_fma(a, b, c)
+    return None
 
 
 #: What numba compiles: the modules with compiled functions and what those call into or read

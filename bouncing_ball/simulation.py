@@ -139,7 +139,7 @@ from .free_flight import (
     speed_squared_coefficients,
     whole_step_integrals,
 )
-from .jit import njit
+from .jit import fma, njit
 from .pcg64 import next_double, standard_normal, stream_words
 from .settings import RETURN_LAW_SPEED_BINS, ShardSettings
 from .tallies import EARLY_FRACTION, SCALAR_INDEX, ShardTallies, tally_seed_sequence
@@ -236,7 +236,19 @@ def _bin_index(value, log_lo, per_ln, n, edges):
         return 0
     if value >= edges[n]:
         return n + 1
-    k = int((math.log(value) - log_lo) * per_ln)
+    return _log_bin_index(value, math.log(value), log_lo, per_ln, n, edges)
+
+
+@njit(cache=True, inline="always")
+def _log_bin_index(value, log_value, log_lo, per_ln, n, edges):
+    """``_bin_index`` of ``value`` given its logarithm ``log_value``, or any estimate of it:
+    the estimate only picks the bin the walk over the edges starts from, and the edges decide
+    (so a collision's two speeds, v_out = r v_in, share one logarithm)."""
+    if value < edges[0]:
+        return 0
+    if value >= edges[n]:
+        return n + 1
+    k = int((log_value - log_lo) * per_ln)
     if k < 0:
         k = 0
     if k > n - 1:
@@ -604,6 +616,7 @@ def _run(
     nf = f_edges.shape[0] - 1
     f_log_lo = math.log(f_edges[0])
     f_per_ln = nf / (math.log(f_edges[nf]) - f_log_lo)
+    log_restitution = math.log(restitution)
     nw = w_edges.shape[0] - 1
     w_log_lo = math.log(w_edges[0])
     w_per_ln = nw / (math.log(w_edges[nw]) - w_log_lo)
@@ -682,7 +695,7 @@ def _run(
         if steps >= max_steps:
             exhausted = 1
             break
-        dt = root * root + delta  # eq. (criterion) plus delta
+        dt = fma(root, root, delta)  # eq. (criterion) plus delta
         if not dt > COLLAPSED_STEP:  # below r_c without a floor on delta: the speed is going to 0
             exhausted = 1
             break
@@ -847,11 +860,14 @@ def _run(
         if collided:
             v_in = abs(v_tau)
             v_out = restitution * v_in  # eq. (restitution)
-            out_bin = _bin_index(v_out, v_log_lo, v_per_ln, nv, v_edges)
+            log_v_out = math.log(v_out)  # the bins of v_out, and of v_in = v_out / r, from it
+            out_bin = _log_bin_index(v_out, log_v_out, v_log_lo, v_per_ln, nv, v_edges)
             if recording:
                 collisions += 1
                 speed_counts[out_bin] += 1
-                return_law_speed_counts[_bin_index(v_out, w_log_lo, w_per_ln, nw, w_edges)] += 1
+                return_law_speed_counts[
+                    _log_bin_index(v_out, log_v_out, w_log_lo, w_per_ln, nw, w_edges)
+                ] += 1
                 if collided_before and parts & FLIGHTS:  # the flight that ends here
                     flights += 1
                     flight_time_sum += since_collision
@@ -860,7 +876,10 @@ def _run(
                         _bin_index(since_collision, f_log_lo, f_per_ln, nf, f_edges)
                     ] += 1
                     return_speed_counts[
-                        last_out_bin, _bin_index(v_in, v_log_lo, v_per_ln, nv, v_edges)
+                        last_out_bin,
+                        _log_bin_index(
+                            v_in, log_v_out - log_restitution, v_log_lo, v_per_ln, nv, v_edges
+                        ),
                     ] += 1
             collided_before = True
             since_collision = 0.0

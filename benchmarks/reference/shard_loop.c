@@ -11,7 +11,7 @@
  *       level_time_one_step, level_time, cubic_level_time, slope_zeros,
  *       monotone_piece_end, first_crossing_time, bridge_sample,
  *       bridge_speed_squared_given_position
- *   bouncing_ball/simulation.py: _bin_index, _linear_bin_index, _walked_bin_index,
+ *   bouncing_ball/simulation.py: _bin_index, _log_bin_index, _linear_bin_index, _walked_bin_index,
  *       _tally_position, _tally_step, _bridge_correction, floor_stratum_end,
  *       _tally_second_bridge_point, _run
  *
@@ -19,8 +19,10 @@
  * operation is the same as in the Python source and in the same order (same
  * parenthesisation, same constants, ``np.cbrt`` -> cbrt, ``math.log`` -> log,
  * Python's min/max -> py_min/py_max, which keep Python's choice between equal
- * arguments), so with the FMA contraction switched off (numba does not fuse
- * multiply-adds) it gives bit-identical tallies.  Where Python returns a tuple
+ * arguments, ``jit.fma`` -> fma, the correctly rounded fused multiply-add both
+ * give), so with the compiler's own contraction switched off (numba fuses a
+ * multiply-add only where the source calls ``fma``) it gives bit-identical
+ * tallies.  Where Python returns a tuple
  * the C returns a struct (piece_inverse) or the first value with the second
  * through a pointer (tally_position and tally_step, whose (k, k_s, k_s2) are the
  * bin of the step's end and the bins its mean-path assignment gives the bridge
@@ -102,8 +104,9 @@ static inline void free_flight_step(double x, double v, double dt, double normal
                                     double *x_new, double *v_new)
 {
     double root_2dt = sqrt(2.0 * dt);
-    *x_new = x + v * dt - 0.5 * dt * dt + dt * root_2dt * SQRT1_12 * (normal_s + SQRT3 * normal_r);
-    *v_new = v - dt + root_2dt * normal_r;
+    double position_noise = SQRT1_12 * fma(SQRT3, normal_r, normal_s);
+    *x_new = fma(dt, fma(root_2dt, position_noise, fma(-0.5, dt, v)), x);
+    *v_new = fma(root_2dt, normal_r, v - dt);
 }
 
 /* _floor_root: s* at x = 0, the root of s^2 (v - c s - s^2/2), 0 for v <= 0 */
@@ -142,8 +145,8 @@ static inline double criterion_root(double x, double v, double c, double start, 
     int i = 0;
     for (;;) {
         double s2 = s * s;
-        double f = x + s2 * (v - s * (c + 0.5 * s));
-        double f1 = s * (2.0 * v - s * (3.0 * c + 2.0 * s));
+        double f = fma(s2, fma(-s, fma(0.5, s, c), v), x);
+        double f1 = s * fma(-s, fma(2.0, s, 3.0 * c), 2.0 * v);
         if (!(f1 < 0.0) || i == 60) {
             if (fitted) { /* from the fitted start: only on underflow */
                 *slope_out = f1;
@@ -154,13 +157,13 @@ static inline double criterion_root(double x, double v, double c, double start, 
             i = 0;
             continue;
         }
-        double f2 = 2.0 * v - s * (6.0 * c + 6.0 * s);
-        double f3 = -6.0 * c - 12.0 * s;
+        double f2 = fma(-s, fma(6.0, s, 6.0 * c), 2.0 * v);
+        double f3 = fma(-12.0, s, -6.0 * c);
         double f_f2 = f * f2;
-        double f1_squared = f1 * f1;
-        double denominator = f1 * (6.0 * f1_squared - 6.0 * f_f2) + f * f * f3;
+        double six_f1_squared = 6.0 * (f1 * f1);
+        double denominator = fma(f1, fma(-6.0, f_f2, six_f1_squared), f * f * f3);
         /* Householder where its denominator is negative, else Newton */
-        double step = denominator < 0.0 ? f * (6.0 * f1_squared - 3.0 * f_f2) / denominator : f / f1;
+        double step = denominator < 0.0 ? f * fma(-3.0, f_f2, six_f1_squared) / denominator : f / f1;
         i += 1;
         if (!(s - step > 0.0)) { /* overshot past 0: halve instead (f(0) = x > 0) */
             s *= 0.5;
@@ -187,12 +190,12 @@ static inline void hermite_cubic(double x0, double v0, double x1, double v1, dou
 
 static inline double cubic_value(double a0, double a1, double a2, double a3, double t)
 {
-    return a0 + t * (a1 + t * (a2 + t * a3));
+    return fma(t, fma(t, fma(t, a3, a2), a1), a0);
 }
 
 static inline double cubic_slope(double a1, double a2, double a3, double t)
 {
-    return a1 + t * (2.0 * a2 + t * 3.0 * a3);
+    return fma(t, fma(3.0 * t, a3, 2.0 * a2), a1);
 }
 
 static inline void mean_path_integrals(double a0, double a1, double a2, double a3, double dt,
@@ -233,11 +236,11 @@ static inline void mean_path_integrals(double a0, double a1, double a2, double a
 static inline void whole_step_integrals(double x0, double v0, double x1, double v1, double dt,
                                         double *int_x_out, double *int_x2_out)
 {
-    *int_x_out = dt * (0.5 * (x0 + x1) + dt * (1.0 / 12.0) * (v0 - v1));
-    double m0 = (13.0 / 35.0) * (x0 * x0 + x1 * x1) + (9.0 / 35.0) * (x0 * x1);
-    double m1 = (11.0 / 105.0) * (x0 * v0 - x1 * v1) + (13.0 / 210.0) * (x1 * v0 - x0 * v1);
-    double m2 = (1.0 / 105.0) * (v0 * v0 + v1 * v1) - (1.0 / 70.0) * (v0 * v1);
-    *int_x2_out = dt * (m0 + dt * (m1 + dt * (m2 + dt * (1.0 / 210.0))));
+    *int_x_out = dt * fma(dt * (1.0 / 12.0), v0 - v1, 0.5 * (x0 + x1));
+    double m0 = fma(13.0 / 35.0, fma(x0, x0, x1 * x1), (9.0 / 35.0) * (x0 * x1));
+    double m1 = fma(11.0 / 105.0, fma(x0, v0, -(x1 * v1)), (13.0 / 210.0) * fma(x1, v0, -(x0 * v1)));
+    double m2 = fma(1.0 / 105.0, fma(v0, v0, v1 * v1), -(1.0 / 70.0) * (v0 * v1));
+    *int_x2_out = dt * fma(dt, fma(dt, fma(dt, 1.0 / 210.0, m2), m1), m0);
 }
 
 typedef struct {
@@ -259,7 +262,7 @@ static inline quintic speed_squared_coefficients(double a1, double a2, double a3
 static inline double quintic_antiderivative_value(double s1, double s2, double s3, double s4,
                                                   double s5, double t)
 {
-    return t * (s1 + t * (s2 + t * (s3 + t * (s4 + t * s5))));
+    return t * fma(t, fma(t, fma(t, fma(t, s5, s4), s3), s2), s1);
 }
 
 /* piece_inverse: what level_time needs of a monotone piece (Python returns the 7-tuple
@@ -474,14 +477,15 @@ static inline int64_t linear_bin_index(double value, double lo, double per_unit,
     return k + 1;
 }
 
-static inline int64_t bin_index(double value, double log_lo, double per_ln, int64_t n,
-                                const double *edges)
+/* _log_bin_index: bin_index given log(value), or an estimate of it (the edges decide) */
+static inline int64_t log_bin_index(double value, double log_value, double log_lo, double per_ln,
+                                    int64_t n, const double *edges)
 {
     if (value < edges[0])
         return 0;
     if (value >= edges[n])
         return n + 1;
-    int64_t k = (int64_t)((log(value) - log_lo) * per_ln);
+    int64_t k = (int64_t)((log_value - log_lo) * per_ln);
     if (k < 0)
         k = 0;
     if (k > n - 1)
@@ -492,6 +496,16 @@ static inline int64_t bin_index(double value, double log_lo, double per_ln, int6
     while (k < n - 1 && value >= edges[k + 1])
         k += 1;
     return k + 1;
+}
+
+static inline int64_t bin_index(double value, double log_lo, double per_ln, int64_t n,
+                                const double *edges)
+{
+    if (value < edges[0])
+        return 0;
+    if (value >= edges[n])
+        return n + 1;
+    return log_bin_index(value, log(value), log_lo, per_ln, n, edges);
 }
 
 /* floor_stratum_end: t_low = FLOOR_STRATUM_HEIGHT / v in a step that starts at the floor with
@@ -660,6 +674,7 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
     double u_per_unit = (double)nu / (u_edges[nu] - u_lo);
     double f_log_lo = log(f_edges[0]);
     double f_per_ln = (double)nf / (log(f_edges[nf]) - f_log_lo);
+    double log_restitution = log(restitution);
     double w_log_lo = log(w_edges[0]);
     double w_per_ln = (double)nw / (log(w_edges[nw]) - w_log_lo);
     /* the two ends of every x bin, the under- and overflow bins unbounded */
@@ -748,7 +763,7 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
             exhausted = 1;
             break;
         }
-        double dt = root * root + delta; /* eq. (criterion) plus delta */
+        double dt = fma(root, root, delta); /* eq. (criterion) plus delta */
         if (!(dt > COLLAPSED_STEP)) { /* below r_c without a floor on delta */
             exhausted = 1;
             break;
@@ -760,7 +775,7 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
            = k0 - k1 x1 - k2 v1, with coefficients ready (division included) before the step */
         double k1 = slope_at_root < 0.0 ? 1.0 / slope_at_root : 0.0;
         double k2 = k1 * root * root;
-        double k0 = root + k1 * x + k2 * v;
+        double k0 = fma(k2, v, fma(k1, x, root));
         double normal_r = random_standard_normal(rng);
         double normal_s = random_standard_normal(rng);
         double x1, v1;
@@ -862,18 +877,21 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
         if (collided) {
             double v_in = fabs(v_tau);
             double v_out = restitution * v_in; /* eq. (restitution) */
-            int64_t out_bin = bin_index(v_out, v_log_lo, v_per_ln, nv, v_edges);
+            double log_v_out = log(v_out); /* the bins of v_out, and of v_in = v_out / r, from it */
+            int64_t out_bin = log_bin_index(v_out, log_v_out, v_log_lo, v_per_ln, nv, v_edges);
             if (recording) {
                 collisions += 1;
                 speed_counts[out_bin] += 1;
-                return_law_speed_counts[bin_index(v_out, w_log_lo, w_per_ln, nw, w_edges)] += 1;
+                return_law_speed_counts[log_bin_index(v_out, log_v_out, w_log_lo, w_per_ln, nw,
+                                                      w_edges)] += 1;
                 if (collided_before) { /* the flight that ends here (parts & FLIGHTS: always) */
                     flights += 1;
                     flight_time_sum += since_collision;
                     flight_time_squared_sum += since_collision * since_collision;
                     flight_time_counts[bin_index(since_collision, f_log_lo, f_per_ln, nf, f_edges)] += 1;
                     return_speed_counts[last_out_bin * (nv + 2)
-                                        + bin_index(v_in, v_log_lo, v_per_ln, nv, v_edges)] += 1;
+                                        + log_bin_index(v_in, log_v_out - log_restitution,
+                                                        v_log_lo, v_per_ln, nv, v_edges)] += 1;
                 }
             }
             collided_before = 1;
@@ -888,7 +906,7 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
         } else {
             x = x1;
             v = v1;
-            double predicted = k0 - k1 * x1 - k2 * v1;
+            double predicted = fma(-k2, v1, fma(-k1, x1, k0));
             root = criterion_root(x, v, c, predicted > 0.0 ? predicted : root, &slope_at_root);
         }
     }

@@ -214,3 +214,38 @@ def test_whole_step_integrals_are_the_mean_path_integrals_over_the_step():
         scale_x2 = dt * (x0 + x1 + dt * (abs(v0) + abs(v1)) + dt * dt) ** 2
         assert got[0] == pytest.approx(expected[0], rel=0, abs=1e-13 * scale_x)
         assert got[1] == pytest.approx(expected[1], rel=0, abs=1e-13 * scale_x2)
+
+
+def _same(first, second):
+    return np.array_equal(np.asarray(first, dtype=float), np.asarray(second, dtype=float))
+
+
+def test_the_compiled_step_does_the_written_arithmetic():
+    """The compiled update, root and start, and whole-step integrals give the doubles of their
+    Python functions (``py_func``, fma rounded from the exact product and sum): the compiler
+    fuses, contracts or reorders nothing but the source's own fused multiply-adds, so a step
+    is the same on every machine (and in the C reference, which calls fma() at those places)."""
+    from bouncing_ball.free_flight import (
+        _householder_root,
+        criterion_root,
+        predicted_start,
+        root_predictor,
+    )
+
+    rng = np.random.default_rng(5)
+    for x, v in zip(10 ** rng.uniform(-6, 2, 200), rng.normal(0.0, 2.0, 200)):
+        normal_r, normal_s = rng.normal(size=2)
+        root, slope = criterion_root(x, v, 5.0, 0.0)
+        # the iteration itself in Python (criterion_root.py_func calls the compiled one)
+        for start in (0.7 * root, 1.3 * root):
+            iterated = _householder_root(x, v, 5.0, start, 60)
+            assert _same(iterated, _householder_root.py_func(x, v, 5.0, start, 60))
+        dt = root * root + 1e-6
+        step = free_flight_step(x, v, dt, normal_r, normal_s)
+        assert _same(step, free_flight_step.py_func(x, v, dt, normal_r, normal_s))
+        predictor = root_predictor(root, slope, x, v)
+        assert _same(predictor, root_predictor.py_func(root, slope, x, v))
+        start = predicted_start(predictor, root, *step)
+        assert start == predicted_start.py_func(predictor, root, *step)
+        integrals = whole_step_integrals(x, v, *step, dt)
+        assert _same(integrals, whole_step_integrals.py_func(x, v, *step, dt))
