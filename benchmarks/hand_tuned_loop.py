@@ -19,7 +19,8 @@ How it differs from ``simulation._run`` (and from its line-by-line translation
   * the step-size root starts from a first-order prediction off the previous step's root
     (Householder's third-order iteration, no cube root), where the project's loop starts
     cold, and a step that does not collide skips the bridge's cubic;
-  * gcc -O3 -march=native with fused multiply-adds allowed (the reference switches them off).
+  * gcc -O3 -march=native with fused multiply-adds contracted wherever gcc likes (the
+    reference switches contraction off and calls fma() where the numba loop does).
 
 Its physics is checked by ``physics_check``: I, <x> and Delta x against the exact r = 1/2
 values and the solver's at other r (z-scores from the scatter of independent seeds), and

@@ -39,8 +39,9 @@
  *     splitmix64; the lowest 3 bits of xoshiro256+, its weak ones, are never used.  About
  *     1.5 ns a normal, mostly hidden behind the root's latency.
  *   - Built with gcc -O3 -march=native -ffp-contract=fast -fno-math-errno -std=c99: fused
- *     multiply-adds are allowed (unlike the line-by-line reference shard_loop.c, which must
- *     match numba bit for bit), and sqrt needs no errno branch.
+ *     multiply-adds are contracted wherever gcc likes (the line-by-line reference
+ *     shard_loop.c switches contraction off and calls fma() exactly where the numba loop
+ *     does, to match it bit for bit), and sqrt needs no errno branch.
  *
  * Entry points (ctypes, benchmarks/hand_tuned_loop.py):
  *   hand_tuned_run      one shard; CPU time measured inside (CLOCK_PROCESS_CPUTIME_ID)
