@@ -339,9 +339,10 @@ def return_law_prediction(shards: list[ShardTallies], restitution: float, outgoi
     if lower.size == 0:
         return np.zeros((len(shards), bins.n + 2))
     r = float(restitution)
-    law = return_speed_bin_probabilities(
-        outgoing_density, lower, upper, bins.lower / r, bins.upper / r, RETURN_LAW_POINTS
-    )
+    with np.errstate(invalid="ignore"):  # a bin where P(0, u) underflows: NaN, redone below
+        law = return_speed_bin_probabilities(
+            outgoing_density, lower, upper, bins.lower / r, bins.upper / r, RETURN_LAW_POINTS
+        )
     lost = ~np.all(np.isfinite(law), axis=1)  # P(0, u) of 0 all over a bin: weigh ln u evenly
     if np.any(lost):
         law[lost] = return_speed_bin_probabilities(
@@ -461,9 +462,9 @@ def outgoing_speed_histogram(
     p0v, err = jackknife(density, counts, times)
     if return_law is None and restitution is not None:
         exact = parse_restitution(restitution)
-        density = _solver_outgoing_density(exact)
-        if density is not None:
-            return_law = return_law_prediction(shards, float(exact), density)
+        solver_density = _solver_outgoing_density(exact)
+        if solver_density is not None:
+            return_law = return_law_prediction(shards, float(exact), solver_density)
     if return_law is None:
         controls = shard_controls(shards, RATE_CONTROLS)
         controlled, controlled_err = _controlled(density, controls, times[:, 0], [counts], [times])
