@@ -553,7 +553,7 @@ def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None, per
         and overflow bins, nor bins beyond the solver's grid), and the largest relative error
         p0v_err / p0v over the bins with 0.01 <= v <= 5 (an empty bin there counts as an
         infinite relative error); the same of ``p0v_controlled`` (``p0v_controlled_*`` rows,
-        with no p_sign_flip) where the table has it.
+        with no p_sign_flip) where the table has it, else those rows empty (NaN).
 
     Raises
     ------
@@ -569,6 +569,21 @@ def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None, per
         rows += _outgoing_speed_rows(
             "p0v_controlled", controlled, restitution, shards, solver_curve, None
         )
+    else:  # every check in every r's rows: these empty
+        rows += [
+            {
+                "check": check,
+                "reference": "none",
+                "bins": 0,
+                "value": np.nan,
+                "bin_centre": np.nan,
+                "p_sign_flip": np.nan,
+                "detail": "no controlled P(0,v): fewer than 4 shards, or r outside the "
+                "solver's range",
+            }
+            for check in VALIDATION_CHECKS
+            if check.startswith("p0v_controlled")
+        ]
     return rows
 
 

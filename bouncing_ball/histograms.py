@@ -493,8 +493,8 @@ def outgoing_speed_histogram(
 def _return_law_controlled(shards, counts, times, return_law, density):
     """P(0, v) and its error from counts corrected bin by bin by the return-law control of
     the bin and, with ``SHARDS_PER_CONTROL`` shards per control for them, those of
-    ``tallies.RATE_CONTROLS`` (NaN with fewer than ``SHARDS_PER_CONTROL`` shards)."""
-    if len(shards) < SHARDS_PER_CONTROL:
+    ``tallies.RATE_CONTROLS`` (NaN with fewer than 4 shards)."""
+    if len(shards) < max(SHARDS_PER_CONTROL, 4):  # a fitted slope and intercept need 4
         return _controlled(density, None, times[:, 0], [counts], [times])
     # the martingale controls too, where the shards are enough for them and the bin's own
     rate = None
