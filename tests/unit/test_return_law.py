@@ -80,3 +80,23 @@ def test_no_collisions_predict_none():
     empty = ShardTallies.from_loop(SETTINGS, ShardTallies.loop_arrays(SETTINGS))
     prediction = return_law_prediction([empty, empty], 0.5, lambda u: np.ones_like(u))
     assert prediction.shape == (2, SETTINGS.speed_bins.n + 2) and not prediction.any()
+
+
+@pytest.mark.parametrize("r", exact.EXACT_RESTITUTIONS, ids=str)
+def test_equilibrium_outgoing_speeds_predict_the_flight_moments(r):
+    """Fed the exact equilibrium's outgoing speeds, the flight-law prediction gives the mean
+    time between collisions 1 / I of eq. (xandDeltax) (3 at r = 1/2, 4/3 at r = 1/3) and
+    the solver's <T^2>, per flight, to 1e-6 (a wrong E[T | u] is off by percents)."""
+    from bouncing_ball import flight_time, solver
+    from bouncing_ball.histograms import flight_law_prediction
+
+    def density(u):
+        return exact.outgoing_speed_density(u, r)
+
+    shard = _equilibrium_shard(density)
+    flights = shard.return_law_speed_counts.sum()
+    mean, second = flight_law_prediction([shard], density)[0] / flights
+    rate = exact.position_moments(r)["collision_rate"]
+    assert mean == pytest.approx(1.0 / rate, rel=1e-6)
+    solution = solver.solve_outgoing_speed_density(r)
+    assert second == pytest.approx(flight_time.flight_time_second_moment(solution), rel=1e-6)
