@@ -182,8 +182,29 @@ WEDGE_CLEAN = 1e6
 ACCURATE_RANGE = 0.4  # P(0, v) of a solution is used up to this fraction of its highest node
 NEGLIGIBLE_EFOLDS = 60.0
 
-_TAU_X, _TAU_W = np.polynomial.legendre.leggauss(TAU_NODES)
-_TAU_X, _TAU_W = 0.5 * (_TAU_X + 1.0), 0.5 * _TAU_W
+#: The tau integral of a term of the complex Nystrom sum (``_complex_kernel_sums``) by
+#: Gauss-Legendre with the fewest of these nodes that meets ~1e-15 relative: the integrand is a
+#: function of (tau / upper)^2 with the parameter eps = max(|z0 upper^2|, |upper^2|) (its
+#: Taylor coefficients fall like eps^k), so the rule with TAU_RULE_NODES[k] nodes is used where
+#: eps < TAU_RULE_LIMITS[k] (checked against 40 nodes, tests/unit/test_distribution.py), and the
+#: kernel's TAU_NODES above the last limit.
+TAU_RULE_NODES = (6, 8, 10, 14, TAU_NODES)
+TAU_RULE_LIMITS = (0.01, 0.1, 0.3, 3.0)
+
+
+def _tau_rules():
+    """The Gauss-Legendre rules of TAU_RULE_NODES on [0, 1], one row each (zero-padded)."""
+    size = max(TAU_RULE_NODES)
+    x, w = np.zeros((len(TAU_RULE_NODES), size)), np.zeros((len(TAU_RULE_NODES), size))
+    for k, count in enumerate(TAU_RULE_NODES):
+        nodes, weights = np.polynomial.legendre.leggauss(count)
+        x[k, :count], w[k, :count] = 0.5 * (nodes + 1.0), 0.5 * weights
+    return x, w
+
+
+_TAU_X, _TAU_W = _tau_rules()
+_TAU_COUNTS = np.array(TAU_RULE_NODES, dtype=np.int64)
+_TAU_LIMITS = np.array(TAU_RULE_LIMITS)
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(PANEL_NODES)
 
 
@@ -317,11 +338,13 @@ def _log_psi(force, v):
 
 def _psi(force, v):
     """psi_F(v), eq. (psi), for real v (any sign)."""
+    v = np.asarray(v, dtype=float)
     argument = force ** (1.0 / 3.0) * v + 0.25 * force ** (-2.0 / 3.0)
     positive = argument > 0.0
-    decaying = np.exp(_log_psi(force, np.where(positive, v, 0.0)))
-    oscillating = force ** (-1.0 / 6.0) * special.airy(np.where(positive, 0.0, argument))[0]
-    return np.where(positive, decaying, oscillating)
+    out = np.empty(np.broadcast(argument).shape)
+    out[positive] = np.exp(_log_psi(force, np.broadcast_to(v, out.shape)[positive]))
+    out[~positive] = force ** (-1.0 / 6.0) * special.airy(argument[~positive])[0]
+    return out
 
 
 def _log_psi_omega(force, v):
@@ -453,7 +476,17 @@ class _OutgoingDensity:
         out = np.empty(v.size, dtype=complex)
         magnitude = np.empty(v.size)
         _complex_kernel_sums(
-            v, r, self.q, self.nodes, self.log_weights, _TAU_X, _TAU_W, out, magnitude
+            v,
+            r,
+            self.q,
+            self.nodes,
+            self.log_weights,
+            _TAU_X,
+            _TAU_W,
+            _TAU_COUNTS,
+            _TAU_LIMITS,
+            out,
+            magnitude,
         )
         incoming = v / r
         tail = (
@@ -487,11 +520,14 @@ def _evaluate_wedge_cell(cell, key, origin, sigma, theta, v, beta):
 
 
 @njit(cache=True)
-def _complex_kernel_sums(v, r, q, u, log_weights, tau_x, tau_w, out, magnitude):
+def _complex_kernel_sums(
+    v, r, q, u, log_weights, tau_x, tau_w, tau_counts, tau_limits, out, magnitude
+):
     """out_i = e^(q v_i) r^-2 sum_j exp(log_weights_j) G_g(v_i / r, u_j) for complex v_i: the
     stable form of eq. (kernel3) in kernel.py, continued to complex v (the tau integral runs
-    along the straight segment from 0 to tau1).  Terms below e^-SKIP_EFOLDS of the largest
-    are skipped (at large |v| the kernel confines u to a window of width ~ |v|^(1/2))."""
+    along the straight segment from 0 to tau1, by the rule of ``_tau_rules`` that eps selects,
+    TAU_RULE_LIMITS).  Terms below e^-SKIP_EFOLDS of the largest are skipped (at large |v| the
+    kernel confines u to a window of width ~ |v|^(1/2))."""
     root3_pi = math.sqrt(3.0) / math.pi
     # per u: z0, the exponent and its real part with the u^(1/2) bound (first pass, reused)
     z0s = np.empty(u.size, dtype=np.complex128)
@@ -535,12 +571,17 @@ def _complex_kernel_sums(v, r, q, u, log_weights, tau_x, tau_w, out, magnitude):
             upper = tau1
             if decay > 0.0 and KERNEL_TAIL / math.sqrt(decay) < 1.0:
                 upper = tau1 * (KERNEL_TAIL / math.sqrt(decay))
+            upper2 = upper * upper
+            eps = max(abs(z0 * upper2), abs(upper2))
+            rule = 0
+            while rule < tau_limits.size and eps >= tau_limits[rule]:
+                rule += 1
             acc = 0.0 + 0.0j
-            for k in range(tau_x.size):
-                tau = upper * tau_x[k]
+            for k in range(tau_counts[rule]):
+                tau = upper * tau_x[rule, k]
                 t2 = tau * tau
                 one_t2 = 1.0 + t2
-                acc += tau_w[k] * (
+                acc += tau_w[rule, k] * (
                     cmath.exp(-z0 * t2)
                     * (1.0 + z0 * one_t2)
                     / (one_t2 * one_t2 * cmath.sqrt(2.0 + t2))
@@ -688,12 +729,12 @@ def _real_segment_terms(density, force, v1):
     v = speed_of_coordinate(s)
     turning = 0.25 / force  # beyond, psi_F(-v) oscillates with amplitude O(F^(-1/6))
     inside = v <= turning
-    psi_beyond = _psi(force, -np.where(inside, turning, v))
+    log_psi, signs = np.empty(v.shape), np.ones(v.shape)
+    log_psi[inside] = _log_psi(force, -v[inside])
+    psi_beyond = _psi(force, -v[~inside])
     with np.errstate(divide="ignore"):
-        log_psi = np.where(
-            inside, _log_psi(force, -np.minimum(v, turning)), np.log(np.abs(psi_beyond))
-        )
-    signs = np.where(inside, 1.0, np.sign(psi_beyond))
+        log_psi[~inside] = np.log(np.abs(psi_beyond))
+    signs[~inside] = np.sign(psi_beyond)
     log_terms = np.log(ws * _jacobian(v) * v) + 0.5 * v + density.log_density(v) + log_psi
     beta = density.beta
     small = (
