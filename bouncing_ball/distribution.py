@@ -1804,6 +1804,131 @@ def distribution_by_force_integral(x, v, weight):
     return value, error
 
 
+#: The fixed rule of ``distribution_by_force_rule``: Gauss-Legendre with FORCE_RULE_NODES nodes
+#: on panels in ln F across each of which the integrand of eq. (fpsol) turns through at most
+#: FORCE_RULE_PHASE radians or e-folds, split at the panel edges of the interpolated w (where
+#: its series join with jumps of the order of its interpolation error); its check rule,
+#: FORCE_CHECK_NODES nodes on panels of FORCE_CHECK_PHASE.  Against a rule six times finer
+#: both are within 1e-13 of the largest value at that x (tests/unit/test_distribution.py).
+#: Where the integrand's bound is below e^-FORCE_RULE_MARGIN of its largest value the range of
+#: ln F is cut.
+FORCE_RULE_NODES = 20
+FORCE_RULE_PHASE = 16.0
+FORCE_CHECK_NODES = 16
+FORCE_CHECK_PHASE = 12.0
+FORCE_RULE_MARGIN = 50.0
+FORCE_RULE_GRID = 1500  # points in ln F on which the bound and the panel edges are found
+
+
+def _force_rule_sum(x, speeds, log_rest_grid, y_grid, decay, phase, nodes, weight):
+    """sum over the panels of Gauss-Legendre (``nodes``) of the integrand of eq. (fpsol) in
+    ln F, per v (see ``distribution_by_force_rule``)."""
+    gx, gw = np.polynomial.legendre.leggauss(nodes)
+    force = np.exp(y_grid)
+    airy_argument = -np.cbrt(force)[None, :] * speeds[:, None] + 0.25 * force[None, :] ** (
+        -2.0 / 3.0
+    )
+    # |Ai(z)| <= e^(-(2/3) z^(3/2)) (z > 0), <= 1 (z < 0): a bound of the integrand's log
+    bound = (
+        log_rest_grid[None, :]
+        - 0.5 * speeds[:, None]
+        - (2.0 / 3.0) * np.maximum(airy_argument, 0.0) ** 1.5
+    )
+    which, y, w = [], [], []
+    for k, v in enumerate(speeds):
+        kept = np.nonzero(bound[k] >= np.max(bound[k]) - FORCE_RULE_MARGIN)[0]
+        grid = y_grid[max(kept[0] - 1, 0) : min(kept[-1] + 2, y_grid.size)]
+        # the integrand turns through e^-decay/F (small F), e^-F x, and the Airy phase or decay
+        # (2/3) F^(1/2) |v|^(3/2): phi counts them, panels are equal in phi
+        phi = grid - decay * np.exp(-grid) + x * np.exp(grid)
+        phi += (2.0 / 3.0) * abs(v) ** 1.5 * np.exp(0.5 * grid)
+        count = max(1, int(np.ceil((phi[-1] - phi[0]) / phase)))
+        edges = np.interp(np.linspace(phi[0], phi[-1], count + 1), phi, grid)
+        if hasattr(weight, "edges"):  # a WeightFunction: smooth only within its panels
+            inside = (weight.edges > edges[0]) & (weight.edges < edges[-1])
+            edges = np.union1d(edges, weight.edges[inside])
+        half = 0.5 * np.diff(edges)[:, None]
+        y.append((0.5 * (edges[:-1, None] + edges[1:, None]) + half * gx).ravel())
+        w.append((half * gw).ravel())
+        which.append(np.full(y[-1].size, k))
+    which, y, w = np.concatenate(which), np.concatenate(y), np.concatenate(w)
+    force, v = np.exp(y), speeds[which]
+    argument = -np.cbrt(force) * v + 0.25 * force ** (-2.0 / 3.0)
+    log_rest = weight.log(force) + (5.0 / 6.0) * y - force * x - 0.5 * v
+    positive = argument > 0.0
+    airy = np.empty(argument.size)
+    airy[positive] = _airy_scaled(argument[positive])
+    airy[~positive] = special.airy(argument[~positive])[0]
+    terms = w * airy * np.exp(log_rest - (2.0 / 3.0) * np.maximum(argument, 0.0) ** 1.5)
+    return np.bincount(which, terms, minlength=speeds.size)
+
+
+def distribution_by_force_rule(x, speeds, weight):
+    """P(x, v) of eq. (fpsol) at one x > 0 and many v by a fixed rule in ln F, with an error
+    estimate.
+
+    The F integral of eq. (fpsol) over ln F, between the limits of
+    ``distribution_by_force_integral``, by Gauss-Legendre (FORCE_RULE_NODES nodes) on panels
+    across each of which the integrand turns through at most FORCE_RULE_PHASE radians (the
+    Airy phase (2/3) F^(1/2) v^(3/2)) or e-folds (e^(-(S + 1/12)/F), e^(-F x), the Airy decay
+    for v < 0), cut where a bound of the integrand is below e^-FORCE_RULE_MARGIN of its
+    largest value, and split at the panel edges of an interpolated w.  w(F) is evaluated at all
+    nodes of all v at once.  The error estimate is the difference from a second, coarser rule
+    (FORCE_CHECK_NODES nodes on panels of FORCE_CHECK_PHASE).
+
+    Parameters
+    ----------
+    x : float
+        The height, x > 0.
+    speeds : array_like
+        Velocities v (1-d); each (x, v) as ``check_force_integral_point`` allows.
+    weight : WeightFunction or ClosedFormWeight
+        w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
+        ``closed_form_weight_function``).
+
+    Returns
+    -------
+    values : numpy.ndarray
+        P(x, v), the shape of ``speeds``.
+    errors : numpy.ndarray
+        The estimates of their absolute errors.
+
+    Raises
+    ------
+    ValueError
+        As ``check_force_integral_point``, or if x is not > 0.
+
+    Examples
+    --------
+    >>> from bouncing_ball.distribution import closed_form_weight_function
+    >>> from bouncing_ball.distribution import distribution_by_force_rule
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> values, errors = distribution_by_force_rule(0.5, [-1.0, 1.0], weight)
+    >>> print(values.round(8), bool(np.all(errors < 1e-10 * values)))
+    [0.04201018 0.07568971] True
+    """
+    x = float(x)
+    speeds = np.atleast_1d(np.asarray(speeds, dtype=float))
+    if not x > 0.0:
+        raise ValueError(f"x = {x}: the fixed rule of eq. (fpsol) needs x > 0")
+    for v in speeds:
+        check_force_integral_point(x, float(v))
+    decay = _total_decay(weight)
+    lower = np.log(decay / 150.0)
+    y_grid = np.linspace(lower, max(np.log(60.0 / x), lower + 1.0), FORCE_RULE_GRID)
+    log_rest_grid = weight.log(np.exp(y_grid)) + (5.0 / 6.0) * y_grid - np.exp(y_grid) * x
+    values, check = (
+        _force_rule_sum(x, speeds, log_rest_grid, y_grid, decay, phase, nodes, weight)
+        for phase, nodes in (
+            (FORCE_RULE_PHASE, FORCE_RULE_NODES),
+            (FORCE_CHECK_PHASE, FORCE_CHECK_NODES),
+        )
+    )
+    return values, np.abs(values - check)
+
+
 #: Gauss-Legendre nodes per panel in v of ``distribution_cell_average``.
 CELL_SPEED_NODES = 8
 
@@ -1893,7 +2018,8 @@ def distribution_cell_average(x_lo, x_hi, v_lo, v_hi, weight, speed_nodes=CELL_S
 def distribution_with_error(x, v, weight, solution):
     """P(x, v) and an estimate of its absolute error, for broadcast arrays x >= 0 and v.
 
-    x > 0: eq. (fpsol) by the F integral.  x = 0: the outgoing side is the
+    x > 0: eq. (fpsol) by the F integral, every v at one x by one fixed rule
+    (``distribution_by_force_rule``).  x = 0: the outgoing side is the
     solver's P(0, v), the incoming side the boundary condition eq. (bc),
     P(0, -v) = r^2 P(0, r v); P(0, 0) diverges and is NaN.
 
@@ -1913,7 +2039,7 @@ def distribution_with_error(x, v, weight, solution):
     values : numpy.ndarray
         P(x, v), the broadcast shape.
     errors : numpy.ndarray
-        quad's estimates of their absolute errors (0 at x = 0).
+        Estimates of their absolute errors (``distribution_by_force_rule``; 0 at x = 0).
 
     Raises
     ------
@@ -1954,8 +2080,10 @@ def distribution_with_error(x, v, weight, solution):
                 values[index] = r * r * solution.outgoing_speed_density(-r * vi)
             else:
                 values[index] = np.nan
-            continue
-        values[index], errors[index] = distribution_by_force_integral(xi, vi, weight)
+    # x > 0: every v at one x by one fixed rule in ln F (w(F) evaluated once for them all)
+    for xi in np.unique(x[x > 0.0]):
+        at = x == xi
+        values[at], errors[at] = distribution_by_force_rule(xi, v[at], weight)
     return values, errors
 
 
@@ -2093,7 +2221,8 @@ def distribution_table(weight, solution, positions, speeds):
     table : pandas.DataFrame
         Long format: columns x, v and pxv, x varying slowest.
     worst : float
-        The largest relative error quad estimates for a positive P(x, v) of the table.
+        The largest estimated relative error of a positive P(x, v) of the table
+        (``distribution_by_force_rule``).
 
     Raises
     ------
@@ -2312,7 +2441,8 @@ EXPONENT_TOLERANCES = {
 #: P(x, v) at x > 0 by the F integral of eq. (fpsol) is accurate to about this fraction of its
 #: largest value at that x (w(F) is known to ~1e-10 relative, and the oscillating Airy factor
 #: cancels): far-tail values below it are noise of either sign (at r = 0.05, x = 0.0126,
-#: v = 2.3 to 6: +-9e-11 where the peak is 3.4; quad's own error estimate does not see it).
+#: v = 2.3 to 6: +-9e-11 where the peak is 3.4; the quadrature's own error estimate does not
+#: see it).
 DISTRIBUTION_NOISE = 1e-10
 
 
