@@ -317,13 +317,22 @@ def outgoing_speed_solution(restitution, step=DEFAULT_STEP):
 
 def _airy_scaled(z):
     """Ai(z) exp((2/3) z^(3/2)) (scipy's airye), with its leading asymptotic form where |z| > 1e6
-    (scipy returns NaN there)."""
+    (scipy returns NaN there); for real 0 < z <= 1e6 from the scaled Bessel function,
+    (z / 3)^(1/2) kve(1/3, (2/3) z^(3/2)) / pi (the same to ~5e-15, several times faster)."""
     z = np.asarray(z)
     big = np.abs(z) > 1e6
-    safe = np.where(big, 1.0, z)
     far = np.where(big, z, 1e6)
     asymptotic = far**-0.25 / (2.0 * np.sqrt(np.pi)) * (1.0 - 5.0 / (48.0 * far**1.5))
-    return np.where(big, asymptotic, special.airye(safe)[0])
+    if np.iscomplexobj(z):
+        return np.where(big, asymptotic, special.airye(np.where(big, 1.0, z))[0])
+    bessel = (z > 0.0) & ~big
+    out = np.where(big, asymptotic, 0.0)
+    out[bessel] = (
+        np.sqrt(z[bessel] / 3.0) * special.kve(1.0 / 3.0, (2.0 / 3.0) * z[bessel] ** 1.5) / np.pi
+    )
+    rest = ~bessel & ~big
+    out[rest] = special.airye(z[rest])[0]
+    return out
 
 
 def _log_psi(force, v):
