@@ -315,18 +315,21 @@ def outgoing_speed_solution(restitution, step=DEFAULT_STEP):
 # special functions
 
 
+#: Ai from K_1/3 (``_airy_scaled``) where |arg z| is below this (the formula holds up to 2 pi / 3).
+BESSEL_AIRY_PHASE = 2.0
+
+
 def _airy_scaled(z):
     """Ai(z) exp((2/3) z^(3/2)) (scipy's airye), with its leading asymptotic form where |z| > 1e6
-    (scipy returns NaN there); for real 0 < z <= 1e6 from the scaled Bessel function,
-    (z / 3)^(1/2) kve(1/3, (2/3) z^(3/2)) / pi (the same to ~5e-15, several times faster)."""
+    (scipy returns NaN there); for 0 < |z| <= 1e6 with |arg z| < BESSEL_AIRY_PHASE from the
+    scaled Bessel function, (z / 3)^(1/2) kve(1/3, (2/3) z^(3/2)) / pi (DLMF 9.6.1: the same to
+    ~5e-15, and as close to mpmath's, three to nine times faster)."""
     z = np.asarray(z)
     big = np.abs(z) > 1e6
     far = np.where(big, z, 1e6)
     asymptotic = far**-0.25 / (2.0 * np.sqrt(np.pi)) * (1.0 - 5.0 / (48.0 * far**1.5))
-    if np.iscomplexobj(z):
-        return np.where(big, asymptotic, special.airye(np.where(big, 1.0, z))[0])
-    bessel = (z > 0.0) & ~big
-    out = np.where(big, asymptotic, 0.0)
+    bessel = (z != 0.0) & (np.abs(np.angle(z)) < BESSEL_AIRY_PHASE) & ~big
+    out = np.where(big, asymptotic, 0.0 * z)
     out[bessel] = (
         np.sqrt(z[bessel] / 3.0) * special.kve(1.0 / 3.0, (2.0 / 3.0) * z[bessel] ** 1.5) / np.pi
     )
