@@ -338,6 +338,21 @@ def _airy_scaled(z):
     return out
 
 
+def _airy_oscillating(z):
+    """Ai(-z) for real z >= 0 from Bessel functions, (z^(1/2) / 3) (J_1/3 + J_-1/3)((2/3) z^(3/2))
+    (DLMF 9.6.6; as close to mpmath's as scipy's airy up to z = 120, and faster), scipy's airy
+    where z < 1e-3."""
+    z = np.asarray(z, dtype=float)
+    out = np.empty(z.shape)
+    small = z < 1e-3
+    out[small] = special.airy(-z[small])[0]
+    zeta = (2.0 / 3.0) * z[~small] ** 1.5
+    out[~small] = (
+        np.sqrt(z[~small]) / 3.0 * (special.jv(1.0 / 3.0, zeta) + special.jv(-1.0 / 3.0, zeta))
+    )
+    return out
+
+
 def _log_psi(force, v):
     """ln psi_F(v) of eq. (psi) where its argument F^(1/3) v + F^(-2/3)/4 is >= 0 (psi > 0 there)."""
     argument = force ** (1.0 / 3.0) * v + 0.25 * force ** (-2.0 / 3.0)
@@ -1870,7 +1885,7 @@ def _force_rule_sum(x, speeds, log_rest_grid, y_grid, decay, phase, nodes, weigh
     positive = argument > 0.0
     airy = np.empty(argument.size)
     airy[positive] = _airy_scaled(argument[positive])
-    airy[~positive] = special.airy(argument[~positive])[0]
+    airy[~positive] = _airy_oscillating(-argument[~positive])
     terms = w * airy * np.exp(log_rest - (2.0 / 3.0) * np.maximum(argument, 0.0) ** 1.5)
     return np.bincount(which, terms, minlength=speeds.size)
 
