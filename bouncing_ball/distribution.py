@@ -183,13 +183,16 @@ ACCURATE_RANGE = 0.4  # P(0, v) of a solution is used up to this fraction of its
 NEGLIGIBLE_EFOLDS = 60.0
 
 #: The tau integral of a term of the complex Nystrom sum (``_complex_kernel_sums``) by
-#: Gauss-Legendre with the fewest of these nodes that meets ~1e-15 relative: the integrand is a
-#: function of (tau / upper)^2 with the parameter eps = max(|z0 upper^2|, |upper^2|) (its
-#: Taylor coefficients fall like eps^k), so the rule with TAU_RULE_NODES[k] nodes is used where
-#: eps < TAU_RULE_LIMITS[k] (each within ~1e-15 of 40 nodes there), and the kernel's TAU_NODES
-#: above the last limit (tests/unit/test_distribution.py compares the sums).
-TAU_RULE_NODES = (6, 8, 10, 14, TAU_NODES)
-TAU_RULE_LIMITS = (0.01, 0.1, 0.3, 3.0)
+#: Gauss-Legendre with the fewest of TAU_RULE_NODES nodes that is accurate enough: the integrand
+#: is a function of (tau / upper)^2 with the parameter eps = max(|z0 upper^2|, |upper^2|) (its
+#: Taylor coefficients fall like eps^k).  The rule with TAU_RULE_NODES[k] nodes is used where
+#: eps < TAU_RULE_LIMITS[tier][k], the kernel's TAU_NODES above the last limit.  Tier 0, for the
+#: terms within e^-TAU_LOOSE_GAP of the sum's largest, holds each term to ~1e-15 of itself
+#: (against 40 nodes); tier 1, for the smaller terms, to ~1e-6 of itself, i.e. below 1e-19 of
+#: the largest (tests/unit/test_distribution.py compares the sums with TAU_NODES throughout).
+TAU_RULE_NODES = (4, 6, 8, 10, 14, TAU_NODES)
+TAU_RULE_LIMITS = ((0.0, 0.01, 0.1, 0.3, 3.0), (0.1, 3.0, 10.0, 20.0, 50.0))
+TAU_LOOSE_GAP = 30.0
 
 
 def _tau_rules():
@@ -560,9 +563,11 @@ def _complex_kernel_sums(
     z0s = np.empty(u.size, dtype=np.complex128)
     exponents = np.empty(u.size, dtype=np.complex128)
     levels = np.empty(u.size)
+    half_log_u = 0.5 * np.log(u)
     for i in range(v.size):
         big_v = v[i] / r
         size_v = abs(big_v)
+        half_log_size_v = 0.5 * math.log(size_v)
         best = -1e300
         for j in range(u.size):
             d = big_v - u[j]
@@ -571,24 +576,18 @@ def _complex_kernel_sums(
             z0s[j] = z0
             exponents[j] = exponent
             # G ~ u^(1/2) for u << |v|
-            levels[j] = exponent.real + 0.5 * math.log(min(u[j] / size_v, 1.0))
+            levels[j] = exponent.real + min(half_log_u[j] - half_log_size_v, 0.0)
             if levels[j] > best:
                 best = levels[j]
+        # kernel.kernel_small_u_limit (relative error O(u / |v|)) without its u^(1/2) e^(...)
+        small_u = 1.5 / math.pi * big_v**-2.5 * (1.0 + big_v) * cmath.exp(-0.5 * big_v + q * v[i])
         total = 0.0 + 0.0j
         size = 0.0
         for j in range(u.size):
             if levels[j] < best - 46.0:
                 continue
             if u[j] < 1e-13 * size_v:
-                # kernel.kernel_small_u_limit: relative error O(u / |v|)
-                term = (
-                    1.5
-                    / math.pi
-                    * math.sqrt(u[j])
-                    * big_v**-2.5
-                    * (1.0 + big_v)
-                    * cmath.exp(log_weights[j] - 0.5 * big_v + q * v[i])
-                )
+                term = small_u * math.sqrt(u[j]) * math.exp(log_weights[j])
                 total += term
                 size += abs(term)
                 continue
@@ -600,8 +599,9 @@ def _complex_kernel_sums(
                 upper = tau1 * (KERNEL_TAIL / math.sqrt(decay))
             upper2 = upper * upper
             eps = max(abs(z0 * upper2), abs(upper2))
+            tier = 0 if levels[j] > best - TAU_LOOSE_GAP else 1
             rule = 0
-            while rule < tau_limits.size and eps >= tau_limits[rule]:
+            while rule < tau_limits.shape[1] and eps >= tau_limits[tier, rule]:
                 rule += 1
             acc = 0.0 + 0.0j
             for k in range(tau_counts[rule]):

@@ -175,6 +175,6 @@ def test_tau_rules_match_the_kernels_rule(r, built):
         0.5 * (nodes[None, :] + 1.0),
         0.5 * weights[None, :],
         np.array([count]),
-        np.zeros(0),
+        np.zeros((2, 0)),
     )
     assert np.max(np.abs(ours - reference) / magnitude) < 1e-14
