@@ -168,10 +168,11 @@ PANEL_NODES = 10  # Gauss-Legendre nodes per panel of the real-axis v integrals
 # interpolated from Nystrom sums at the nodes of cells WEDGE_SPEED_WIDTH wide in s = ln |v| +
 # |v|^(1/2) and WEDGE_ANGLE_WIDTH wide in arg v (tensor Chebyshev, ~1e-13 relative: the contour
 # integrals of w(F) need ~1e4 values per r, the cells ~1e3 sums; one panel of 12 nodes across
-# the wedge's angle is as accurate as two of 8, with 3/4 of the sums)
+# the wedge's angle is as accurate as two of 8, and 22 nodes across 4 in s as two of 14 across
+# 2, each with fewer sums)
 WEDGE_SMALLEST_SPEED = 5e-4
-WEDGE_SPEED_WIDTH = 2.0
-WEDGE_SPEED_NODES = 14
+WEDGE_SPEED_WIDTH = 4.0
+WEDGE_SPEED_NODES = 22
 WEDGE_ANGLE_PANELS = 1
 WEDGE_ANGLE_WIDTH = THETA_MAX / WEDGE_ANGLE_PANELS
 WEDGE_ANGLE_NODES = 12
