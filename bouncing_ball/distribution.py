@@ -166,16 +166,16 @@ SMALL_FORCE_DEGREE = 5  # of the polynomial in F continuing ln w below F_min
 PANEL_NODES = 10  # Gauss-Legendre nodes per panel of the real-axis v integrals
 # P(0, v) e^(q v) in the wedge 0 <= arg v <= THETA_MAX, |v| >= WEDGE_SMALLEST_SPEED, is
 # interpolated from Nystrom sums at the nodes of cells WEDGE_SPEED_WIDTH wide in s = ln |v| +
-# |v|^(1/2) and WEDGE_ANGLE_WIDTH wide in arg v (tensor Chebyshev, ~1e-13 relative: the contour
+# |v|^(1/2) and across the wedge's angle (tensor Chebyshev, ~1e-13 relative: the contour
 # integrals of w(F) need ~1e4 values per r, the cells ~1e3 sums; one panel of 12 nodes across
-# the wedge's angle is as accurate as two of 8, and 22 nodes across 4 in s as two of 14 across
-# 2, each with fewer sums)
+# the angle is as accurate as two of 8, and 22 nodes across 4 in s as two of 14 across 2, each
+# with fewer sums).  Where a cell's sums cancel (at its largest arg v first) a cell across the
+# lower half of the angle, WEDGE_LOW_ANGLE_NODES wide, is tried for the v there.
 WEDGE_SMALLEST_SPEED = 5e-4
 WEDGE_SPEED_WIDTH = 4.0
 WEDGE_SPEED_NODES = 22
-WEDGE_ANGLE_PANELS = 1
-WEDGE_ANGLE_WIDTH = THETA_MAX / WEDGE_ANGLE_PANELS
 WEDGE_ANGLE_NODES = 12
+WEDGE_LOW_ANGLE_NODES = 8
 #: A cell of the interpolant of P(0, v) e^(q v) in the wedge 0 <= arg v <= THETA_MAX whose
 #: Nystrom sums cancel by more (magnitude / abs(value)) is not interpolated: its nodes' rounding
 #: errors would spread over it (the bound of the spread, in the noise estimate of w, would raise
@@ -219,7 +219,11 @@ def _chebyshev_nodes_and_inverse(count):
 
 
 _WEDGE_SPEED_X, _WEDGE_INVERSE_SPEED = _chebyshev_nodes_and_inverse(WEDGE_SPEED_NODES)
-_WEDGE_ANGLE_X, _WEDGE_INVERSE_ANGLE = _chebyshev_nodes_and_inverse(WEDGE_ANGLE_NODES)
+# the angle layouts of the wedge cells: (width in arg v from 0, Chebyshev nodes, inverse)
+_WEDGE_ANGLES = (
+    (THETA_MAX, *_chebyshev_nodes_and_inverse(WEDGE_ANGLE_NODES)),
+    (0.5 * THETA_MAX, *_chebyshev_nodes_and_inverse(WEDGE_LOW_ANGLE_NODES)),
+)
 
 
 #: On the outgoing side v > 0 the Airy factor of the F integral of eq. (fpsol) oscillates; up to
@@ -452,17 +456,26 @@ class _OutgoingDensity:
         )
         sigma = coordinate_of_speed(np.where(inside, rho, 1.0))
         row = np.floor((sigma - self._wedge_origin) / WEDGE_SPEED_WIDTH).astype(int)
-        column = np.clip(np.floor(theta / WEDGE_ANGLE_WIDTH), 0, WEDGE_ANGLE_PANELS - 1).astype(int)
         direct = ~inside
-        for key in set(zip(row[inside].tolist(), column[inside].tolist())):
-            members = inside & (row == key[0]) & (column == key[1])
-            cell = self._wedge_cell(*key)
-            if cell is None:
-                direct |= members
-                continue
-            value[members], magnitude[members] = _evaluate_wedge_cell(
-                cell, key, self._wedge_origin, sigma[members], theta[members], v[members], self.beta
-            )
+        for index in set(row[inside].tolist()):
+            left = inside & (row == index)  # not yet evaluated
+            for layout, (width, *_) in enumerate(_WEDGE_ANGLES):
+                members = left & (theta <= width + 1e-12)
+                if not members.any():
+                    continue
+                cell = self._wedge_cell(index, layout)
+                if cell is not None:
+                    value[members], magnitude[members] = _evaluate_wedge_cell(
+                        cell,
+                        (index, layout),
+                        self._wedge_origin,
+                        sigma[members],
+                        theta[members],
+                        v[members],
+                        self.beta,
+                    )
+                    left &= ~members
+            direct |= left
         if direct.any():
             value[direct], magnitude[direct] = self.scaled_complex_direct(v[direct])
         return value.reshape(shape), magnitude.reshape(shape)
@@ -471,20 +484,21 @@ class _OutgoingDensity:
     def _wedge_origin(self):
         return float(coordinate_of_speed(WEDGE_SMALLEST_SPEED))
 
-    def _wedge_cell(self, row, column):
-        """One cell of the interpolant of P(0, v) e^(q v) in the wedge 0 <= arg v <= THETA_MAX:
-        the Chebyshev coefficients (in s = ln |v| + |v|^(1/2) and arg v) of
-        ln(P(0, v) e^(q v)) + beta ln v, and magnitude / |value| of the Nystrom sums at its
-        nodes; None for a cell in which that ratio exceeds WEDGE_CLEAN somewhere (such v are
-        summed directly)."""
-        key = (row, column)
+    def _wedge_cell(self, row, layout):
+        """One cell of the interpolant of P(0, v) e^(q v) in the wedge 0 <= arg v <= THETA_MAX
+        (``layout`` 0: the whole angle; 1: its lower half): the Chebyshev coefficients (in
+        s = ln |v| + |v|^(1/2) and arg v) of ln(P(0, v) e^(q v)) + beta ln v, and
+        magnitude / |value| of the Nystrom sums at its nodes; None for a cell in which that
+        ratio exceeds WEDGE_CLEAN somewhere (such v are summed directly)."""
+        key = (row, layout)
         if key not in self.cells:
-            self.cells[key] = self._build_wedge_cell(row, column)
+            self.cells[key] = self._build_wedge_cell(row, layout)
         return self.cells[key]
 
-    def _build_wedge_cell(self, row, column):
+    def _build_wedge_cell(self, row, layout):
+        width, angle_x, inverse_angle = _WEDGE_ANGLES[layout]
         sigma = self._wedge_origin + WEDGE_SPEED_WIDTH * (row + 0.5 * (_WEDGE_SPEED_X + 1.0))
-        theta = WEDGE_ANGLE_WIDTH * (column + 0.5 * (_WEDGE_ANGLE_X + 1.0))
+        theta = width * 0.5 * (angle_x + 1.0)
         # the noisiest node first (largest |v| and arg v): a dirty cell costs one sum
         corner = speed_of_coordinate(sigma.max()) * np.exp(1j * theta.max())
         value, magnitude = self.scaled_complex_direct(np.array([corner]))
@@ -497,7 +511,7 @@ class _OutgoingDensity:
         if not np.all(noise <= WEDGE_CLEAN):
             return None
         log_value = np.log(value) + self.beta * np.log(v)
-        return _WEDGE_INVERSE_SPEED @ log_value @ _WEDGE_INVERSE_ANGLE.T, noise
+        return _WEDGE_INVERSE_SPEED @ log_value @ inverse_angle.T, noise
 
     def scaled_complex_direct(self, v):
         """P(0, v) e^(q v) at complex v, |arg v| < pi/3, by the Nystrom sum, and the sum of the
@@ -540,13 +554,14 @@ def _evaluate_wedge_cell(cell, key, origin, sigma, theta, v, beta):
     Nystrom sums weighted by |Lagrange basis| at v (in the units of ``scaled_complex_direct``'s
     magnitude: the interpolant carries the rounding errors of all its nodes)."""
     coefficients, noise = cell
+    width, angle_x, inverse_angle = _WEDGE_ANGLES[key[1]]
     t_speed = 2.0 * (sigma - origin) / WEDGE_SPEED_WIDTH - 2.0 * key[0] - 1.0
-    t_angle = 2.0 * theta / WEDGE_ANGLE_WIDTH - 2.0 * key[1] - 1.0
+    t_angle = 2.0 * theta / width - 1.0
     speed = np.polynomial.chebyshev.chebvander(t_speed, WEDGE_SPEED_NODES - 1)
-    angle = np.polynomial.chebyshev.chebvander(t_angle, WEDGE_ANGLE_NODES - 1)
+    angle = np.polynomial.chebyshev.chebvander(t_angle, angle_x.size - 1)
     value = np.exp(np.einsum("pi,ij,pj->p", speed, coefficients, angle) - beta * np.log(v))
     lagrange_speed = np.abs(speed @ _WEDGE_INVERSE_SPEED)
-    lagrange_angle = np.abs(angle @ _WEDGE_INVERSE_ANGLE)
+    lagrange_angle = np.abs(angle @ inverse_angle)
     spread = np.einsum("pi,ij,pj->p", lagrange_speed, noise, lagrange_angle)
     return value, np.abs(value) * spread
 
