@@ -559,10 +559,10 @@ def _evaluate_wedge_cell(cell, key, origin, sigma, theta, v, beta):
     t_angle = 2.0 * theta / width - 1.0
     speed = np.polynomial.chebyshev.chebvander(t_speed, WEDGE_SPEED_NODES - 1)
     angle = np.polynomial.chebyshev.chebvander(t_angle, angle_x.size - 1)
-    value = np.exp(np.einsum("pi,ij,pj->p", speed, coefficients, angle) - beta * np.log(v))
+    value = np.exp(np.einsum("pj,pj->p", speed @ coefficients, angle) - beta * np.log(v))
     lagrange_speed = np.abs(speed @ _WEDGE_INVERSE_SPEED)
     lagrange_angle = np.abs(angle @ inverse_angle)
-    spread = np.einsum("pi,ij,pj->p", lagrange_speed, noise, lagrange_angle)
+    spread = np.einsum("pj,pj->p", lagrange_speed @ noise, lagrange_angle)
     return value, np.abs(value) * spread
 
 
