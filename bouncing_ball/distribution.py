@@ -439,13 +439,14 @@ class _OutgoingDensity:
         power = self.log_amplitude - self.beta * np.log(np.where(v > 0, v, 1.0))
         return np.where(below, power, smooth - self.beta * np.log(v) - self.q * v)
 
-    def scaled_complex(self, v):
+    def scaled_complex(self, v, slack=None):
         """P(0, v) e^(q v) at complex v, |arg v| < pi/3, and a bound on its rounding error in
         units of EPSILON: from the wedge interpolant (``_wedge_cell``) where v lies in a clean
-        cell of it, else from the Nystrom sum (``scaled_complex_direct``)."""
+        cell of it, else from the Nystrom sum (``scaled_complex_direct``, with ``slack``)."""
         v = np.asarray(v, dtype=complex)
         shape = v.shape
         v = v.ravel()
+        slack = np.zeros(v.size) if slack is None else np.asarray(slack, dtype=float).ravel()
         value, magnitude = np.empty(v.size, dtype=complex), np.empty(v.size)
         rho, theta = np.abs(v), np.angle(v)
         inside = (
@@ -477,7 +478,7 @@ class _OutgoingDensity:
                     left &= ~members
             direct |= left
         if direct.any():
-            value[direct], magnitude[direct] = self.scaled_complex_direct(v[direct])
+            value[direct], magnitude[direct] = self.scaled_complex_direct(v[direct], slack[direct])
         return value.reshape(shape), magnitude.reshape(shape)
 
     @functools.cached_property
@@ -513,11 +514,13 @@ class _OutgoingDensity:
         log_value = np.log(value) + self.beta * np.log(v)
         return _WEDGE_INVERSE_SPEED @ log_value @ inverse_angle.T, noise
 
-    def scaled_complex_direct(self, v):
+    def scaled_complex_direct(self, v, slack=None):
         """P(0, v) e^(q v) at complex v, |arg v| < pi/3, by the Nystrom sum, and the sum of the
         magnitudes of its terms (rounding errors are ~1e-16 of it: at complex v the terms
-        cancel, increasingly so as Im(v)^2 / Re(v) grows)."""
+        cancel, increasingly so as Im(v)^2 / Re(v) grows).  ``slack``: per v, the e-folds by
+        which its result may be less accurate (``_complex_kernel_sums``; none if None)."""
         v = np.ascontiguousarray(np.asarray(v, dtype=complex).ravel())
+        slack = np.zeros(v.size) if slack is None else np.ascontiguousarray(slack, dtype=float)
         r = self.restitution
         out = np.empty(v.size, dtype=complex)
         magnitude = np.empty(v.size)
@@ -531,6 +534,7 @@ class _OutgoingDensity:
             _TAU_W,
             _TAU_COUNTS,
             _TAU_LIMITS,
+            slack,
             out,
             magnitude,
         )
@@ -568,13 +572,15 @@ def _evaluate_wedge_cell(cell, key, origin, sigma, theta, v, beta):
 
 @njit(cache=True)
 def _complex_kernel_sums(
-    v, r, q, u, log_weights, tau_x, tau_w, tau_counts, tau_limits, out, magnitude
+    v, r, q, u, log_weights, tau_x, tau_w, tau_counts, tau_limits, slack, out, magnitude
 ):
     """out_i = e^(q v_i) r^-2 sum_j exp(log_weights_j) G_g(v_i / r, u_j) for complex v_i: the
     stable form of eq. (kernel3) in kernel.py, continued to complex v (the tau integral runs
     along the straight segment from 0 to tau1, by the rule of ``_tau_rules`` that eps selects,
     TAU_RULE_LIMITS).  Terms below e^-SKIP_EFOLDS of the largest are skipped (at large |v| the
-    kernel confines u to a window of width ~ |v|^(1/2))."""
+    kernel confines u to a window of width ~ |v|^(1/2)).  A sum whose result is needed only to
+    e^slack_i times the accuracy of the others skips below e^-(SKIP_EFOLDS - slack_i) and
+    takes tau rule tier 1 below e^-(TAU_LOOSE_GAP - slack_i)."""
     root3_pi = math.sqrt(3.0) / math.pi
     # per u: z0, the exponent and its real part with the u^(1/2) bound (first pass, reused)
     z0s = np.empty(u.size, dtype=np.complex128)
@@ -601,7 +607,7 @@ def _complex_kernel_sums(
         total = 0.0 + 0.0j
         size = 0.0
         for j in range(u.size):
-            if levels[j] < best - 46.0:
+            if levels[j] < best - (SKIP_EFOLDS - slack[i]):
                 continue
             if u[j] < 1e-13 * size_v:
                 term = small_u * math.sqrt(u[j]) * math.exp(log_weights[j])
@@ -616,7 +622,7 @@ def _complex_kernel_sums(
                 upper = tau1 * (KERNEL_TAIL / math.sqrt(decay))
             upper2 = upper * upper
             eps = max(abs(z0 * upper2), abs(upper2))
-            tier = 0 if levels[j] > best - TAU_LOOSE_GAP else 1
+            tier = 0 if levels[j] > best - (TAU_LOOSE_GAP - slack[i]) else 1
             rule = 0
             while rule < tau_limits.shape[1] and eps >= tau_limits[tier, rule]:
                 rule += 1
@@ -921,6 +927,11 @@ def _compute_kernel_transform_table(density):
 
 
 EPSILON = np.finfo(float).eps
+#: A contour node of A(F) whose term (by the real-axis P(0, |v|)) is below the largest by more
+#: than CONTOUR_SLACK_MARGIN e-folds may take P(0, v) from a Nystrom sum that many e-folds less
+#: accurate (at most LARGEST_SLACK: still ~1e-4 of itself, below 1e-19 of the largest term).
+CONTOUR_SLACK_MARGIN = 10.0
+LARGEST_SLACK = 26.0
 # rounding error of a sum of N terms of mixed signs, in units of EPSILON times the sum of their
 # magnitudes (~ N^(1/2) for N ~ 1000 terms)
 ROUNDING = 50.0
@@ -963,7 +974,14 @@ def _log_contour_part(density, force):
         raise ValueError(
             f"w({force}) needs P(0, v) at |v| = {np.max(np.abs(v)):.4g} > {density.largest:.4g}"
         )
-    scaled, magnitude = density.scaled_complex(v)
+    # a node far below the largest term needs P(0, v) less accurately: its slack (the e-folds,
+    # less CONTOUR_SLACK_MARGIN for |P(0, v) e^(q v)| off the real axis, up to LARGEST_SLACK)
+    # from the real-axis |P(0, |v|)| e^(q |v|)
+    proxy = estimate[keep] + density.log_density(np.abs(v)) + q * np.abs(v)
+    slack = np.clip(
+        max(np.max(proxy), np.max(all_terms)) - proxy - CONTOUR_SLACK_MARGIN, 0.0, LARGEST_SLACK
+    )
+    scaled, magnitude = density.scaled_complex(v, slack)
     log_rest = np.log(wv * v) + (0.5 - q) * v + log_airy
     log_terms_c = np.log(scaled) + log_rest  # complex logs
     top = max(np.max(log_terms_c.real), np.max(all_terms))
