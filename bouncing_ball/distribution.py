@@ -772,32 +772,10 @@ def _log_sum(log_terms, signs=None):
     return top + np.log(abs(total)), float(np.sign(total))
 
 
-#: The real-axis v integral of A(F) by Gauss-Legendre panels in s, 0.5 wide, but
-#: SMOOTH_PANEL_WIDTH wide from the solution's lowest node up to SMOOTH_SPEED_FRACTION of
-#: min(1, F^(-1/3)) (there v h(v) psi_F(-v) is C v^(1 - beta) times a factor that varies only
-#: on the scales 1 and F^(-1/3)), and below that node (the pure power law).
-SMOOTH_PANEL_WIDTH = 2.0
-SMOOTH_SPEED_FRACTION = 0.05
-
-
-def _speed_panels(density, force, v1):
-    """Gauss-Legendre nodes and weights in s from SMALLEST_SPEED to v1 (``_real_segment_terms``)."""
-    lo, hi = coordinate_of_speed(SMALLEST_SPEED), coordinate_of_speed(v1)
-    lowest = coordinate_of_speed(density.lowest)
-    smooth = coordinate_of_speed(SMOOTH_SPEED_FRACTION * min(1.0, force ** (-1.0 / 3.0)))
-    cuts = np.clip([lo, lowest, max(smooth, lowest), hi], lo, hi)
-    parts = [
-        _panels(a, b, width)
-        for a, b, width in zip(cuts[:-1], cuts[1:], (SMOOTH_PANEL_WIDTH, SMOOTH_PANEL_WIDTH, 0.5))
-        if b > a
-    ]
-    return tuple(np.concatenate(part) for part in zip(*parts))
-
-
 def _real_segment_terms(density, force, v1):
     """ln |terms| and signs of int_{SMALLEST_SPEED}^{v1} dv v h(v) psi_F(-v) (Gauss-Legendre in s),
     and ln of the closed-form part below SMALLEST_SPEED (C psi_F(0) eps^(2-beta) / (2-beta))."""
-    s, ws = _speed_panels(density, force, v1)
+    s, ws = _panels(coordinate_of_speed(SMALLEST_SPEED), coordinate_of_speed(v1), 0.5)
     v = speed_of_coordinate(s)
     turning = 0.25 / force  # beyond, psi_F(-v) oscillates with amplitude O(F^(-1/6))
     inside = v <= turning
