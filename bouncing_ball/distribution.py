@@ -348,17 +348,15 @@ def _airy_scaled(z):
 
 
 def _airy_oscillating(z):
-    """Ai(-z) for real z >= 0 from Bessel functions, (z^(1/2) / 3) (J_1/3 + J_-1/3)((2/3) z^(3/2))
-    (DLMF 9.6.6; as close to mpmath's as scipy's airy up to z = 120, and faster), scipy's airy
-    where z < 1e-3."""
+    """Ai(-z) for real z >= 0 from the Hankel function, (z^(1/2) / 2) (J_1/3 - Y_1/3 / 3^(1/2))
+    at (2/3) z^(3/2) (DLMF 9.6.6 with J_-1/3 = (J_1/3 - 3^(1/2) Y_1/3) / 2: as close to mpmath's
+    as scipy's airy up to z = 120, and several times faster), scipy's airy where z < 1e-3."""
     z = np.asarray(z, dtype=float)
     out = np.empty(z.shape)
     small = z < 1e-3
     out[small] = special.airy(-z[small])[0]
-    zeta = (2.0 / 3.0) * z[~small] ** 1.5
-    out[~small] = (
-        np.sqrt(z[~small]) / 3.0 * (special.jv(1.0 / 3.0, zeta) + special.jv(-1.0 / 3.0, zeta))
-    )
+    hankel = special.hankel1(1.0 / 3.0, (2.0 / 3.0) * z[~small] ** 1.5)
+    out[~small] = 0.5 * np.sqrt(z[~small]) * (hankel.real - hankel.imag / np.sqrt(3.0))
     return out
 
 
