@@ -164,6 +164,7 @@ SMALL_PANEL_WIDTH = 1.2  # (F < 1, r > 1/2)
 PANEL_CHEBYSHEV_NODES = 12
 SMALL_FORCE_DEGREE = 5  # of the polynomial in F continuing ln w below F_min
 PANEL_NODES = 10  # Gauss-Legendre nodes per panel of the real-axis v integrals
+REAL_PANEL_WIDTH = 0.5  # in s, of the panels of the real-axis part of A(F)
 # P(0, v) e^(q v) in the wedge 0 <= arg v <= THETA_MAX, |v| >= WEDGE_SMALLEST_SPEED, is
 # interpolated from Nystrom sums at the nodes of cells WEDGE_SPEED_WIDTH wide in s = ln |v| +
 # |v|^(1/2) and across the wedge's angle (tensor Chebyshev, ~1e-13 relative: the contour
@@ -479,6 +480,32 @@ class _OutgoingDensity:
             value[direct], magnitude[direct] = self.scaled_complex_direct(v[direct], slack[direct])
         return value.reshape(shape), magnitude.reshape(shape)
 
+    def real_axis_nodes(self, v1):
+        """Gauss-Legendre nodes v of int_{SMALLEST_SPEED}^{v1} dv on panels REAL_PANEL_WIDTH
+        wide in s = ln v + v^(1/2) from SMALLEST_SPEED (the last one shorter), and ln of
+        weight x v h(v), h(v) = e^(v/2) P(0, v): the complete panels' from a table kept for
+        all F, the last one's computed."""
+        lo, hi = coordinate_of_speed(SMALLEST_SPEED), coordinate_of_speed(v1)
+        complete = min(
+            int((hi - lo) / REAL_PANEL_WIDTH), self._real_axis_table[0].size // PANEL_NODES
+        )
+        v, log_vh = (part[: complete * PANEL_NODES] for part in self._real_axis_table)
+        start = lo + complete * REAL_PANEL_WIDTH
+        if hi > start:
+            last_v, last_log_vh = self._real_axis_terms(*_panels(start, hi, REAL_PANEL_WIDTH))
+            v, log_vh = np.concatenate([v, last_v]), np.concatenate([log_vh, last_log_vh])
+        return v, log_vh
+
+    def _real_axis_terms(self, s, ws):
+        v = speed_of_coordinate(s)
+        return v, np.log(ws * _jacobian(v) * v) + 0.5 * v + self.log_density(v)
+
+    @functools.cached_property
+    def _real_axis_table(self):
+        lo, hi = coordinate_of_speed(SMALLEST_SPEED), coordinate_of_speed(self.largest)
+        count = int((hi - lo) / REAL_PANEL_WIDTH)
+        return self._real_axis_terms(*_panels(lo, lo + count * REAL_PANEL_WIDTH, REAL_PANEL_WIDTH))
+
     @functools.cached_property
     def _wedge_origin(self):
         return float(coordinate_of_speed(WEDGE_SMALLEST_SPEED))
@@ -773,8 +800,7 @@ def _log_sum(log_terms, signs=None):
 def _real_segment_terms(density, force, v1):
     """ln |terms| and signs of int_{SMALLEST_SPEED}^{v1} dv v h(v) psi_F(-v) (Gauss-Legendre in s),
     and ln of the closed-form part below SMALLEST_SPEED (C psi_F(0) eps^(2-beta) / (2-beta))."""
-    s, ws = _panels(coordinate_of_speed(SMALLEST_SPEED), coordinate_of_speed(v1), 0.5)
-    v = speed_of_coordinate(s)
+    v, log_vh = density.real_axis_nodes(v1)
     turning = 0.25 / force  # beyond, psi_F(-v) oscillates with amplitude O(F^(-1/6))
     inside = v <= turning
     log_psi, signs = np.empty(v.shape), np.ones(v.shape)
@@ -783,7 +809,7 @@ def _real_segment_terms(density, force, v1):
     with np.errstate(divide="ignore"):
         log_psi[~inside] = np.log(np.abs(psi_beyond))
     signs[~inside] = np.sign(psi_beyond)
-    log_terms = np.log(ws * _jacobian(v) * v) + 0.5 * v + density.log_density(v) + log_psi
+    log_terms = log_vh + log_psi
     beta = density.beta
     small = (
         density.log_amplitude
