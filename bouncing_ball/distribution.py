@@ -899,21 +899,25 @@ def _kernel_transforms(density, g):
     s, ws = _panels(coordinate_of_speed(SMALLEST_SPEED), coordinate_of_speed(top), 0.5)
     v = speed_of_coordinate(s)
     log_vh = np.log(ws * _jacobian(v) * v) + 0.5 * v + density.log_density(v)
-    transforms = np.empty(g.size)
-    for k, gk in enumerate(g):
-        # psi_G(v) <= G^(-1/6) exp(-(2/3) (G^(1/3) v)^(3/2)): the terms beyond e^-120 of the
-        # largest such bound are dropped before the Airy function is evaluated
-        bound = log_vh - np.log(gk) / 6.0 - (2.0 / 3.0) * (gk ** (1.0 / 3.0) * v) ** 1.5
-        kept = bound > np.max(bound) - 2.0 * NEGLIGIBLE_EFOLDS
-        body = np.sum(np.exp(log_vh[kept] + _log_psi(gk, v[kept])))
-        small = (
-            np.exp(density.log_amplitude + _log_psi(gk, 0.0))
-            * SMALLEST_SPEED ** (2.0 - beta)
-            / (2.0 - beta)
-            * (1.0 + _small_speed_slope(gk, beta))
-        )
-        transforms[k] = body + small
-    return transforms
+    # psi_G(v) <= G^(-1/6) exp(-(2/3) (G^(1/3) v)^(3/2)): the terms beyond e^-120 of the
+    # largest such bound (per G) are dropped before the Airy function is evaluated
+    bound = (
+        log_vh[None, :]
+        - np.log(g)[:, None] / 6.0
+        - (2.0 / 3.0) * (np.cbrt(g)[:, None] * v[None, :]) ** 1.5
+    )
+    which, index = np.nonzero(
+        bound > np.max(bound, axis=1, keepdims=True) - 2.0 * NEGLIGIBLE_EFOLDS
+    )
+    log_psi = _log_psi(g[which], v[index])
+    body = np.bincount(which, np.exp(log_vh[index] + log_psi), minlength=g.size)
+    small = (
+        np.exp(density.log_amplitude + _log_psi(g, 0.0))
+        * SMALLEST_SPEED ** (2.0 - beta)
+        / (2.0 - beta)
+        * (1.0 + _small_speed_slope(g, beta))
+    )
+    return body + small
 
 
 # T(G) G^-alpha e^(1/(12G)) (smooth in ln G, alpha = (2 beta - 5)/6) is computed at
