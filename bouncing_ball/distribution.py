@@ -617,6 +617,7 @@ def _complex_kernel_sums(
         size_v = abs(big_v)
         half_log_size_v = 0.5 * math.log(size_v)
         best = -1e300
+        last = u.size
         for j in range(u.size):
             d = big_v - u[j]
             z0 = cmath.sqrt(d * d + big_v * u[j])
@@ -627,11 +628,16 @@ def _complex_kernel_sums(
             levels[j] = exponent.real + min(half_log_u[j] - half_log_size_v, 0.0)
             if levels[j] > best:
                 best = levels[j]
+            # beyond u = 2 |V| + 10 the terms only fall (like e^(-(1/2 + q) u)): stop once they
+            # are 10 e-folds below the skipped ones
+            if u[j] > 2.0 * size_v + 10.0 and levels[j] < best - SKIP_EFOLDS - 10.0:
+                last = j
+                break
         # kernel.kernel_small_u_limit (relative error O(u / |v|)) without its u^(1/2) e^(...)
         small_u = 1.5 / math.pi * big_v**-2.5 * (1.0 + big_v) * cmath.exp(-0.5 * big_v + q * v[i])
         total = 0.0 + 0.0j
         size = 0.0
-        for j in range(u.size):
+        for j in range(last):
             if levels[j] < best - (SKIP_EFOLDS - slack[i]):
                 continue
             if u[j] < 1e-13 * size_v:
