@@ -438,10 +438,11 @@ class _OutgoingDensity:
         power = self.log_amplitude - self.beta * np.log(np.where(v > 0, v, 1.0))
         return np.where(below, power, smooth - self.beta * np.log(v) - self.q * v)
 
-    def scaled_complex(self, v, slack=None):
+    def scaled_complex(self, v, slack=None, with_noise=True):
         """P(0, v) e^(q v) at complex v, |arg v| < pi/3, and a bound on its rounding error in
         units of EPSILON: from the wedge interpolant (``_wedge_cell``) where v lies in a clean
-        cell of it, else from the Nystrom sum (``scaled_complex_direct``, with ``slack``)."""
+        cell of it, else from the Nystrom sum (``scaled_complex_direct``, with ``slack``).
+        Without ``with_noise`` the interpolated v's bound is not computed (NaN)."""
         v = np.asarray(v, dtype=complex)
         shape = v.shape
         v = v.ravel()
@@ -473,6 +474,7 @@ class _OutgoingDensity:
                         theta[members],
                         v[members],
                         self.beta,
+                        with_noise,
                     )
                     left &= ~members
             direct |= left
@@ -578,10 +580,11 @@ class _OutgoingDensity:
         )
 
 
-def _evaluate_wedge_cell(cell, key, origin, sigma, theta, v, beta):
+def _evaluate_wedge_cell(cell, key, origin, sigma, theta, v, beta, with_noise=True):
     """P(0, v) e^(q v) from a wedge cell, and the sum of the rounding errors of its nodes'
     Nystrom sums weighted by |Lagrange basis| at v (in the units of ``scaled_complex_direct``'s
-    magnitude: the interpolant carries the rounding errors of all its nodes)."""
+    magnitude: the interpolant carries the rounding errors of all its nodes; NaN without
+    ``with_noise``)."""
     coefficients, noise = cell
     width, angle_x, inverse_angle = _WEDGE_ANGLES[key[1]]
     t_speed = 2.0 * (sigma - origin) / WEDGE_SPEED_WIDTH - 2.0 * key[0] - 1.0
@@ -589,6 +592,8 @@ def _evaluate_wedge_cell(cell, key, origin, sigma, theta, v, beta):
     speed = np.polynomial.chebyshev.chebvander(t_speed, WEDGE_SPEED_NODES - 1)
     angle = np.polynomial.chebyshev.chebvander(t_angle, angle_x.size - 1)
     value = np.exp(np.einsum("pj,pj->p", speed @ coefficients, angle) - beta * np.log(v))
+    if not with_noise:
+        return value, np.full(value.shape, np.nan)
     lagrange_speed = np.abs(speed @ _WEDGE_INVERSE_SPEED)
     lagrange_angle = np.abs(angle @ inverse_angle)
     spread = np.einsum("pj,pj->p", lagrange_speed @ noise, lagrange_angle)
@@ -978,10 +983,10 @@ def _split_point(q, force):
     return max(v1, 0.5 * force ** (-1.0 / 3.0))
 
 
-def _log_contour_part(density, force):
-    """ln |A(F)|, its sign, and ln of an estimate of its rounding error: the real segment plus
-    2 Re of the complex path.  Raises ValueError where P(0, v) would be needed beyond the range
-    in which the solution's is accurate."""
+def _log_contour_part(density, force, with_noise=True):
+    """ln |A(F)|, its sign, and ln of an estimate of its rounding error (NaN without
+    ``with_noise``): the real segment plus 2 Re of the complex path.  Raises ValueError where
+    P(0, v) would be needed beyond the range in which the solution's is accurate."""
     q = density.q
     v1 = _split_point(q, force)
     cut = min(v1, density.largest)
@@ -1015,28 +1020,30 @@ def _log_contour_part(density, force):
     slack = np.clip(
         max(np.max(proxy), np.max(all_terms)) - proxy - CONTOUR_SLACK_MARGIN, 0.0, LARGEST_SLACK
     )
-    scaled, magnitude = density.scaled_complex(v, slack)
+    scaled, magnitude = density.scaled_complex(v, slack, with_noise)
     log_rest = np.log(wv * v) + (0.5 - q) * v + log_airy
     log_terms_c = np.log(scaled) + log_rest  # complex logs
     top = max(np.max(log_terms_c.real), np.max(all_terms))
     contour = 2.0 * np.sum(np.exp(log_terms_c - top)).real
     real = np.sum(all_signs * np.exp(all_terms - top))
     total = contour + real
+    if not with_noise:
+        return top + np.log(abs(total)), float(np.sign(total)), np.nan
     noise = 2.0 * np.sum(np.exp(np.log(magnitude) + log_rest.real - top)) * EPSILON
     noise += np.sum(np.exp(all_terms - top)) * ROUNDING * EPSILON
     return top + np.log(abs(total)), float(np.sign(total)), top + np.log(noise)
 
 
-def _log_weight_with_noise(forces, density):
+def _log_weight_with_noise(forces, density, with_noise=True):
     """ln w(F) and an estimate of its relative rounding error (inf, and ln w NaN, where the
-    solution's P(0, v) does not reach far enough)."""
+    solution's P(0, v) does not reach far enough; NaN without ``with_noise``)."""
     forces = np.atleast_1d(np.asarray(forces, dtype=float))
     b = _log_kernel_transform(density, forces)
     log_w = np.full(forces.size, np.nan)
     noise = np.full(forces.size, np.inf)
     for k, f in enumerate(forces):
         try:
-            log_a, sign_a, log_noise = _log_contour_part(density, f)
+            log_a, sign_a, log_noise = _log_contour_part(density, f, with_noise)
         except ValueError:
             continue
         z = 1.0 / (12.0 * f)
@@ -1086,7 +1093,7 @@ def log_weight_function(force, solution, density=None):
     [0.22905337 0.15334074]
     """
     density = _outgoing_density(solution) if density is None else density
-    return _log_weight_with_noise(force, density)[0].reshape(np.shape(force))
+    return _log_weight_with_noise(force, density, with_noise=False)[0].reshape(np.shape(force))
 
 
 def weight_function(force, solution, density=None):
