@@ -164,16 +164,19 @@ SMALL_PANEL_WIDTH = 1.2  # (F < 1, r > 1/2)
 PANEL_CHEBYSHEV_NODES = 12
 SMALL_FORCE_DEGREE = 5  # of the polynomial in F continuing ln w below F_min
 PANEL_NODES = 10  # Gauss-Legendre nodes per panel of the real-axis v integrals
+REAL_PANEL_WIDTH = 0.5  # in s, of the panels of the real-axis part of A(F)
 # P(0, v) e^(q v) in the wedge 0 <= arg v <= THETA_MAX, |v| >= WEDGE_SMALLEST_SPEED, is
 # interpolated from Nystrom sums at the nodes of cells WEDGE_SPEED_WIDTH wide in s = ln |v| +
-# |v|^(1/2) and WEDGE_ANGLE_WIDTH wide in arg v (tensor Chebyshev, ~1e-13 relative: the contour
-# integrals of w(F) need ~1e4 values per r, the cells ~1e3 sums)
+# |v|^(1/2) and across the wedge's angle (tensor Chebyshev, ~1e-13 relative: the contour
+# integrals of w(F) need ~1e4 values per r, the cells ~1e3 sums; one panel of 12 nodes across
+# the angle is as accurate as two of 8, and 22 nodes across 4 in s as two of 14 across 2, each
+# with fewer sums).  Where a cell's sums cancel (at its largest arg v first) a cell across the
+# lower half of the angle, WEDGE_LOW_ANGLE_NODES wide, is tried for the v there.
 WEDGE_SMALLEST_SPEED = 5e-4
-WEDGE_SPEED_WIDTH = 2.0
-WEDGE_SPEED_NODES = 14
-WEDGE_ANGLE_PANELS = 2
-WEDGE_ANGLE_WIDTH = THETA_MAX / WEDGE_ANGLE_PANELS
-WEDGE_ANGLE_NODES = 8
+WEDGE_SPEED_WIDTH = 4.0
+WEDGE_SPEED_NODES = 22
+WEDGE_ANGLE_NODES = 12
+WEDGE_LOW_ANGLE_NODES = 8
 #: A cell of the interpolant of P(0, v) e^(q v) in the wedge 0 <= arg v <= THETA_MAX whose
 #: Nystrom sums cancel by more (magnitude / abs(value)) is not interpolated: its nodes' rounding
 #: errors would spread over it (the bound of the spread, in the noise estimate of w, would raise
@@ -182,8 +185,32 @@ WEDGE_CLEAN = 1e6
 ACCURATE_RANGE = 0.4  # P(0, v) of a solution is used up to this fraction of its highest node
 NEGLIGIBLE_EFOLDS = 60.0
 
-_TAU_X, _TAU_W = np.polynomial.legendre.leggauss(TAU_NODES)
-_TAU_X, _TAU_W = 0.5 * (_TAU_X + 1.0), 0.5 * _TAU_W
+#: The tau integral of a term of the complex Nystrom sum (``_complex_kernel_sums``) by
+#: Gauss-Legendre with the fewest of TAU_RULE_NODES nodes that is accurate enough: the integrand
+#: is a function of (tau / upper)^2 with the parameter eps = max(|z0 upper^2|, |upper^2|) (its
+#: Taylor coefficients fall like eps^k).  The rule with TAU_RULE_NODES[k] nodes is used where
+#: eps < TAU_RULE_LIMITS[tier][k], the kernel's TAU_NODES above the last limit.  Tier 0, for the
+#: terms within e^-TAU_LOOSE_GAP of the sum's largest, holds each term to ~1e-15 of itself
+#: (against 40 nodes); tier 1, for the smaller terms, to ~1e-6 of itself, i.e. below 1e-19 of
+#: the largest (tests/unit/test_distribution.py compares the sums with TAU_NODES throughout).
+TAU_RULE_NODES = (4, 6, 8, 10, 14, TAU_NODES)
+TAU_RULE_LIMITS = ((0.0, 0.01, 0.1, 0.3, 3.0), (0.1, 3.0, 10.0, 20.0, 50.0))
+TAU_LOOSE_GAP = 30.0
+
+
+def _tau_rules():
+    """The Gauss-Legendre rules of TAU_RULE_NODES on [0, 1], one row each (zero-padded)."""
+    size = max(TAU_RULE_NODES)
+    x, w = np.zeros((len(TAU_RULE_NODES), size)), np.zeros((len(TAU_RULE_NODES), size))
+    for k, count in enumerate(TAU_RULE_NODES):
+        nodes, weights = np.polynomial.legendre.leggauss(count)
+        x[k, :count], w[k, :count] = 0.5 * (nodes + 1.0), 0.5 * weights
+    return x, w
+
+
+_TAU_X, _TAU_W = _tau_rules()
+_TAU_COUNTS = np.array(TAU_RULE_NODES, dtype=np.int64)
+_TAU_LIMITS = np.array(TAU_RULE_LIMITS)
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(PANEL_NODES)
 
 
@@ -193,7 +220,11 @@ def _chebyshev_nodes_and_inverse(count):
 
 
 _WEDGE_SPEED_X, _WEDGE_INVERSE_SPEED = _chebyshev_nodes_and_inverse(WEDGE_SPEED_NODES)
-_WEDGE_ANGLE_X, _WEDGE_INVERSE_ANGLE = _chebyshev_nodes_and_inverse(WEDGE_ANGLE_NODES)
+# the angle layouts of the wedge cells: (width in arg v from 0, Chebyshev nodes, inverse)
+_WEDGE_ANGLES = (
+    (THETA_MAX, *_chebyshev_nodes_and_inverse(WEDGE_ANGLE_NODES)),
+    (0.5 * THETA_MAX, *_chebyshev_nodes_and_inverse(WEDGE_LOW_ANGLE_NODES)),
+)
 
 
 #: On the outgoing side v > 0 the Airy factor of the F integral of eq. (fpsol) oscillates; up to
@@ -294,15 +325,40 @@ def outgoing_speed_solution(restitution, step=DEFAULT_STEP):
 # special functions
 
 
+#: Ai from K_1/3 (``_airy_scaled``) where |arg z| is below this (the formula holds up to 2 pi / 3).
+BESSEL_AIRY_PHASE = 2.0
+
+
 def _airy_scaled(z):
     """Ai(z) exp((2/3) z^(3/2)) (scipy's airye), with its leading asymptotic form where |z| > 1e6
-    (scipy returns NaN there)."""
+    (scipy returns NaN there); for 0 < |z| <= 1e6 with |arg z| < BESSEL_AIRY_PHASE from the
+    scaled Bessel function, (z / 3)^(1/2) kve(1/3, (2/3) z^(3/2)) / pi (DLMF 9.6.1: the same to
+    ~5e-15, and as close to mpmath's, three to nine times faster)."""
     z = np.asarray(z)
     big = np.abs(z) > 1e6
-    safe = np.where(big, 1.0, z)
     far = np.where(big, z, 1e6)
     asymptotic = far**-0.25 / (2.0 * np.sqrt(np.pi)) * (1.0 - 5.0 / (48.0 * far**1.5))
-    return np.where(big, asymptotic, special.airye(safe)[0])
+    bessel = (z != 0.0) & (np.abs(np.angle(z)) < BESSEL_AIRY_PHASE) & ~big
+    out = np.where(big, asymptotic, 0.0 * z)
+    out[bessel] = (
+        np.sqrt(z[bessel] / 3.0) * special.kve(1.0 / 3.0, (2.0 / 3.0) * z[bessel] ** 1.5) / np.pi
+    )
+    rest = ~bessel & ~big
+    out[rest] = special.airye(z[rest])[0]
+    return out
+
+
+def _airy_oscillating(z):
+    """Ai(-z) for real z >= 0 from the Hankel function, (z^(1/2) / 2) (J_1/3 - Y_1/3 / 3^(1/2))
+    at (2/3) z^(3/2) (DLMF 9.6.6 with J_-1/3 = (J_1/3 - 3^(1/2) Y_1/3) / 2: as close to mpmath's
+    as scipy's airy up to z = 120, and several times faster), scipy's airy where z < 1e-3."""
+    z = np.asarray(z, dtype=float)
+    out = np.empty(z.shape)
+    small = z < 1e-3
+    out[small] = special.airy(-z[small])[0]
+    hankel = special.hankel1(1.0 / 3.0, (2.0 / 3.0) * z[~small] ** 1.5)
+    out[~small] = 0.5 * np.sqrt(z[~small]) * (hankel.real - hankel.imag / np.sqrt(3.0))
+    return out
 
 
 def _log_psi(force, v):
@@ -317,11 +373,13 @@ def _log_psi(force, v):
 
 def _psi(force, v):
     """psi_F(v), eq. (psi), for real v (any sign)."""
+    v = np.asarray(v, dtype=float)
     argument = force ** (1.0 / 3.0) * v + 0.25 * force ** (-2.0 / 3.0)
     positive = argument > 0.0
-    decaying = np.exp(_log_psi(force, np.where(positive, v, 0.0)))
-    oscillating = force ** (-1.0 / 6.0) * special.airy(np.where(positive, 0.0, argument))[0]
-    return np.where(positive, decaying, oscillating)
+    out = np.empty(np.broadcast(argument).shape)
+    out[positive] = np.exp(_log_psi(force, np.broadcast_to(v, out.shape)[positive]))
+    out[~positive] = force ** (-1.0 / 6.0) * special.airy(argument[~positive])[0]
+    return out
 
 
 def _log_psi_omega(force, v):
@@ -380,13 +438,15 @@ class _OutgoingDensity:
         power = self.log_amplitude - self.beta * np.log(np.where(v > 0, v, 1.0))
         return np.where(below, power, smooth - self.beta * np.log(v) - self.q * v)
 
-    def scaled_complex(self, v):
+    def scaled_complex(self, v, slack=None, with_noise=True):
         """P(0, v) e^(q v) at complex v, |arg v| < pi/3, and a bound on its rounding error in
         units of EPSILON: from the wedge interpolant (``_wedge_cell``) where v lies in a clean
-        cell of it, else from the Nystrom sum (``scaled_complex_direct``)."""
+        cell of it, else from the Nystrom sum (``scaled_complex_direct``, with ``slack``).
+        Without ``with_noise`` the interpolated v's bound is not computed (NaN)."""
         v = np.asarray(v, dtype=complex)
         shape = v.shape
         v = v.ravel()
+        slack = np.zeros(v.size) if slack is None else np.asarray(slack, dtype=float).ravel()
         value, magnitude = np.empty(v.size, dtype=complex), np.empty(v.size)
         rho, theta = np.abs(v), np.angle(v)
         inside = (
@@ -397,39 +457,76 @@ class _OutgoingDensity:
         )
         sigma = coordinate_of_speed(np.where(inside, rho, 1.0))
         row = np.floor((sigma - self._wedge_origin) / WEDGE_SPEED_WIDTH).astype(int)
-        column = np.clip(np.floor(theta / WEDGE_ANGLE_WIDTH), 0, WEDGE_ANGLE_PANELS - 1).astype(int)
         direct = ~inside
-        for key in set(zip(row[inside].tolist(), column[inside].tolist())):
-            members = inside & (row == key[0]) & (column == key[1])
-            cell = self._wedge_cell(*key)
-            if cell is None:
-                direct |= members
-                continue
-            value[members], magnitude[members] = _evaluate_wedge_cell(
-                cell, key, self._wedge_origin, sigma[members], theta[members], v[members], self.beta
-            )
+        for index in set(row[inside].tolist()):
+            left = inside & (row == index)  # not yet evaluated
+            for layout, (width, *_) in enumerate(_WEDGE_ANGLES):
+                members = left & (theta <= width + 1e-12)
+                if not members.any():
+                    continue
+                cell = self._wedge_cell(index, layout)
+                if cell is not None:
+                    value[members], magnitude[members] = _evaluate_wedge_cell(
+                        cell,
+                        (index, layout),
+                        self._wedge_origin,
+                        sigma[members],
+                        theta[members],
+                        v[members],
+                        self.beta,
+                        with_noise,
+                    )
+                    left &= ~members
+            direct |= left
         if direct.any():
-            value[direct], magnitude[direct] = self.scaled_complex_direct(v[direct])
+            value[direct], magnitude[direct] = self.scaled_complex_direct(v[direct], slack[direct])
         return value.reshape(shape), magnitude.reshape(shape)
+
+    def real_axis_nodes(self, v1):
+        """Gauss-Legendre nodes v of int_{SMALLEST_SPEED}^{v1} dv on panels REAL_PANEL_WIDTH
+        wide in s = ln v + v^(1/2) from SMALLEST_SPEED (the last one shorter), and ln of
+        weight x v h(v), h(v) = e^(v/2) P(0, v): the complete panels' from a table kept for
+        all F, the last one's computed."""
+        lo, hi = coordinate_of_speed(SMALLEST_SPEED), coordinate_of_speed(v1)
+        complete = min(
+            int((hi - lo) / REAL_PANEL_WIDTH), self._real_axis_table[0].size // PANEL_NODES
+        )
+        v, log_vh = (part[: complete * PANEL_NODES] for part in self._real_axis_table)
+        start = lo + complete * REAL_PANEL_WIDTH
+        if hi > start:
+            last_v, last_log_vh = self._real_axis_terms(*_panels(start, hi, REAL_PANEL_WIDTH))
+            v, log_vh = np.concatenate([v, last_v]), np.concatenate([log_vh, last_log_vh])
+        return v, log_vh
+
+    def _real_axis_terms(self, s, ws):
+        v = speed_of_coordinate(s)
+        return v, np.log(ws * _jacobian(v) * v) + 0.5 * v + self.log_density(v)
+
+    @functools.cached_property
+    def _real_axis_table(self):
+        lo, hi = coordinate_of_speed(SMALLEST_SPEED), coordinate_of_speed(self.largest)
+        count = int((hi - lo) / REAL_PANEL_WIDTH)
+        return self._real_axis_terms(*_panels(lo, lo + count * REAL_PANEL_WIDTH, REAL_PANEL_WIDTH))
 
     @functools.cached_property
     def _wedge_origin(self):
         return float(coordinate_of_speed(WEDGE_SMALLEST_SPEED))
 
-    def _wedge_cell(self, row, column):
-        """One cell of the interpolant of P(0, v) e^(q v) in the wedge 0 <= arg v <= THETA_MAX:
-        the Chebyshev coefficients (in s = ln |v| + |v|^(1/2) and arg v) of
-        ln(P(0, v) e^(q v)) + beta ln v, and magnitude / |value| of the Nystrom sums at its
-        nodes; None for a cell in which that ratio exceeds WEDGE_CLEAN somewhere (such v are
-        summed directly)."""
-        key = (row, column)
+    def _wedge_cell(self, row, layout):
+        """One cell of the interpolant of P(0, v) e^(q v) in the wedge 0 <= arg v <= THETA_MAX
+        (``layout`` 0: the whole angle; 1: its lower half): the Chebyshev coefficients (in
+        s = ln |v| + |v|^(1/2) and arg v) of ln(P(0, v) e^(q v)) + beta ln v, and
+        magnitude / |value| of the Nystrom sums at its nodes; None for a cell in which that
+        ratio exceeds WEDGE_CLEAN somewhere (such v are summed directly)."""
+        key = (row, layout)
         if key not in self.cells:
-            self.cells[key] = self._build_wedge_cell(row, column)
+            self.cells[key] = self._build_wedge_cell(row, layout)
         return self.cells[key]
 
-    def _build_wedge_cell(self, row, column):
+    def _build_wedge_cell(self, row, layout):
+        width, angle_x, inverse_angle = _WEDGE_ANGLES[layout]
         sigma = self._wedge_origin + WEDGE_SPEED_WIDTH * (row + 0.5 * (_WEDGE_SPEED_X + 1.0))
-        theta = WEDGE_ANGLE_WIDTH * (column + 0.5 * (_WEDGE_ANGLE_X + 1.0))
+        theta = width * 0.5 * (angle_x + 1.0)
         # the noisiest node first (largest |v| and arg v): a dirty cell costs one sum
         corner = speed_of_coordinate(sigma.max()) * np.exp(1j * theta.max())
         value, magnitude = self.scaled_complex_direct(np.array([corner]))
@@ -442,18 +539,31 @@ class _OutgoingDensity:
         if not np.all(noise <= WEDGE_CLEAN):
             return None
         log_value = np.log(value) + self.beta * np.log(v)
-        return _WEDGE_INVERSE_SPEED @ log_value @ _WEDGE_INVERSE_ANGLE.T, noise
+        return _WEDGE_INVERSE_SPEED @ log_value @ inverse_angle.T, noise
 
-    def scaled_complex_direct(self, v):
+    def scaled_complex_direct(self, v, slack=None):
         """P(0, v) e^(q v) at complex v, |arg v| < pi/3, by the Nystrom sum, and the sum of the
         magnitudes of its terms (rounding errors are ~1e-16 of it: at complex v the terms
-        cancel, increasingly so as Im(v)^2 / Re(v) grows)."""
+        cancel, increasingly so as Im(v)^2 / Re(v) grows).  ``slack``: per v, the e-folds by
+        which its result may be less accurate (``_complex_kernel_sums``; none if None)."""
         v = np.ascontiguousarray(np.asarray(v, dtype=complex).ravel())
+        slack = np.zeros(v.size) if slack is None else np.ascontiguousarray(slack, dtype=float)
         r = self.restitution
         out = np.empty(v.size, dtype=complex)
         magnitude = np.empty(v.size)
         _complex_kernel_sums(
-            v, r, self.q, self.nodes, self.log_weights, _TAU_X, _TAU_W, out, magnitude
+            v,
+            r,
+            self.q,
+            self.nodes,
+            self.log_weights,
+            _TAU_X,
+            _TAU_W,
+            _TAU_COUNTS,
+            _TAU_LIMITS,
+            slack,
+            out,
+            magnitude,
         )
         incoming = v / r
         tail = (
@@ -470,37 +580,49 @@ class _OutgoingDensity:
         )
 
 
-def _evaluate_wedge_cell(cell, key, origin, sigma, theta, v, beta):
+def _evaluate_wedge_cell(cell, key, origin, sigma, theta, v, beta, with_noise=True):
     """P(0, v) e^(q v) from a wedge cell, and the sum of the rounding errors of its nodes'
     Nystrom sums weighted by |Lagrange basis| at v (in the units of ``scaled_complex_direct``'s
-    magnitude: the interpolant carries the rounding errors of all its nodes)."""
+    magnitude: the interpolant carries the rounding errors of all its nodes; NaN without
+    ``with_noise``)."""
     coefficients, noise = cell
+    width, angle_x, inverse_angle = _WEDGE_ANGLES[key[1]]
     t_speed = 2.0 * (sigma - origin) / WEDGE_SPEED_WIDTH - 2.0 * key[0] - 1.0
-    t_angle = 2.0 * theta / WEDGE_ANGLE_WIDTH - 2.0 * key[1] - 1.0
+    t_angle = 2.0 * theta / width - 1.0
     speed = np.polynomial.chebyshev.chebvander(t_speed, WEDGE_SPEED_NODES - 1)
-    angle = np.polynomial.chebyshev.chebvander(t_angle, WEDGE_ANGLE_NODES - 1)
-    value = np.exp(np.einsum("pi,ij,pj->p", speed, coefficients, angle) - beta * np.log(v))
+    angle = np.polynomial.chebyshev.chebvander(t_angle, angle_x.size - 1)
+    value = np.exp(np.einsum("pj,pj->p", speed @ coefficients, angle) - beta * np.log(v))
+    if not with_noise:
+        return value, np.full(value.shape, np.nan)
     lagrange_speed = np.abs(speed @ _WEDGE_INVERSE_SPEED)
-    lagrange_angle = np.abs(angle @ _WEDGE_INVERSE_ANGLE)
-    spread = np.einsum("pi,ij,pj->p", lagrange_speed, noise, lagrange_angle)
+    lagrange_angle = np.abs(angle @ inverse_angle)
+    spread = np.einsum("pj,pj->p", lagrange_speed @ noise, lagrange_angle)
     return value, np.abs(value) * spread
 
 
 @njit(cache=True)
-def _complex_kernel_sums(v, r, q, u, log_weights, tau_x, tau_w, out, magnitude):
+def _complex_kernel_sums(
+    v, r, q, u, log_weights, tau_x, tau_w, tau_counts, tau_limits, slack, out, magnitude
+):
     """out_i = e^(q v_i) r^-2 sum_j exp(log_weights_j) G_g(v_i / r, u_j) for complex v_i: the
     stable form of eq. (kernel3) in kernel.py, continued to complex v (the tau integral runs
-    along the straight segment from 0 to tau1).  Terms below e^-SKIP_EFOLDS of the largest
-    are skipped (at large |v| the kernel confines u to a window of width ~ |v|^(1/2))."""
+    along the straight segment from 0 to tau1, by the rule of ``_tau_rules`` that eps selects,
+    TAU_RULE_LIMITS).  Terms below e^-SKIP_EFOLDS of the largest are skipped (at large |v| the
+    kernel confines u to a window of width ~ |v|^(1/2)).  A sum whose result is needed only to
+    e^slack_i times the accuracy of the others skips below e^-(SKIP_EFOLDS - slack_i) and
+    takes tau rule tier 1 below e^-(TAU_LOOSE_GAP - slack_i)."""
     root3_pi = math.sqrt(3.0) / math.pi
     # per u: z0, the exponent and its real part with the u^(1/2) bound (first pass, reused)
     z0s = np.empty(u.size, dtype=np.complex128)
     exponents = np.empty(u.size, dtype=np.complex128)
     levels = np.empty(u.size)
+    half_log_u = 0.5 * np.log(u)
     for i in range(v.size):
         big_v = v[i] / r
         size_v = abs(big_v)
+        half_log_size_v = 0.5 * math.log(size_v)
         best = -1e300
+        last = u.size
         for j in range(u.size):
             d = big_v - u[j]
             z0 = cmath.sqrt(d * d + big_v * u[j])
@@ -508,24 +630,23 @@ def _complex_kernel_sums(v, r, q, u, log_weights, tau_x, tau_w, out, magnitude):
             z0s[j] = z0
             exponents[j] = exponent
             # G ~ u^(1/2) for u << |v|
-            levels[j] = exponent.real + 0.5 * math.log(min(u[j] / size_v, 1.0))
+            levels[j] = exponent.real + min(half_log_u[j] - half_log_size_v, 0.0)
             if levels[j] > best:
                 best = levels[j]
+            # beyond u = 2 |V| + 10 the terms only fall (like e^(-(1/2 + q) u)): stop once they
+            # are 10 e-folds below the skipped ones
+            if u[j] > 2.0 * size_v + 10.0 and levels[j] < best - SKIP_EFOLDS - 10.0:
+                last = j
+                break
+        # kernel.kernel_small_u_limit (relative error O(u / |v|)) without its u^(1/2) e^(...)
+        small_u = 1.5 / math.pi * big_v**-2.5 * (1.0 + big_v) * cmath.exp(-0.5 * big_v + q * v[i])
         total = 0.0 + 0.0j
         size = 0.0
-        for j in range(u.size):
-            if levels[j] < best - 46.0:
+        for j in range(last):
+            if levels[j] < best - (SKIP_EFOLDS - slack[i]):
                 continue
             if u[j] < 1e-13 * size_v:
-                # kernel.kernel_small_u_limit: relative error O(u / |v|)
-                term = (
-                    1.5
-                    / math.pi
-                    * math.sqrt(u[j])
-                    * big_v**-2.5
-                    * (1.0 + big_v)
-                    * cmath.exp(log_weights[j] - 0.5 * big_v + q * v[i])
-                )
+                term = small_u * math.sqrt(u[j]) * math.exp(log_weights[j])
                 total += term
                 size += abs(term)
                 continue
@@ -535,12 +656,18 @@ def _complex_kernel_sums(v, r, q, u, log_weights, tau_x, tau_w, out, magnitude):
             upper = tau1
             if decay > 0.0 and KERNEL_TAIL / math.sqrt(decay) < 1.0:
                 upper = tau1 * (KERNEL_TAIL / math.sqrt(decay))
+            upper2 = upper * upper
+            eps = max(abs(z0 * upper2), abs(upper2))
+            tier = 0 if levels[j] > best - (TAU_LOOSE_GAP - slack[i]) else 1
+            rule = 0
+            while rule < tau_limits.shape[1] and eps >= tau_limits[tier, rule]:
+                rule += 1
             acc = 0.0 + 0.0j
-            for k in range(tau_x.size):
-                tau = upper * tau_x[k]
+            for k in range(tau_counts[rule]):
+                tau = upper * tau_x[rule, k]
                 t2 = tau * tau
                 one_t2 = 1.0 + t2
-                acc += tau_w[k] * (
+                acc += tau_w[rule, k] * (
                     cmath.exp(-z0 * t2)
                     * (1.0 + z0 * one_t2)
                     / (one_t2 * one_t2 * cmath.sqrt(2.0 + t2))
@@ -684,17 +811,16 @@ def _log_sum(log_terms, signs=None):
 def _real_segment_terms(density, force, v1):
     """ln |terms| and signs of int_{SMALLEST_SPEED}^{v1} dv v h(v) psi_F(-v) (Gauss-Legendre in s),
     and ln of the closed-form part below SMALLEST_SPEED (C psi_F(0) eps^(2-beta) / (2-beta))."""
-    s, ws = _panels(coordinate_of_speed(SMALLEST_SPEED), coordinate_of_speed(v1), 0.5)
-    v = speed_of_coordinate(s)
+    v, log_vh = density.real_axis_nodes(v1)
     turning = 0.25 / force  # beyond, psi_F(-v) oscillates with amplitude O(F^(-1/6))
     inside = v <= turning
-    psi_beyond = _psi(force, -np.where(inside, turning, v))
+    log_psi, signs = np.empty(v.shape), np.ones(v.shape)
+    log_psi[inside] = _log_psi(force, -v[inside])
+    psi_beyond = _psi(force, -v[~inside])
     with np.errstate(divide="ignore"):
-        log_psi = np.where(
-            inside, _log_psi(force, -np.minimum(v, turning)), np.log(np.abs(psi_beyond))
-        )
-    signs = np.where(inside, 1.0, np.sign(psi_beyond))
-    log_terms = np.log(ws * _jacobian(v) * v) + 0.5 * v + density.log_density(v) + log_psi
+        log_psi[~inside] = np.log(np.abs(psi_beyond))
+    signs[~inside] = np.sign(psi_beyond)
+    log_terms = log_vh + log_psi
     beta = density.beta
     small = (
         density.log_amplitude
@@ -784,21 +910,25 @@ def _kernel_transforms(density, g):
     s, ws = _panels(coordinate_of_speed(SMALLEST_SPEED), coordinate_of_speed(top), 0.5)
     v = speed_of_coordinate(s)
     log_vh = np.log(ws * _jacobian(v) * v) + 0.5 * v + density.log_density(v)
-    transforms = np.empty(g.size)
-    for k, gk in enumerate(g):
-        # psi_G(v) <= G^(-1/6) exp(-(2/3) (G^(1/3) v)^(3/2)): the terms beyond e^-120 of the
-        # largest such bound are dropped before the Airy function is evaluated
-        bound = log_vh - np.log(gk) / 6.0 - (2.0 / 3.0) * (gk ** (1.0 / 3.0) * v) ** 1.5
-        kept = bound > np.max(bound) - 2.0 * NEGLIGIBLE_EFOLDS
-        body = np.sum(np.exp(log_vh[kept] + _log_psi(gk, v[kept])))
-        small = (
-            np.exp(density.log_amplitude + _log_psi(gk, 0.0))
-            * SMALLEST_SPEED ** (2.0 - beta)
-            / (2.0 - beta)
-            * (1.0 + _small_speed_slope(gk, beta))
-        )
-        transforms[k] = body + small
-    return transforms
+    # psi_G(v) <= G^(-1/6) exp(-(2/3) (G^(1/3) v)^(3/2)): the terms beyond e^-120 of the
+    # largest such bound (per G) are dropped before the Airy function is evaluated
+    bound = (
+        log_vh[None, :]
+        - np.log(g)[:, None] / 6.0
+        - (2.0 / 3.0) * (np.cbrt(g)[:, None] * v[None, :]) ** 1.5
+    )
+    which, index = np.nonzero(
+        bound > np.max(bound, axis=1, keepdims=True) - 2.0 * NEGLIGIBLE_EFOLDS
+    )
+    log_psi = _log_psi(g[which], v[index])
+    body = np.bincount(which, np.exp(log_vh[index] + log_psi), minlength=g.size)
+    small = (
+        np.exp(density.log_amplitude + _log_psi(g, 0.0))
+        * SMALLEST_SPEED ** (2.0 - beta)
+        / (2.0 - beta)
+        * (1.0 + _small_speed_slope(g, beta))
+    )
+    return body + small
 
 
 # T(G) G^-alpha e^(1/(12G)) (smooth in ln G, alpha = (2 beta - 5)/6) is computed at
@@ -836,6 +966,11 @@ def _compute_kernel_transform_table(density):
 
 
 EPSILON = np.finfo(float).eps
+#: A contour node of A(F) whose term (by the real-axis P(0, |v|)) is below the largest by more
+#: than CONTOUR_SLACK_MARGIN e-folds may take P(0, v) from a Nystrom sum that many e-folds less
+#: accurate (at most LARGEST_SLACK: still ~1e-4 of itself, below 1e-19 of the largest term).
+CONTOUR_SLACK_MARGIN = 10.0
+LARGEST_SLACK = 26.0
 # rounding error of a sum of N terms of mixed signs, in units of EPSILON times the sum of their
 # magnitudes (~ N^(1/2) for N ~ 1000 terms)
 ROUNDING = 50.0
@@ -848,10 +983,10 @@ def _split_point(q, force):
     return max(v1, 0.5 * force ** (-1.0 / 3.0))
 
 
-def _log_contour_part(density, force):
-    """ln |A(F)|, its sign, and ln of an estimate of its rounding error: the real segment plus
-    2 Re of the complex path.  Raises ValueError where P(0, v) would be needed beyond the range
-    in which the solution's is accurate."""
+def _log_contour_part(density, force, with_noise=True):
+    """ln |A(F)|, its sign, and ln of an estimate of its rounding error (NaN without
+    ``with_noise``): the real segment plus 2 Re of the complex path.  Raises ValueError where
+    P(0, v) would be needed beyond the range in which the solution's is accurate."""
     q = density.q
     v1 = _split_point(q, force)
     cut = min(v1, density.largest)
@@ -878,28 +1013,37 @@ def _log_contour_part(density, force):
         raise ValueError(
             f"w({force}) needs P(0, v) at |v| = {np.max(np.abs(v)):.4g} > {density.largest:.4g}"
         )
-    scaled, magnitude = density.scaled_complex(v)
+    # a node far below the largest term needs P(0, v) less accurately: its slack (the e-folds,
+    # less CONTOUR_SLACK_MARGIN for |P(0, v) e^(q v)| off the real axis, up to LARGEST_SLACK)
+    # from the real-axis |P(0, |v|)| e^(q |v|)
+    proxy = estimate[keep] + density.log_density(np.abs(v)) + q * np.abs(v)
+    slack = np.clip(
+        max(np.max(proxy), np.max(all_terms)) - proxy - CONTOUR_SLACK_MARGIN, 0.0, LARGEST_SLACK
+    )
+    scaled, magnitude = density.scaled_complex(v, slack, with_noise)
     log_rest = np.log(wv * v) + (0.5 - q) * v + log_airy
     log_terms_c = np.log(scaled) + log_rest  # complex logs
     top = max(np.max(log_terms_c.real), np.max(all_terms))
     contour = 2.0 * np.sum(np.exp(log_terms_c - top)).real
     real = np.sum(all_signs * np.exp(all_terms - top))
     total = contour + real
+    if not with_noise:
+        return top + np.log(abs(total)), float(np.sign(total)), np.nan
     noise = 2.0 * np.sum(np.exp(np.log(magnitude) + log_rest.real - top)) * EPSILON
     noise += np.sum(np.exp(all_terms - top)) * ROUNDING * EPSILON
     return top + np.log(abs(total)), float(np.sign(total)), top + np.log(noise)
 
 
-def _log_weight_with_noise(forces, density):
+def _log_weight_with_noise(forces, density, with_noise=True):
     """ln w(F) and an estimate of its relative rounding error (inf, and ln w NaN, where the
-    solution's P(0, v) does not reach far enough)."""
+    solution's P(0, v) does not reach far enough; NaN without ``with_noise``)."""
     forces = np.atleast_1d(np.asarray(forces, dtype=float))
     b = _log_kernel_transform(density, forces)
     log_w = np.full(forces.size, np.nan)
     noise = np.full(forces.size, np.inf)
     for k, f in enumerate(forces):
         try:
-            log_a, sign_a, log_noise = _log_contour_part(density, f)
+            log_a, sign_a, log_noise = _log_contour_part(density, f, with_noise)
         except ValueError:
             continue
         z = 1.0 / (12.0 * f)
@@ -949,7 +1093,7 @@ def log_weight_function(force, solution, density=None):
     [0.22905337 0.15334074]
     """
     density = _outgoing_density(solution) if density is None else density
-    return _log_weight_with_noise(force, density)[0].reshape(np.shape(force))
+    return _log_weight_with_noise(force, density, with_noise=False)[0].reshape(np.shape(force))
 
 
 def weight_function(force, solution, density=None):
@@ -1763,6 +1907,131 @@ def distribution_by_force_integral(x, v, weight):
     return value, error
 
 
+#: The fixed rule of ``distribution_by_force_rule``: Gauss-Legendre with FORCE_RULE_NODES nodes
+#: on panels in ln F across each of which the integrand of eq. (fpsol) turns through at most
+#: FORCE_RULE_PHASE radians or e-folds, split at the panel edges of the interpolated w (where
+#: its series join with jumps of the order of its interpolation error); its check rule,
+#: FORCE_CHECK_NODES nodes on panels of FORCE_CHECK_PHASE.  Against a rule six times finer
+#: both are within 1e-13 of the largest value at that x (tests/unit/test_distribution.py).
+#: Where the integrand's bound is below e^-FORCE_RULE_MARGIN of its largest value the range of
+#: ln F is cut.
+FORCE_RULE_NODES = 20
+FORCE_RULE_PHASE = 16.0
+FORCE_CHECK_NODES = 16
+FORCE_CHECK_PHASE = 12.0
+FORCE_RULE_MARGIN = 50.0
+FORCE_RULE_GRID = 1500  # points in ln F on which the bound and the panel edges are found
+
+
+def _force_rule_sum(x, speeds, log_rest_grid, y_grid, decay, phase, nodes, weight):
+    """sum over the panels of Gauss-Legendre (``nodes``) of the integrand of eq. (fpsol) in
+    ln F, per v (see ``distribution_by_force_rule``)."""
+    gx, gw = np.polynomial.legendre.leggauss(nodes)
+    force = np.exp(y_grid)
+    airy_argument = -np.cbrt(force)[None, :] * speeds[:, None] + 0.25 * force[None, :] ** (
+        -2.0 / 3.0
+    )
+    # |Ai(z)| <= e^(-(2/3) z^(3/2)) (z > 0), <= 1 (z < 0): a bound of the integrand's log
+    bound = (
+        log_rest_grid[None, :]
+        - 0.5 * speeds[:, None]
+        - (2.0 / 3.0) * np.maximum(airy_argument, 0.0) ** 1.5
+    )
+    which, y, w = [], [], []
+    for k, v in enumerate(speeds):
+        kept = np.nonzero(bound[k] >= np.max(bound[k]) - FORCE_RULE_MARGIN)[0]
+        grid = y_grid[max(kept[0] - 1, 0) : min(kept[-1] + 2, y_grid.size)]
+        # the integrand turns through e^-decay/F (small F), e^-F x, and the Airy phase or decay
+        # (2/3) F^(1/2) |v|^(3/2): phi counts them, panels are equal in phi
+        phi = grid - decay * np.exp(-grid) + x * np.exp(grid)
+        phi += (2.0 / 3.0) * abs(v) ** 1.5 * np.exp(0.5 * grid)
+        count = max(1, int(np.ceil((phi[-1] - phi[0]) / phase)))
+        edges = np.interp(np.linspace(phi[0], phi[-1], count + 1), phi, grid)
+        if hasattr(weight, "edges"):  # a WeightFunction: smooth only within its panels
+            inside = (weight.edges > edges[0]) & (weight.edges < edges[-1])
+            edges = np.union1d(edges, weight.edges[inside])
+        half = 0.5 * np.diff(edges)[:, None]
+        y.append((0.5 * (edges[:-1, None] + edges[1:, None]) + half * gx).ravel())
+        w.append((half * gw).ravel())
+        which.append(np.full(y[-1].size, k))
+    which, y, w = np.concatenate(which), np.concatenate(y), np.concatenate(w)
+    force, v = np.exp(y), speeds[which]
+    argument = -np.cbrt(force) * v + 0.25 * force ** (-2.0 / 3.0)
+    log_rest = weight.log(force) + (5.0 / 6.0) * y - force * x - 0.5 * v
+    positive = argument > 0.0
+    airy = np.empty(argument.size)
+    airy[positive] = _airy_scaled(argument[positive])
+    airy[~positive] = _airy_oscillating(-argument[~positive])
+    terms = w * airy * np.exp(log_rest - (2.0 / 3.0) * np.maximum(argument, 0.0) ** 1.5)
+    return np.bincount(which, terms, minlength=speeds.size)
+
+
+def distribution_by_force_rule(x, speeds, weight):
+    """P(x, v) of eq. (fpsol) at one x > 0 and many v by a fixed rule in ln F, with an error
+    estimate.
+
+    The F integral of eq. (fpsol) over ln F, between the limits of
+    ``distribution_by_force_integral``, by Gauss-Legendre (FORCE_RULE_NODES nodes) on panels
+    across each of which the integrand turns through at most FORCE_RULE_PHASE radians (the
+    Airy phase (2/3) F^(1/2) v^(3/2)) or e-folds (e^(-(S + 1/12)/F), e^(-F x), the Airy decay
+    for v < 0), cut where a bound of the integrand is below e^-FORCE_RULE_MARGIN of its
+    largest value, and split at the panel edges of an interpolated w.  w(F) is evaluated at all
+    nodes of all v at once.  The error estimate is the difference from a second, coarser rule
+    (FORCE_CHECK_NODES nodes on panels of FORCE_CHECK_PHASE).
+
+    Parameters
+    ----------
+    x : float
+        The height, x > 0.
+    speeds : array_like
+        Velocities v (1-d); each (x, v) as ``check_force_integral_point`` allows.
+    weight : WeightFunction or ClosedFormWeight
+        w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
+        ``closed_form_weight_function``).
+
+    Returns
+    -------
+    values : numpy.ndarray
+        P(x, v), the shape of ``speeds``.
+    errors : numpy.ndarray
+        The estimates of their absolute errors.
+
+    Raises
+    ------
+    ValueError
+        As ``check_force_integral_point``, or if x is not > 0.
+
+    Examples
+    --------
+    >>> from bouncing_ball.distribution import closed_form_weight_function
+    >>> from bouncing_ball.distribution import distribution_by_force_rule
+    >>> import numpy as np
+    >>> from bouncing_ball import exact
+    >>> weight = closed_form_weight_function(0.5, lambda f: np.log(exact.weight_function(f, "1/2")))
+    >>> values, errors = distribution_by_force_rule(0.5, [-1.0, 1.0], weight)
+    >>> print(values.round(8), bool(np.all(errors < 1e-10 * values)))
+    [0.04201018 0.07568971] True
+    """
+    x = float(x)
+    speeds = np.atleast_1d(np.asarray(speeds, dtype=float))
+    if not x > 0.0:
+        raise ValueError(f"x = {x}: the fixed rule of eq. (fpsol) needs x > 0")
+    for v in speeds:
+        check_force_integral_point(x, float(v))
+    decay = _total_decay(weight)
+    lower = np.log(decay / 150.0)
+    y_grid = np.linspace(lower, max(np.log(60.0 / x), lower + 1.0), FORCE_RULE_GRID)
+    log_rest_grid = weight.log(np.exp(y_grid)) + (5.0 / 6.0) * y_grid - np.exp(y_grid) * x
+    values, check = (
+        _force_rule_sum(x, speeds, log_rest_grid, y_grid, decay, phase, nodes, weight)
+        for phase, nodes in (
+            (FORCE_RULE_PHASE, FORCE_RULE_NODES),
+            (FORCE_CHECK_PHASE, FORCE_CHECK_NODES),
+        )
+    )
+    return values, np.abs(values - check)
+
+
 #: Gauss-Legendre nodes per panel in v of ``distribution_cell_average``.
 CELL_SPEED_NODES = 8
 
@@ -1852,7 +2121,8 @@ def distribution_cell_average(x_lo, x_hi, v_lo, v_hi, weight, speed_nodes=CELL_S
 def distribution_with_error(x, v, weight, solution):
     """P(x, v) and an estimate of its absolute error, for broadcast arrays x >= 0 and v.
 
-    x > 0: eq. (fpsol) by the F integral.  x = 0: the outgoing side is the
+    x > 0: eq. (fpsol) by the F integral, every v at one x by one fixed rule
+    (``distribution_by_force_rule``).  x = 0: the outgoing side is the
     solver's P(0, v), the incoming side the boundary condition eq. (bc),
     P(0, -v) = r^2 P(0, r v); P(0, 0) diverges and is NaN.
 
@@ -1872,7 +2142,7 @@ def distribution_with_error(x, v, weight, solution):
     values : numpy.ndarray
         P(x, v), the broadcast shape.
     errors : numpy.ndarray
-        quad's estimates of their absolute errors (0 at x = 0).
+        Estimates of their absolute errors (``distribution_by_force_rule``; 0 at x = 0).
 
     Raises
     ------
@@ -1913,8 +2183,10 @@ def distribution_with_error(x, v, weight, solution):
                 values[index] = r * r * solution.outgoing_speed_density(-r * vi)
             else:
                 values[index] = np.nan
-            continue
-        values[index], errors[index] = distribution_by_force_integral(xi, vi, weight)
+    # x > 0: every v at one x by one fixed rule in ln F (w(F) evaluated once for them all)
+    for xi in np.unique(x[x > 0.0]):
+        at = x == xi
+        values[at], errors[at] = distribution_by_force_rule(xi, v[at], weight)
     return values, errors
 
 
@@ -2052,7 +2324,8 @@ def distribution_table(weight, solution, positions, speeds):
     table : pandas.DataFrame
         Long format: columns x, v and pxv, x varying slowest.
     worst : float
-        The largest relative error quad estimates for a positive P(x, v) of the table.
+        The largest estimated relative error of a positive P(x, v) of the table
+        (``distribution_by_force_rule``).
 
     Raises
     ------
@@ -2271,7 +2544,8 @@ EXPONENT_TOLERANCES = {
 #: P(x, v) at x > 0 by the F integral of eq. (fpsol) is accurate to about this fraction of its
 #: largest value at that x (w(F) is known to ~1e-10 relative, and the oscillating Airy factor
 #: cancels): far-tail values below it are noise of either sign (at r = 0.05, x = 0.0126,
-#: v = 2.3 to 6: +-9e-11 where the peak is 3.4; quad's own error estimate does not see it).
+#: v = 2.3 to 6: +-9e-11 where the peak is 3.4; the quadrature's own error estimate does not
+#: see it).
 DISTRIBUTION_NOISE = 1e-10
 
 

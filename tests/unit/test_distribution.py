@@ -94,3 +94,106 @@ def test_asymptotic_exponents_at_one_half(built):
     measured = distribution.measured_exponents(weight)
     assert measured["large_x_rate"] == pytest.approx(np.sqrt(2.0 / 3.0), rel=1e-4)
     assert measured["large_x_power"] == pytest.approx(-0.25, abs=2e-3)
+
+
+# the default config's P(x, v) grid (config/config.yaml, solver: positions, speeds)
+RULE_POSITIONS = [0.012589, 0.12589, 1.2589]
+RULE_SPEEDS = np.linspace(-4.0, 6.0, 101)
+
+
+@pytest.mark.parametrize("r", EXACT, ids=str)
+def test_force_rule_meets_its_error_estimate(r):
+    """The fixed rule of eq. (fpsol) with the exact w(F) of eq. (weightfunc2) against
+    exact.distribution_by_force_integral (quad, with its own error estimate): the difference is
+    within the sum of the two estimates (plus rounding, 1e-15 of the largest value at that x),
+    and within 1e-10 relative wherever P(x, v) is above DISTRIBUTION_NOISE of that largest
+    value."""
+    weight = distribution.closed_form_weight_function(
+        float(r), lambda f: np.log(exact.weight_function(f, r))
+    )
+    for x in RULE_POSITIONS:
+        ours, estimate = distribution.distribution_by_force_rule(x, RULE_SPEEDS, weight)
+        theirs, their_error = np.array(
+            [exact.distribution_by_force_integral(x, v, r) for v in RULE_SPEEDS]
+        ).T
+        peak = np.max(theirs)
+        assert np.all(np.abs(ours - theirs) <= estimate + their_error + 1e-15 * peak)
+        above = theirs > distribution.DISTRIBUTION_NOISE * peak
+        assert np.max(np.abs(ours[above] / theirs[above] - 1.0)) < 1e-10
+
+
+@pytest.mark.parametrize("r", EXACT, ids=str)
+def test_distribution_table_matches_the_exact_one(r, built):
+    """P(x, v) on the default config's grid from the computed w(F) against exact.distribution:
+    within DISTRIBUTION_NOISE (1e-10) of its largest value at that x, and the quadrature's own
+    error estimate within 1e-12 of it (the rest is w's)."""
+    solution, weight = built(r)
+    table, _ = distribution.distribution_table(weight, solution, RULE_POSITIONS, RULE_SPEEDS)
+    ours = table["pxv"].to_numpy().reshape(len(RULE_POSITIONS), -1)
+    x, v = np.meshgrid(RULE_POSITIONS, RULE_SPEEDS, indexing="ij")
+    theirs = exact.distribution(x, v, r)
+    peak = theirs.max(axis=1, keepdims=True)
+    assert np.max(np.abs(ours - theirs) / peak) < distribution.DISTRIBUTION_NOISE
+    _, errors = distribution.distribution_with_error(x, v, weight, solution)
+    assert np.max(errors / peak) < 1e-12
+
+
+def _kernel_sums(density, v, tau_x, tau_w, counts, limits, slack=0.0):
+    """The complex Nystrom sums at v with the given tau rules and slack, and the sums of their
+    terms' magnitudes (distribution._complex_kernel_sums)."""
+    out, magnitude = np.empty(v.size, dtype=complex), np.empty(v.size)
+    distribution._complex_kernel_sums(
+        v, density.restitution, density.q, density.nodes, density.log_weights,
+        tau_x, tau_w, counts, limits, np.full(v.size, slack), out, magnitude,
+    )  # fmt: skip
+    return out, magnitude
+
+
+@pytest.mark.parametrize("r", [0.25, 0.75])
+def test_tau_rules_match_the_kernels_rule(r, built):
+    """The complex Nystrom sums of P(0, v) e^(q v) with the tau rules TAU_RULE_NODES chosen by
+    eps (TAU_RULE_LIMITS) against the same sums with the kernel's TAU_NODES for every term:
+    within 1e-14 of the sum of the terms' magnitudes, over the wedge 0 <= arg v <= THETA_MAX."""
+    solution, _ = built(r)
+    density = distribution._outgoing_density(solution)
+    rho = np.geomspace(distribution.WEDGE_SMALLEST_SPEED, 0.3 * density.largest, 12)
+    theta = np.linspace(0.0, distribution.THETA_MAX, 4)
+    v = np.ascontiguousarray((rho[:, None] * np.exp(1j * theta[None, :])).ravel())
+    ours, magnitude = _kernel_sums(
+        density,
+        v,
+        distribution._TAU_X,
+        distribution._TAU_W,
+        distribution._TAU_COUNTS,
+        distribution._TAU_LIMITS,
+    )
+    count = distribution.TAU_RULE_NODES[-1]
+    nodes, weights = np.polynomial.legendre.leggauss(count)
+    reference, _ = _kernel_sums(
+        density,
+        v,
+        0.5 * (nodes[None, :] + 1.0),
+        0.5 * weights[None, :],
+        np.array([count]),
+        np.zeros((2, 0)),
+    )
+    assert np.max(np.abs(ours - reference) / magnitude) < 1e-14
+
+
+@pytest.mark.parametrize("r", [0.25, 0.75])
+def test_slack_sums_meet_their_accuracy(r, built):
+    """A Nystrom sum with the largest slack (distribution.LARGEST_SLACK) against the full one:
+    within 1e-4 of its value, over the wedge 0 <= arg v <= THETA_MAX (where it is used, its
+    contour node is at least CONTOUR_SLACK_MARGIN + LARGEST_SLACK = 36 e-folds, 2e-16, below the
+    largest term: below 1e-19 of it)."""
+    solution, _ = built(r)
+    density = distribution._outgoing_density(solution)
+    rho = np.geomspace(distribution.WEDGE_SMALLEST_SPEED, 0.3 * density.largest, 12)
+    theta = np.linspace(0.0, distribution.THETA_MAX, 4)
+    v = np.ascontiguousarray((rho[:, None] * np.exp(1j * theta[None, :])).ravel())
+    rules = (distribution._TAU_X, distribution._TAU_W, distribution._TAU_COUNTS)
+    full, magnitude = _kernel_sums(density, v, *rules, distribution._TAU_LIMITS)
+    loose, _ = _kernel_sums(
+        density, v, *rules, distribution._TAU_LIMITS, slack=distribution.LARGEST_SLACK
+    )
+    assert np.max(np.abs(loose - full) / np.maximum(np.abs(full), 1e-16 * magnitude)) < 1e-4

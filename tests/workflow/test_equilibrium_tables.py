@@ -44,9 +44,11 @@ def _same(ours, theirs, atol=0.0):
     np.testing.assert_allclose(ours, np.asarray(theirs, dtype=float), rtol=1e-12, atol=atol)
 
 
-# the residuals and the accuracy estimate are differences of numbers near 1: equal to the
-# rounding of those (their last bits vary with the LAPACK thread count between processes)
+# the residuals, the accuracy estimate and (at r = 1/2, where w(F) is smooth) the interpolation
+# error of w are differences of numbers near 1: equal to the rounding of those (their last bits
+# vary with the LAPACK thread count between processes)
 RESIDUAL = 1e-13
+ROUNDING_COLUMNS = ("residual", "accuracy", "interpolation_error")
 
 
 def test_position_quantities_are_the_workflow_tables(solved):
@@ -84,7 +86,8 @@ def test_scalars_are_the_workflow_summary(solved):
     summary = eq.summary()
     assert set(summary) == set(tables["summary"].columns)
     for name, value in summary.items():
-        _same(value, row[name], atol=RESIDUAL if "residual" in name or "accuracy" in name else 0.0)
+        rounding = any(part in name for part in ROUNDING_COLUMNS)
+        _same(value, row[name], atol=RESIDUAL if rounding else 0.0)
 
 
 def test_the_rule_tables_are_the_table_methods_with_its_settings(solved):
