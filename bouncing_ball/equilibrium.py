@@ -6,7 +6,7 @@ methods, so that one can stand in for the other.
 (``distribution.outgoing_speed_solution``: its nodes reach where P(0, v) falls to e^-690, as
 w(F) at small F needs), and builds the weight function w(F) of eq. (weightfunc) from that
 solution (``distribution``) the first time a position-dependent quantity is asked for (P(x),
-<v^2>_x, P(x, v), w(F): several seconds).  It is the workflow's solve rule (scripts/solve.py
+<v^2>_x, P(x, v), w(F): about a second).  It is the workflow's solve rule (scripts/solve.py
 writes its tables to ``results/solver/r{r}/``), so every number is the one the rule writes for
 the same settings.  Above ``restitution.DISTRIBUTION_RESTITUTION_RANGE`` (up to
 ``SOLVER_RESTITUTION_RANGE``) it gives P(0, v), the time averages, the flight times and the
@@ -569,7 +569,7 @@ class Equilibrium(_EquilibriumState):
     @property
     def weight_function(self):
         """w(F) of eq. (weightfunc), interpolated from ``solution``
-        (``distribution.WeightFunction``); built on first use (several seconds), then kept for
+        (``distribution.WeightFunction``); built on first use (about a second), then kept for
         the process."""
         self._check_distribution("weight_function")
         return _weight_function(self.restitution, self.quadrature_step, self.weight_panel_nodes)

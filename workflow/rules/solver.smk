@@ -12,9 +12,9 @@ rule solve:
         weight="results/solver/r{r}/weight.parquet",
     log:
         "logs/solver/r{r}.log",
-    # about 10 s where r > 1/2 (w(F) on narrower panels, bouncing_ball/distribution.py), the
-    # longest job of the quick look: first; the others after the exact solutions and the
-    # longest batches of shards, so that they do not compile the solver at the same time
+    # longer where r > 1/2 (w(F) on narrower panels, bouncing_ball/distribution.py): first;
+    # the others after the exact solutions and the longest batches of shards, so that they
+    # do not compile the solver at the same time
     priority: solve_priority
     localrule: True
     conda:
