@@ -140,12 +140,16 @@ LONGEST_BATCH = max(
 
 
 def batch_priority(wildcards):
-    """10 times the batch's simulated time over the longest batch's (at most 10): on a few
-    cores the longest batches (r = 0.75's) start first, with the exact solutions (10) and
-    the solver where r > 1/2 (11; solve_priority), so that none runs alone at the end, and
-    the first batch compiles the loop before the shorter batches start."""
-    simulated = batch_time(wildcards.r, len(batch_shards(wildcards)))
-    return round(min(10.0, 10.0 * simulated / LONGEST_BATCH), 2)
+    """12 for the first batch of the longest (r = 0.75's), else 8.9 times the batch's
+    simulated time over the longest batch's: on a few cores one batch starts first and
+    compiles the loop while the other cores run the solver (11 where r > 1/2, else 9;
+    solve_priority) and the exact solutions (10), so that no second job compiles it at the
+    same time; then the longest batches, so that none runs alone at the end."""
+    shards = batch_shards(wildcards)
+    simulated = batch_time(wildcards.r, len(shards))
+    if shards[0] == 0 and simulated >= LONGEST_BATCH:
+        return 12
+    return round(min(8.9, 8.9 * simulated / LONGEST_BATCH), 2)
 
 
 # the merged tables of each r (rule merge_shards)
