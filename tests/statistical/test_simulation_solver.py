@@ -64,6 +64,27 @@ def test_outgoing_speed_density_agrees(shards, solutions, r):
 
 
 @pytest.mark.parametrize("r", list(SHARD_TIME))
+def test_outgoing_speed_density_with_the_return_law_control(shards, solutions, r):
+    """P(0, v) corrected by its return-law control (``p0v_controlled``) against the solver's
+    bin averages in every bin with 0.01 <= v <= 5, which holds the rare bins of plain counts
+    (the large-v tail at r = 0.25, the small-v end at r = 0.75): every |z| < 5 (16 shards:
+    t with 15 degrees of freedom, a false alarm in about 0.5% of runs over 27 bins) and the
+    worst relative error at most half the plain estimator's.  Smallest error rejected: 5
+    times the largest relative error (asserted at most 2%), 10%."""
+    table = outgoing_speed_histogram(shards[r], r)
+    band = table[(table.v >= 0.01) & (table.v <= 5.0)]
+    predicted = outgoing_speed_bin_average(
+        solutions[r].outgoing_speed_density, band.v_lo.to_numpy(), band.v_hi.to_numpy()
+    )
+    relative = (band.p0v_controlled_err / band.p0v_controlled).to_numpy()
+    plain = (band.p0v_err / band.p0v).to_numpy()
+    assert relative.max() <= 0.02, f"run too short for a sharp test: {relative.max():.4f}"
+    assert relative.max() <= 0.5 * plain.max(), (relative.max(), plain.max())
+    z = (band.p0v_controlled.to_numpy() - predicted) / band.p0v_controlled_err.to_numpy()
+    assert np.abs(z).max() < 5.0, np.round(z, 2)
+
+
+@pytest.mark.parametrize("r", list(SHARD_TIME))
 def test_detects_a_one_percent_error(shards, solutions, r):
     """The comparison has power: the solver's P(0,v) scaled by 1.01 is rejected by the same
     shards, p < 1e-3."""
