@@ -601,6 +601,19 @@ def _evaluate_wedge_cell(cell, key, origin, sigma, theta, v, beta, with_noise=Tr
 
 
 @njit(cache=True)
+def _principal_sqrt(z):
+    """The principal square root of a finite complex z (cmath.sqrt's value, without its
+    handling of infinities and NaN, which the inner loops of the Nystrom sums feel)."""
+    a, b = z.real, z.imag
+    size = math.hypot(a, b)
+    if a >= 0.0:
+        root = math.sqrt(0.5 * (size + a))
+        return complex(root, 0.5 * b / root) if root > 0.0 else complex(0.0, b)
+    root = math.sqrt(0.5 * (size - a))
+    return complex(0.5 * abs(b) / root, math.copysign(root, b))
+
+
+@njit(cache=True)
 def _complex_kernel_sums(
     v, r, q, u, log_weights, tau_x, tau_w, tau_counts, tau_limits, slack, out, magnitude
 ):
@@ -625,7 +638,7 @@ def _complex_kernel_sums(
         last = u.size
         for j in range(u.size):
             d = big_v - u[j]
-            z0 = cmath.sqrt(d * d + big_v * u[j])
+            z0 = _principal_sqrt(d * d + big_v * u[j])
             exponent = -0.75 * d * d / (0.5 * (big_v + u[j]) + z0) + log_weights[j]
             z0s[j] = z0
             exponents[j] = exponent
@@ -651,7 +664,7 @@ def _complex_kernel_sums(
                 size += abs(term)
                 continue
             z0 = z0s[j]
-            tau1 = cmath.sqrt(3.0 * big_v * u[j] / ((big_v + u[j] + z0) * z0))
+            tau1 = _principal_sqrt(3.0 * big_v * u[j] / ((big_v + u[j] + z0) * z0))
             decay = (z0 * tau1 * tau1).real
             upper = tau1
             if decay > 0.0 and KERNEL_TAIL / math.sqrt(decay) < 1.0:
@@ -670,7 +683,7 @@ def _complex_kernel_sums(
                 acc += tau_w[rule, k] * (
                     cmath.exp(-z0 * t2)
                     * (1.0 + z0 * one_t2)
-                    / (one_t2 * one_t2 * cmath.sqrt(2.0 + t2))
+                    / (one_t2 * one_t2 * _principal_sqrt(2.0 + t2))
                 )
             term = cmath.exp(exponents[j] + q * v[i]) * root3_pi * upper * acc / (z0 * z0)
             total += term
