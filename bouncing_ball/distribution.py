@@ -192,7 +192,7 @@ NEGLIGIBLE_EFOLDS = 60.0
 #: eps < TAU_RULE_LIMITS[tier][k], the kernel's TAU_NODES above the last limit.  Tier 0, for the
 #: terms within e^-TAU_LOOSE_GAP of the sum's largest, holds each term to ~1e-15 of itself
 #: (against 40 nodes); tier 1, for the smaller terms, to ~1e-6 of itself, i.e. below 1e-19 of
-#: the largest (tests/unit/test_distribution.py compares the sums with TAU_NODES throughout).
+#: the largest (tests/unit/test_distribution.py compares the sums with 64 nodes throughout).
 TAU_RULE_NODES = (4, 6, 8, 10, 14, TAU_NODES)
 TAU_RULE_LIMITS = ((0.0, 0.01, 0.1, 0.3, 3.0), (0.1, 3.0, 10.0, 20.0, 50.0))
 TAU_LOOSE_GAP = 30.0
