@@ -192,7 +192,7 @@ NEGLIGIBLE_EFOLDS = 60.0
 #: eps < TAU_RULE_LIMITS[tier][k], the kernel's TAU_NODES above the last limit.  Tier 0, for the
 #: terms within e^-TAU_LOOSE_GAP of the sum's largest, holds each term to ~1e-15 of itself
 #: (against 40 nodes); tier 1, for the smaller terms, to ~1e-6 of itself, i.e. below 1e-19 of
-#: the largest (tests/unit/test_distribution.py compares the sums with TAU_NODES throughout).
+#: the largest (tests/unit/test_distribution.py compares the sums with 64 nodes throughout).
 TAU_RULE_NODES = (4, 6, 8, 10, 14, TAU_NODES)
 TAU_RULE_LIMITS = ((0.0, 0.01, 0.1, 0.3, 3.0), (0.1, 3.0, 10.0, 20.0, 50.0))
 TAU_LOOSE_GAP = 30.0
@@ -211,6 +211,37 @@ def _tau_rules():
 _TAU_X, _TAU_W = _tau_rules()
 _TAU_COUNTS = np.array(TAU_RULE_NODES, dtype=np.int64)
 _TAU_LIMITS = np.array(TAU_RULE_LIMITS)
+
+#: A term whose Gaussian e^(-z0 tau^2) falls by more than TAIL^2 e-folds before tau1 (where the
+#: rules above cut the tau integral) is integrated instead to infinity along arg tau =
+#: -arg(z0) / 2: the integrand is analytic and decays in the sector between that ray and
+#: tau1's, which holds neither of its singularities (tau^2 = -1, -2), and the part beyond tau1
+#: is below e^-TAIL^2.  With tau = x / z0^(1/2) the integral is z0^(-1/2) int_0^inf e^(-x^2)
+#: g(x^2 / z0) dx, g smooth with its poles at |x| ~ |z0|^(1/2): Gauss-Hermite (the positive
+#: nodes of the 2n-node rule) with the fewest n of TAU_HERMITE_NODES whose limit |z0| reaches,
+#: TAU_HERMITE_LIMITS[tier][k] (|arg z0| <= pi/2): ~1e-15 of the integral in tier 0, ~1e-8 in
+#: tier 1; below the last limit, the rules above.
+TAU_HERMITE_NODES = (4, 5, 6, 7, 8, 10, 12)
+TAU_HERMITE_LIMITS = (
+    (np.inf, 100.0, 60.0, 40.0, 30.0, 20.0, 16.0),
+    (20.0, 16.0, 12.0, 12.0, 8.0, 8.0, 8.0),
+)
+
+
+def _tau_hermite_rules():
+    """x^2 and weights of the positive nodes of the Gauss-Hermite rules of TAU_HERMITE_NODES
+    (int_0^inf e^(-x^2) f(x^2) dx), one row each (zero-padded)."""
+    size = max(TAU_HERMITE_NODES)
+    x2, w = np.zeros((len(TAU_HERMITE_NODES), size)), np.zeros((len(TAU_HERMITE_NODES), size))
+    for k, count in enumerate(TAU_HERMITE_NODES):
+        nodes, weights = np.polynomial.hermite.hermgauss(2 * count)
+        x2[k, :count], w[k, :count] = nodes[count:] ** 2, weights[count:]
+    return x2, w
+
+
+_HERMITE_X2, _HERMITE_W = _tau_hermite_rules()
+_HERMITE_COUNTS = np.array(TAU_HERMITE_NODES, dtype=np.int64)
+_HERMITE_LIMITS = np.array(TAU_HERMITE_LIMITS)
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(PANEL_NODES)
 
 
@@ -561,6 +592,10 @@ class _OutgoingDensity:
             _TAU_W,
             _TAU_COUNTS,
             _TAU_LIMITS,
+            _HERMITE_X2,
+            _HERMITE_W,
+            _HERMITE_COUNTS,
+            _HERMITE_LIMITS,
             slack,
             out,
             magnitude,
@@ -601,13 +636,42 @@ def _evaluate_wedge_cell(cell, key, origin, sigma, theta, v, beta, with_noise=Tr
 
 
 @njit(cache=True)
+def _principal_sqrt(z):
+    """The principal square root of a finite complex z (cmath.sqrt's value, without its
+    handling of infinities and NaN, which the inner loops of the Nystrom sums feel)."""
+    a, b = z.real, z.imag
+    size = math.hypot(a, b)
+    if a >= 0.0:
+        root = math.sqrt(0.5 * (size + a))
+        return complex(root, 0.5 * b / root) if root > 0.0 else complex(0.0, b)
+    root = math.sqrt(0.5 * (size - a))
+    return complex(0.5 * abs(b) / root, math.copysign(root, b))
+
+
+@njit(cache=True)
 def _complex_kernel_sums(
-    v, r, q, u, log_weights, tau_x, tau_w, tau_counts, tau_limits, slack, out, magnitude
+    v,
+    r,
+    q,
+    u,
+    log_weights,
+    tau_x,
+    tau_w,
+    tau_counts,
+    tau_limits,
+    hermite_x2,
+    hermite_w,
+    hermite_counts,
+    hermite_limits,
+    slack,
+    out,
+    magnitude,
 ):
     """out_i = e^(q v_i) r^-2 sum_j exp(log_weights_j) G_g(v_i / r, u_j) for complex v_i: the
     stable form of eq. (kernel3) in kernel.py, continued to complex v (the tau integral runs
     along the straight segment from 0 to tau1, by the rule of ``_tau_rules`` that eps selects,
-    TAU_RULE_LIMITS).  Terms below e^-SKIP_EFOLDS of the largest are skipped (at large |v| the
+    TAU_RULE_LIMITS, or to infinity by the rule of ``_tau_hermite_rules`` where the Gaussian
+    has fallen by TAIL^2 e-folds before tau1, TAU_HERMITE_LIMITS).  Terms below e^-SKIP_EFOLDS of the largest are skipped (at large |v| the
     kernel confines u to a window of width ~ |v|^(1/2)).  A sum whose result is needed only to
     e^slack_i times the accuracy of the others skips below e^-(SKIP_EFOLDS - slack_i) and
     takes tau rule tier 1 below e^-(TAU_LOOSE_GAP - slack_i)."""
@@ -625,7 +689,7 @@ def _complex_kernel_sums(
         last = u.size
         for j in range(u.size):
             d = big_v - u[j]
-            z0 = cmath.sqrt(d * d + big_v * u[j])
+            z0 = _principal_sqrt(d * d + big_v * u[j])
             exponent = -0.75 * d * d / (0.5 * (big_v + u[j]) + z0) + log_weights[j]
             z0s[j] = z0
             exponents[j] = exponent
@@ -651,28 +715,47 @@ def _complex_kernel_sums(
                 size += abs(term)
                 continue
             z0 = z0s[j]
-            tau1 = cmath.sqrt(3.0 * big_v * u[j] / ((big_v + u[j] + z0) * z0))
+            tau1 = _principal_sqrt(3.0 * big_v * u[j] / ((big_v + u[j] + z0) * z0))
             decay = (z0 * tau1 * tau1).real
+            tier = 0 if levels[j] > best - (TAU_LOOSE_GAP - slack[i]) else 1
             upper = tau1
+            hermite = -1
             if decay > 0.0 and KERNEL_TAIL / math.sqrt(decay) < 1.0:
                 upper = tau1 * (KERNEL_TAIL / math.sqrt(decay))
-            upper2 = upper * upper
-            eps = max(abs(z0 * upper2), abs(upper2))
-            tier = 0 if levels[j] > best - (TAU_LOOSE_GAP - slack[i]) else 1
-            rule = 0
-            while rule < tau_limits.shape[1] and eps >= tau_limits[tier, rule]:
-                rule += 1
-            acc = 0.0 + 0.0j
-            for k in range(tau_counts[rule]):
-                tau = upper * tau_x[rule, k]
-                t2 = tau * tau
-                one_t2 = 1.0 + t2
-                acc += tau_w[rule, k] * (
-                    cmath.exp(-z0 * t2)
-                    * (1.0 + z0 * one_t2)
-                    / (one_t2 * one_t2 * cmath.sqrt(2.0 + t2))
-                )
-            term = cmath.exp(exponents[j] + q * v[i]) * root3_pi * upper * acc / (z0 * z0)
+                size_z0 = abs(z0)
+                for k in range(hermite_limits.shape[1]):
+                    if size_z0 >= hermite_limits[tier, k]:
+                        hermite = k
+                        break
+            if hermite >= 0:
+                acc = 0.0 + 0.0j
+                inverse_z0 = 1.0 / z0
+                for k in range(hermite_counts[hermite]):
+                    t2 = hermite_x2[hermite, k] * inverse_z0
+                    one_t2 = 1.0 + t2
+                    acc += hermite_w[hermite, k] * (
+                        (1.0 + z0 + hermite_x2[hermite, k])
+                        / (one_t2 * one_t2 * _principal_sqrt(2.0 + t2))
+                    )
+                integral = acc / _principal_sqrt(z0)
+            else:
+                upper2 = upper * upper
+                eps = max(abs(z0 * upper2), abs(upper2))
+                rule = 0
+                while rule < tau_limits.shape[1] and eps >= tau_limits[tier, rule]:
+                    rule += 1
+                acc = 0.0 + 0.0j
+                for k in range(tau_counts[rule]):
+                    tau = upper * tau_x[rule, k]
+                    t2 = tau * tau
+                    one_t2 = 1.0 + t2
+                    acc += tau_w[rule, k] * (
+                        cmath.exp(-z0 * t2)
+                        * (1.0 + z0 * one_t2)
+                        / (one_t2 * one_t2 * _principal_sqrt(2.0 + t2))
+                    )
+                integral = upper * acc
+            term = cmath.exp(exponents[j] + q * v[i]) * root3_pi * integral / (z0 * z0)
             total += term
             size += abs(term)
         out[i] = total / (r * r)

@@ -71,13 +71,22 @@ r = 1/2, eq. (xandDeltax), from the exact P(0, v) on the solver's nodes:
 {'mean_x': 6.0, 'delta_x': 10.39230485, 'collision_rate': 0.33333333}
 """
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from scipy import linalg, special
 
 from .asymptotics import large_speed_decay_rate, small_speed_exponent
-from .kernel import kernel_small_u_limit, return_speed_kernel_matrix
+from .jit import njit
+from .kernel import (
+    _NODES,
+    _WEIGHTS,
+    TAIL,
+    _kernel,
+    kernel_small_u_limit,
+    return_speed_kernel_matrix,
+)
 from .restitution import SOLVER_RESTITUTION_RANGE, in_range, parse_restitution
 
 __all__ = [
@@ -107,6 +116,9 @@ SQRT_WEIGHT = 1.0  # b in s = ln u + b u^(1/2)
 TAIL_EFOLDS = 25.0  # lower tail summed node by node over this many e-folds of u
 DROP_EFOLDS = 45.0  # P(0, v_max) ~ exp(-45) P(0, 20); M_6 then misses < 1e-12
 UNDERFLOW_EFOLDS = 700.0  # exp(-700) ~ 1e-304 is still a normal double
+#: A term of the Nystrom sum of ``OutgoingSpeedSolution.outgoing_speed_density`` whose bound is
+#: below e^-NEGLIGIBLE_TERM_EFOLDS (~1e-26) of the largest bound is skipped.
+NEGLIGIBLE_TERM_EFOLDS = 60.0
 
 
 def speed_of_coordinate(s, b=SQRT_WEIGHT):
@@ -292,24 +304,30 @@ class OutgoingSpeedSolution:
         s0 = coordinate_of_speed(self.speeds[0])
         return speed_of_coordinate(s0 - self.step * np.arange(1, count + 1)), count
 
-    def _rows(self, incoming):
-        """Rows of r^2 x the operator: int du u G_g(V, u) P(u) = rows @ P for V = incoming."""
-        u = self.speeds
-        rows = return_speed_kernel_matrix(incoming, u) * (self.quadrature_weights * u)
+    def _lower_tail(self, incoming):
+        """The rule's nodes below u_0 (P(u) = P(u_0) (u / u_0)^-beta there): the nodes, their
+        weights of int du u G_g(V, u) P(u) / P(u_0), and the closed-form rest beyond the last."""
+        u0 = self.speeds[0]
         tail_u, count = self._tail_speeds()
         beta = self.small_speed_exponent
-        tail_weights = self.step * _jacobian(tail_u) * tail_u * (tail_u / u[0]) ** -beta
-        tail = return_speed_kernel_matrix(incoming, tail_u) @ tail_weights
+        tail_weights = self.step * _jacobian(tail_u) * tail_u * (tail_u / u0) ** -beta
         # beyond the last tail node, G(V, u) = kernel_small_u_limit (relative error ~ u / V)
         alpha = 2.5 - beta
         remainder = (
             self.step
             * kernel_small_u_limit(incoming, 1.0)
-            * u[0] ** 2.5
+            * u0**2.5
             * np.exp(-alpha * (count + 1) * self.step)
             / -np.expm1(-alpha * self.step)
         )
-        rows[:, 0] += tail + remainder
+        return tail_u, tail_weights, remainder
+
+    def _rows(self, incoming):
+        """Rows of r^2 x the operator: int du u G_g(V, u) P(u) = rows @ P for V = incoming."""
+        u = self.speeds
+        rows = return_speed_kernel_matrix(incoming, u) * (self.quadrature_weights * u)
+        tail_u, tail_weights, remainder = self._lower_tail(incoming)
+        rows[:, 0] += return_speed_kernel_matrix(incoming, tail_u) @ tail_weights + remainder
         return rows
 
     def outgoing_speed_density(self, v):
@@ -339,7 +357,18 @@ class OutgoingSpeedSolution:
                 "the incoming side is r^2 P(0, r |v|), eq. (bc)"
             )
         r = self.restitution
-        flat = self._rows(np.ascontiguousarray(v.ravel()) / r) @ self.density / (r * r)
+        incoming = np.ascontiguousarray(v.ravel()) / r
+        u = self.speeds
+        tail_u, tail_weights, remainder = self._lower_tail(incoming)
+        flat = _kernel_sums(
+            incoming,
+            np.concatenate([u, tail_u]),
+            np.concatenate([self.quadrature_weights * u, tail_weights]),
+            np.concatenate([self.density, np.full(tail_u.size, self.density[0])]),
+            _NODES,
+            _WEIGHTS,
+        )
+        flat = (flat + remainder * self.density[0]) / (r * r)
         return flat.reshape(v.shape)
 
     def moment(self, k: float) -> float:
@@ -364,6 +393,46 @@ class OutgoingSpeedSolution:
         # the rule's nodes below u_0, summed in closed form (du/ds = u there)
         tail = self.step * self.density[0] * u[0] ** (k + 1.0) / np.expm1(exponent * self.step)
         return float(main + tail)
+
+
+@njit(cache=True)
+def _kernel_sums(incoming, u, weights, density, nodes, tau_weights):
+    """sum_j G_g(V_i, u_j) weights_j density_j, eq. (kernel3), for weights, density >= 0,
+    skipping the terms whose bound weights_j density_j (3^(1/2) / pi) e^(-(3/4) (V - u)^2 /
+    ((V + u)/2 + z0)) tau1 (1 + z0) / (2^(1/2) z0^2) (the tau integrand is at most
+    (1 + z0) / 2^(1/2)) is below e^-NEGLIGIBLE_TERM_EFOLDS of the largest."""
+    out = np.zeros(incoming.size)
+    bounds = np.empty(u.size)
+    log_weights = np.full(u.size, -np.inf)
+    for j in range(u.size):
+        if weights[j] > 0.0 and density[j] > 0.0 and u[j] > 0.0:
+            log_weights[j] = math.log(weights[j]) + math.log(density[j])
+    for i in range(incoming.size):
+        big_v = incoming[i]
+        if big_v <= 0.0:
+            continue
+        best = -np.inf
+        for j in range(u.size):
+            if log_weights[j] == -np.inf:
+                bounds[j] = -np.inf
+                continue
+            difference = big_v - u[j]
+            z0_squared = difference * difference + big_v * u[j]
+            z0 = math.sqrt(z0_squared)
+            tau1 = math.sqrt(3.0 * big_v * u[j] / ((big_v + u[j] + z0) * z0))
+            upper = min(tau1, TAIL / math.sqrt(z0))
+            bounds[j] = (
+                log_weights[j]
+                + math.log(upper * (1.0 + z0) / z0_squared)
+                - 0.75 * difference * difference / (0.5 * (big_v + u[j]) + z0)
+            )
+            best = max(best, bounds[j])
+        total = 0.0
+        for j in range(u.size):
+            if bounds[j] >= best - NEGLIGIBLE_TERM_EFOLDS:
+                total += _kernel(big_v, u[j], nodes, tau_weights) * weights[j] * density[j]
+        out[i] = total
+    return out
 
 
 def solve_outgoing_speed_density(

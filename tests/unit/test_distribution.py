@@ -138,22 +138,60 @@ def test_distribution_table_matches_the_exact_one(r, built):
     assert np.max(errors / peak) < 1e-12
 
 
-def _kernel_sums(density, v, tau_x, tau_w, counts, limits, slack=0.0):
-    """The complex Nystrom sums at v with the given tau rules and slack, and the sums of their
-    terms' magnitudes (distribution._complex_kernel_sums)."""
+_HERMITE = (
+    distribution._HERMITE_X2,
+    distribution._HERMITE_W,
+    distribution._HERMITE_COUNTS,
+    distribution._HERMITE_LIMITS,
+)
+_NO_HERMITE = (np.zeros((1, 1)), np.zeros((1, 1)), np.zeros(1, dtype=np.int64), np.zeros((2, 0)))
+
+
+def _kernel_sums(density, v, tau_x, tau_w, counts, limits, slack=0.0, hermite=_HERMITE):
+    """The complex Nystrom sums at v with the given tau rules (Gauss-Legendre, then the
+    Gauss-Hermite ``hermite``) and slack, and the sums of their terms' magnitudes
+    (distribution._complex_kernel_sums)."""
     out, magnitude = np.empty(v.size, dtype=complex), np.empty(v.size)
     distribution._complex_kernel_sums(
         v, density.restitution, density.q, density.nodes, density.log_weights,
-        tau_x, tau_w, counts, limits, np.full(v.size, slack), out, magnitude,
+        tau_x, tau_w, counts, limits, *hermite, np.full(v.size, slack), out, magnitude,
     )  # fmt: skip
     return out, magnitude
+
+
+def _tau_integrand_part(x2, z0):
+    """g(x^2 / z0) of the tau integral z0^(-1/2) int_0^inf e^(-x^2) g(x^2 / z0) dx."""
+    t2 = x2 / z0
+    return (1.0 + z0 + x2) / ((1.0 + t2) ** 2 * np.sqrt(2.0 + t2))
+
+
+@pytest.mark.parametrize("tier, tolerance", [(0, 2e-15), (1, 1e-8)])
+def test_tau_hermite_rules_meet_their_limits(tier, tolerance):
+    """Each Gauss-Hermite rule of the tau integral (distribution.TAU_HERMITE_NODES) from its
+    limit |z0| (TAU_HERMITE_LIMITS[tier]) up, |arg z0| <= pi/2, against a 160-node rule: within
+    ~1e-15 of the integral in tier 0, 1e-8 in tier 1."""
+    nodes, weights = np.polynomial.hermite.hermgauss(160)
+    nodes, weights = nodes[80:], weights[80:]
+    for k, limit in enumerate(distribution.TAU_HERMITE_LIMITS[tier]):
+        if not np.isfinite(limit):
+            continue
+        size = distribution.TAU_HERMITE_NODES[k]
+        x2, w = distribution._HERMITE_X2[k, :size], distribution._HERMITE_W[k, :size]
+        for z0 in np.outer([limit, 1.5 * limit, 3.0 * limit, 30.0 * limit], np.exp(
+            1j * np.linspace(-0.5 * np.pi, 0.5 * np.pi, 31)
+        )).ravel():  # fmt: skip
+            ours = np.sum(w * _tau_integrand_part(x2, z0))
+            reference = np.sum(weights * _tau_integrand_part(nodes**2, z0))
+            assert abs(ours / reference - 1.0) < tolerance, (tier, size, z0)
 
 
 @pytest.mark.parametrize("r", [0.25, 0.75])
 def test_tau_rules_match_the_kernels_rule(r, built):
     """The complex Nystrom sums of P(0, v) e^(q v) with the tau rules TAU_RULE_NODES chosen by
-    eps (TAU_RULE_LIMITS) against the same sums with the kernel's TAU_NODES for every term:
-    within 1e-14 of the sum of the terms' magnitudes, over the wedge 0 <= arg v <= THETA_MAX."""
+    eps (TAU_RULE_LIMITS) and TAU_HERMITE_NODES by |z0| (TAU_HERMITE_LIMITS) against the same
+    sums with 64-node Gauss-Legendre for every term (the kernel's TAU_NODES = 20 leave ~1e-13
+    where the Gaussian is cut at TAIL): within 1e-14 of the sum of the terms' magnitudes, over
+    the wedge 0 <= arg v <= THETA_MAX."""
     solution, _ = built(r)
     density = distribution._outgoing_density(solution)
     rho = np.geomspace(distribution.WEDGE_SMALLEST_SPEED, 0.3 * density.largest, 12)
@@ -167,7 +205,7 @@ def test_tau_rules_match_the_kernels_rule(r, built):
         distribution._TAU_COUNTS,
         distribution._TAU_LIMITS,
     )
-    count = distribution.TAU_RULE_NODES[-1]
+    count = 64
     nodes, weights = np.polynomial.legendre.leggauss(count)
     reference, _ = _kernel_sums(
         density,
@@ -176,6 +214,7 @@ def test_tau_rules_match_the_kernels_rule(r, built):
         0.5 * weights[None, :],
         np.array([count]),
         np.zeros((2, 0)),
+        hermite=_NO_HERMITE,
     )
     assert np.max(np.abs(ours - reference) / magnitude) < 1e-14
 

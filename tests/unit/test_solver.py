@@ -79,6 +79,18 @@ def test_small_speed_power_law(r):
     ), deviation
 
 
+@pytest.mark.parametrize("r", [0.03, 0.5, 0.9])
+def test_density_off_the_nodes_is_the_nystrom_formula(r):
+    """P(0, v) off the nodes (which skips the terms below e^-60 of the largest bound) against
+    the full Nystrom formula, the operator's rows times P at the nodes (the operator the
+    solver solves): to 1e-14, up to the highest node, where P(0, v) nears underflow."""
+    solution = solver.solve_outgoing_speed_density(r)
+    v = np.geomspace(1e-12, solution.speeds[-1], 400)
+    ours = solution.outgoing_speed_density(v)
+    full = solution._rows(v / r) @ solution.density / r**2
+    assert np.max(np.abs(ours / full - 1.0)) < 1e-14
+
+
 def test_collision_rate_diverges_below_critical():
     """r = 0.1 < r_c: int v P(0, v) dv over v > v_min grows like v_min^(2 - beta) as v_min -> 0,
     while both balances still hold."""
