@@ -289,7 +289,16 @@ def _fma_compiled(a, b, c):
 
 #: What numba compiles: the modules with compiled functions and what those call into or read
 #: constants from (the key of numba's cache folder); an edit elsewhere does not recompile.
-COMPILED = ("distribution", "free_flight", "jit", "kernel", "pcg64", "simulation", "tallies")
+COMPILED = (
+    "distribution",
+    "free_flight",
+    "jit",
+    "kernel",
+    "pcg64",
+    "simulation",
+    "solver",
+    "tallies",
+)
 
 _preferred = Path(numba.config.CACHE_DIR) if numba.config.CACHE_DIR else PACKAGE / "__pycache__"
 _base = writable_cache_base(_preferred, user_cache_folder())

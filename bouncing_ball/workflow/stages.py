@@ -21,10 +21,17 @@ SIMULATION = (
     "tallies",
 )
 # reading a job's batch files back and merging their shards (workflow.shards checks each file's
-# provenance against the config with workflow.audit)
+# provenance against the config with workflow.audit); the return-law and flight-law controls of
+# histograms read the return-speed law and the flight times (flight_time, kernel) and the
+# solver's P(0, v) (solver, asymptotics, jit)
 READ_SHARDS = (
+    "asymptotics",
     "bins",
+    "flight_time",
     "histograms",
+    "jit",
+    "kernel",
+    "solver",
     "restitution",
     "settings",
     "tallies",

@@ -466,9 +466,12 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
         "validation_table": 1,
         "position_asymptotics": 1,
     }
+    # the merge's controls of P(0, v) and the flight moments read the return-speed law and the
+    # solver's P(0, v): the merged tables and what draws them (Fig. 5 besides the solved ones)
+    solved_and_merged = {**solved, "merge_shards": 2, "fig5": 1}
     for module, expected in (
-        ("kernel", solved),
-        ("solver", solved),
+        ("kernel", solved_and_merged),
+        ("solver", solved_and_merged),
         (
             "exact",
             {
@@ -494,7 +497,7 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
                 "position_asymptotics": 1,
             },
         ),
-        ("asymptotics", {**solved, "theory": 1, "fig1": 1, "fig2": 1}),
+        ("asymptotics", {**solved_and_merged, "theory": 1, "fig1": 1, "fig2": 1}),
         (
             "comparison",
             {"fig7": 1, "moments_table": 1, "validation_table": 1, "position_asymptotics": 1},
