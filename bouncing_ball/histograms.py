@@ -53,15 +53,8 @@ import functools
 import numpy as np
 import pandas as pd
 
-from .flight_time import (
-    _log_gauss,
-    flight_time_second_moment_given_speed,
-    mean_flight_time_given_speed,
-    return_speed_bin_probabilities,
-)
 from .restitution import SOLVER_RESTITUTION_RANGE, in_range, parse_restitution
 from .settings import RETURN_LAW_SPEED_BINS
-from .solver import solve_outgoing_speed_density
 from .tallies import (
     MOMENT_CONTROLS,
     RATE_CONTROLS,
@@ -258,6 +251,8 @@ def _solver_outgoing_density(exact):
     """The solver's P(0, u) of eq. (inteq) at the exact r, or None outside its range."""
     if not in_range(exact, SOLVER_RESTITUTION_RANGE):
         return None
+    from .solver import solve_outgoing_speed_density  # numba and scipy: only where solved
+
     return solve_outgoing_speed_density(exact).outgoing_speed_density
 
 
@@ -270,6 +265,13 @@ def _occupied_fine_bins(shards):
     lower = np.maximum(fine.lower[occupied], 0.1 * fine.lo)
     upper = np.minimum(fine.upper[occupied], 10.0 * fine.hi)
     return counts[:, occupied], lower, upper
+
+
+# the fewest shards for the return-law control: SHARDS_PER_CONTROL, and 4 for a slope and
+# an intercept fitted out of sample
+_RETURN_LAW_SHARDS = max(SHARDS_PER_CONTROL, 4)
+# the fewest shards for the flight-law controls, beside at least the RATE_CONTROLS
+_FLIGHT_LAW_SHARDS = SHARDS_PER_CONTROL * (len(RATE_CONTROLS) + 2)
 
 
 #: Gauss-Legendre points in ln u per fine bin of ``settings.RETURN_LAW_SPEED_BINS`` (2.3 %
@@ -334,6 +336,8 @@ def return_law_prediction(shards: list[ShardTallies], restitution: float, outgoi
     >>> print(np.round(prediction, 1), round(float(prediction.sum()), 9))
     [[ 0.4 58.5 41.1  0. ]] 100.0
     """
+    from .flight_time import return_speed_bin_probabilities
+
     counts, lower, upper = _occupied_fine_bins(shards)
     bins = shards[0].speed_bins
     if lower.size == 0:
@@ -395,6 +399,12 @@ def flight_law_prediction(shards: list[ShardTallies], outgoing_density) -> np.nd
     >>> print(np.round(flight_law_prediction([shard], density), 1))
     [[ 317.8 2294.7]]
     """
+    from .flight_time import (
+        _log_gauss,
+        flight_time_second_moment_given_speed,
+        mean_flight_time_given_speed,
+    )
+
     counts, lower, upper = _occupied_fine_bins(shards)
     if lower.size == 0:
         return np.zeros((len(shards), 2))
@@ -460,7 +470,7 @@ def outgoing_speed_histogram(
         return outgoing_speed_density(c, t, lower, upper)
 
     p0v, err = jackknife(density, counts, times)
-    if return_law is None and restitution is not None:
+    if return_law is None and restitution is not None and len(shards) >= _RETURN_LAW_SHARDS:
         exact = parse_restitution(restitution)
         solver_density = _solver_outgoing_density(exact)
         if solver_density is not None:
@@ -494,7 +504,7 @@ def _return_law_controlled(shards, counts, times, return_law, density):
     """P(0, v) and its error from counts corrected bin by bin by the return-law control of
     the bin and, with ``SHARDS_PER_CONTROL`` shards per control for them, those of
     ``tallies.RATE_CONTROLS`` (NaN with fewer than 4 shards)."""
-    if len(shards) < max(SHARDS_PER_CONTROL, 4):  # a fitted slope and intercept need 4
+    if len(shards) < _RETURN_LAW_SHARDS:
         return _controlled(density, None, times[:, 0], [counts], [times])
     # the martingale controls too, where the shards are enough for them and the bin's own
     rate = None
@@ -757,8 +767,10 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
     mean_x, mean_x_err = jackknife(_mean_x, int_x, time)
     delta_x, delta_x_err = jackknife(_delta_x, int_x, int_x2, time)
     rate, rate_err = jackknife(lambda c, t: c / t, collisions, time)
-    density = _solver_outgoing_density(parse_restitution(restitution))
-    flight_law = None if density is None else flight_law_prediction(shards, density)
+    flight_law = None
+    if len(shards) >= _FLIGHT_LAW_SHARDS:  # else too few shards to fit them
+        density = _solver_outgoing_density(parse_restitution(restitution))
+        flight_law = None if density is None else flight_law_prediction(shards, density)
     controls = moment_controls(shards, flight_law)
     controlled, controlled_err = _controlled(
         lambda c, t: c / t, controls, time, [collisions], [time]
