@@ -171,7 +171,8 @@ REAL_PANEL_WIDTH = 0.5  # in s, of the panels of the real-axis part of A(F)
 # integrals of w(F) need ~1e4 values per r, the cells ~1e3 sums; one panel of 12 nodes across
 # the angle is as accurate as two of 8, and 22 nodes across 4 in s as two of 14 across 2, each
 # with fewer sums).  Where a cell's sums cancel (at its largest arg v first) a cell across the
-# lower half of the angle, WEDGE_LOW_ANGLE_NODES wide, is tried for the v there.
+# lower half of the angle, WEDGE_LOW_ANGLE_NODES wide, serves the v there if its own sums do
+# not cancel.
 WEDGE_SMALLEST_SPEED = 5e-4
 WEDGE_SPEED_WIDTH = 4.0
 WEDGE_SPEED_NODES = 22
