@@ -186,15 +186,13 @@ def moment_controls(shards, flight_law=None):
     if flight_law is not None:
         sums = np.array([[s.flight_time_sum, s.flight_time_squared_sum] for s in shards])
         extra = sums - np.asarray(flight_law, dtype=float)
+    flight_options = (None,) if extra is None else (extra, None)
     for names in (MOMENT_CONTROLS, RATE_CONTROLS):
-        for with_flights in (True, False):
-            if with_flights and extra is None:
-                continue
-            wanted = len(names) + (extra.shape[1] if with_flights else 0)
-            if len(shards) < SHARDS_PER_CONTROL * wanted:
-                continue
-            controls = shard_controls(shards, names)
-            return np.column_stack([controls, extra]) if with_flights else controls
+        for flights in flight_options:
+            width = len(names) + (0 if flights is None else flights.shape[1])
+            if len(shards) >= SHARDS_PER_CONTROL * width:
+                controls = shard_controls(shards, names)
+                return controls if flights is None else np.column_stack([controls, flights])
     return None
 
 
