@@ -121,7 +121,7 @@ def free_flight_step(x, v, dt, normal_r, normal_s):
     return x_new, v_new
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _floor_root(v, c):
     """s* at x = 0: the root of s^2 (v - c s - s^2/2), 0 for v <= 0."""
     if v <= 0.0:
@@ -129,7 +129,7 @@ def _floor_root(v, c):
     return 2.0 * v / (c + math.sqrt(c * c + 2.0 * v))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _fitted_root(x, v, c):
     """The root of the cubic x + v s^2 - c s^3 (no s^4/2 term), from the rational fits above
     (homogeneous in a = (x/c)^(1/3) and v/c, one division); x > 0."""
@@ -273,7 +273,7 @@ def predicted_start(predictor, root, x1, v1):
     return predicted if predicted > 0.0 else root
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def largest_safe_step(x, v, c):
     """The largest step D(x, v) allowed by eq. (criterion).
 

@@ -280,7 +280,7 @@ def _llvm_fma(typingctx, a, b, c):
     return signature, codegen
 
 
-@overload(fma, jit_options={"error_model": "numpy"}, inline="always")
+@overload(fma, jit_options={"error_model": "numpy"})
 def _fma_compiled(a, b, c):
     if all(isinstance(value, types.Float) and value.bitwidth == 64 for value in (a, b, c)):
         return lambda a, b, c: _llvm_fma(a, b, c)

@@ -110,7 +110,7 @@ cut off at speeds of order (2 min_step_floor)^(1/2).
 What the regularised process gives above that speed scale, and how I grows
 as the floor goes to zero, is measured, not assumed (docs/methods.md, 'Below r_c').
 
-The loop is numba-compiled: a shard compiles it on its first call (a minute), so the Examples
+The loop is numba-compiled: a shard compiles it on its first call (ten seconds or so), so the Examples
 that run a shard are not run as doctests; the unit and statistical tests run shards.
 """
 
@@ -441,7 +441,7 @@ def _tally_step(
     return k, k_s, k_second
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _bridge_correction(a1, a2, a3, dt, weight, s, normal_1, k_s, k_x, time_in, v2_in):
     """The bridge correction of a step's P(x) and <v^2>_x (module docstring): the assignment
     gave the time s to bin k_s, the bridge point x(s) (drawn with ``normal_1``) is in bin
@@ -462,7 +462,7 @@ def _bridge_correction(a1, a2, a3, dt, weight, s, normal_1, k_s, k_x, time_in, v
 FLOOR_STRATUM_HEIGHT = 0.1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def floor_stratum_end(tau, x, v):
     """Where the bridge points of a step of length tau from (x, v) are stratified: t_low.
 
@@ -624,8 +624,9 @@ def _run(
     x_bin_lower = np.empty(nx + 2)
     x_bin_upper = np.empty(nx + 2)
     x_bin_lower[0] = -np.inf
-    x_bin_lower[1:] = x_edges
-    x_bin_upper[: nx + 1] = x_edges
+    for k in range(nx + 1):
+        x_bin_lower[k + 1] = x_edges[k]
+        x_bin_upper[k] = x_edges[k]
     x_bin_upper[nx + 1] = np.inf
 
     # start at rest one unit above the floor; equilibration forgets this
@@ -973,7 +974,7 @@ def simulate_shard(
 
     Examples
     --------
-    Compiles the loop on its first call (a minute), so not run as a doctest.  Same stream,
+    Compiles the loop on its first call (ten seconds or so), so not run as a doctest.  Same stream,
     same numbers:
 
     >>> from bouncing_ball.settings import ShardSettings
