@@ -11,6 +11,7 @@ other r with a ``ValueError``.
 
 import functools
 import math
+import warnings
 from fractions import Fraction
 
 import numpy as np
@@ -489,13 +490,165 @@ def distribution_by_force_integral(x, v, restitution):
     return value, error
 
 
+# QUADPACK's 21-point Gauss-Kronrod rule (dqk21) on [-1, 1]: the Kronrod nodes x >= 0 (the
+# 10-point Gauss rule's at odd index), their Kronrod weights, and the Gauss weights
+_HALF_KRONROD_NODES = (
+    0.995657163025808080735527280689003,
+    0.973906528517171720077964012084452,
+    0.930157491355708226001207180059508,
+    0.865063366688984510732096688423493,
+    0.780817726586416897063717578345042,
+    0.679409568299024406234327365114874,
+    0.562757134668604683339000099272694,
+    0.433395394129247190799265943165784,
+    0.294392862701460198131126603103866,
+    0.148874338981631210884826001129720,
+    0.0,
+)
+_HALF_KRONROD_WEIGHTS = (
+    0.011694638867371874278064396062192,
+    0.032558162307964727478818972459390,
+    0.054755896574351996031381300244580,
+    0.075039674810919952767043140916190,
+    0.093125454583697605535065465083366,
+    0.109387158802297641899210590325805,
+    0.123491976262065851077208814748999,
+    0.134709217311473325928054001771707,
+    0.142775938577060080797094273138717,
+    0.147739104901338491374841515972068,
+    0.149445554002916905664936468389821,
+)
+_HALF_GAUSS_WEIGHTS = (
+    0.066671344308688137593568809893332,
+    0.149451349150580593145776339657697,
+    0.219086362515982043995534934228163,
+    0.269266719309996355091226921569469,
+    0.295524224714752870173892994651338,
+)
+KRONROD_NODES = np.concatenate([np.negative(_HALF_KRONROD_NODES), _HALF_KRONROD_NODES[-2::-1]])
+KRONROD_WEIGHTS = np.concatenate([_HALF_KRONROD_WEIGHTS, _HALF_KRONROD_WEIGHTS[-2::-1]])
+#: the 10-point Gauss rule's weights on KRONROD_NODES (0 at the Kronrod-only nodes)
+GAUSS_WEIGHTS = np.zeros(21)
+GAUSS_WEIGHTS[1:10:2] = _HALF_GAUSS_WEIGHTS
+GAUSS_WEIGHTS[11:21:2] = _HALF_GAUSS_WEIGHTS[::-1]
+
+#: subintervals a point's F integral may be cut into (``_adaptive_gauss_kronrod``)
+MOST_SUBINTERVALS = 10000
+
+
+def _gauss_kronrod(integrand, lower, upper, owner):
+    """The 21-point Gauss-Kronrod rule on every interval [lower, upper] at once: the integrals,
+    their error estimates and the rounding floor of those estimates, as QUADPACK's dqk21 makes
+    them; ``integrand(nodes, owner)`` takes the nodes (intervals x 21) of the integrals
+    ``owner`` (one per interval)."""
+    centre, half = 0.5 * (lower + upper), 0.5 * (upper - lower)
+    f = integrand(centre[:, None] + half[:, None] * KRONROD_NODES, owner)
+    kronrod = f @ KRONROD_WEIGHTS
+    absolute = (np.abs(f) @ KRONROD_WEIGHTS) * half
+    spread = (np.abs(f - 0.5 * kronrod[:, None]) @ KRONROD_WEIGHTS) * half
+    difference = np.abs(kronrod - f @ GAUSS_WEIGHTS) * half
+    both = (spread > 0.0) & (difference > 0.0)
+    ratio = 200.0 * difference / np.where(both, spread, 1.0)
+    error = np.where(both, spread * np.minimum(1.0, ratio**1.5), difference)
+    rounding = 50.0 * np.finfo(float).eps * absolute
+    return kronrod * half, np.maximum(error, rounding), rounding
+
+
+def _adaptive_gauss_kronrod(integrand, lower, upper, relative_tolerance):
+    """Integrals over [lower_i, upper_i] by 21-point Gauss-Kronrod, each bisected adaptively on
+    its own until its error estimate is below ``relative_tolerance`` times its value.
+
+    Every round evaluates all the intervals being refined, of every integral, in one call of
+    ``integrand(nodes, owner)`` (``_gauss_kronrod``).  An integral is refined where an interval's
+    error exceeds its share of the tolerance (in proportion to its length), unless the error
+    is QUADPACK's rounding floor (50 eps int |f|, which bisection does not lower), or the
+    integral has MOST_SUBINTERVALS intervals.  Returns the integrals and their error estimates,
+    the sums over each integral's intervals.
+    """
+    count = len(lower)
+    owner = np.arange(count)
+    lo, hi = np.array(lower, dtype=float), np.array(upper, dtype=float)
+    length = hi - lo
+    value, error, rounding = _gauss_kronrod(integrand, lo, hi, owner)
+    while True:
+        total = np.bincount(owner, value, count)
+        total_error = np.bincount(owner, error, count)
+        refine = (total_error > relative_tolerance * np.abs(total)) & (
+            np.bincount(owner, minlength=count) < MOST_SUBINTERVALS
+        )
+        share = relative_tolerance * np.abs(total[owner]) * (hi - lo) / length[owner]
+        split = refine[owner] & (error > share) & (error > rounding)
+        if not split.any():
+            if np.any(np.bincount(owner, minlength=count) >= MOST_SUBINTERVALS):
+                warnings.warn(
+                    f"an F integral needs more than {MOST_SUBINTERVALS} subintervals",
+                    integrate.IntegrationWarning,
+                    stacklevel=3,
+                )
+            return total, total_error
+        middle = 0.5 * (lo[split] + hi[split])
+        halves = (
+            np.concatenate([lo[split], middle]),
+            np.concatenate([middle, hi[split]]),
+            np.tile(owner[split], 2),
+        )
+        new = _gauss_kronrod(integrand, *halves)
+        keep = ~split
+        lo, hi, owner = (
+            np.concatenate([old[keep], fresh]) for old, fresh in zip((lo, hi, owner), halves)
+        )
+        value, error, rounding = (
+            np.concatenate([old[keep], fresh]) for old, fresh in zip((value, error, rounding), new)
+        )
+
+
+def _airy_ai(z):
+    """Ai(z) for real z: scipy's airy where |z| <= 10, and outside from Bessel functions, which
+    scipy evaluates several times faster there: (z / 3)^(1/2) K_1/3(zeta) / pi (DLMF 9.6.1) and
+    Ai(-t) = (t^(1/2) / 2) (J_1/3(zeta) - Y_1/3(zeta) / 3^(1/2)) (DLMF 9.6.6 with 10.4.7),
+    zeta = (2/3) |z|^(3/2), J and Y from one Hankel function."""
+    out = np.empty(z.shape)
+    middle, below, above = np.abs(z) <= 10.0, z < -10.0, z > 10.0
+    out[middle] = special.airy(z[middle])[0]
+    t = -z[below]
+    hankel = special.hankel1(1.0 / 3.0, (2.0 / 3.0) * t**1.5)
+    out[below] = 0.5 * np.sqrt(t) * (hankel.real - hankel.imag / np.sqrt(3.0))
+    s = z[above]
+    out[above] = np.sqrt(s / 3.0) * special.kv(1.0 / 3.0, (2.0 / 3.0) * s**1.5) / np.pi
+    return out
+
+
+def _force_integrals(x, v, restitution):
+    """P(x, v) at the points x > 0 (1-d arrays x, v), eqs. (fpsol), (psi), (weightfunc2): the
+    integrand of ``distribution_by_force_integral`` on the same range of ln F, all points at
+    once by ``_adaptive_gauss_kronrod`` (relative tolerance 1e-10).  Returns the values and
+    their absolute error estimates."""
+
+    def integrand(log_force, owner):
+        # e^{-v/2} w(F) e^{-F x} psi_{1/4,F}(-v) F, eqs. (fpsol), (psi); dF = F d(ln F)
+        f = np.exp(log_force)
+        xi, vi = x[owner, None], v[owner, None]
+        argument = -np.cbrt(f) * vi + 0.25 * f ** (-2.0 / 3.0)
+        # the points at one x bisect the same interval, so share its nodes: w(F) once per interval
+        key = log_force[:, 0] + 1j * log_force[:, -1]
+        _, first, shared = np.unique(key, return_index=True, return_inverse=True)
+        weight = weight_function(f[first], restitution)[shared.ravel()]
+        return np.exp(-0.5 * vi - f * xi) * weight * f ** (5.0 / 6.0) * _airy_ai(argument)
+
+    if x.size == 0:
+        return np.empty(0), np.empty(0)
+    # as distribution_by_force_integral: w(F) ~ e^{-1/(6F)} below e^-6, e^{-F x} < e^-60 above
+    return _adaptive_gauss_kronrod(integrand, np.full(x.shape, -6.0), np.log(60.0 / x), 1e-10)
+
+
 def distribution_with_error(x, v, restitution):
     """P(x, v) and an estimate of its absolute error, for broadcast arrays x >= 0 and v.
 
     At x = 0 the outgoing side is eq. (P(0,v)) and the incoming side the
     boundary condition eq. (bc), P(0, -v) = r^2 P(0, r v) (the F integral
-    converges only conditionally there); P(0, 0) diverges and is NaN.  Elsewhere P(x, v) is
-    ``distribution_by_force_integral``, eqs. (fpsol), (psi), (weightfunc2).
+    converges only conditionally there); P(0, 0) diverges and is NaN.  Elsewhere P(x, v) is the
+    F integral of eqs. (fpsol), (psi), (weightfunc2) over the same range of ln F as
+    ``distribution_by_force_integral``, every point at once by ``_force_integrals``.
 
     Parameters
     ----------
@@ -511,8 +664,8 @@ def distribution_with_error(x, v, restitution):
     values : numpy.ndarray
         P(x, v), the broadcast shape.
     errors : numpy.ndarray
-        quad's estimate of the absolute error of each value (0 at x = 0, where the values are
-        in closed form).
+        The adaptive Gauss-Kronrod estimate of the absolute error of each value
+        (``_force_integrals``; 0 at x = 0, where the values are in closed form).
 
     Raises
     ------
@@ -532,17 +685,13 @@ def distribution_with_error(x, v, restitution):
             check_force_integral_point(float(x[index]), float(v[index]))
     values, errors = np.empty(x.shape), np.zeros(x.shape)
     r = float(_which(restitution))
-    for index in np.ndindex(x.shape):
-        xi, vi = float(x[index]), float(v[index])
-        if xi == 0.0:
-            if vi > 0.0:
-                values[index] = outgoing_speed_density(vi, restitution)
-            elif vi < 0.0:
-                values[index] = r * r * outgoing_speed_density(-r * vi, restitution)
-            else:
-                values[index] = np.nan
-            continue
-        values[index], errors[index] = distribution_by_force_integral(xi, vi, restitution)
+    wall = x == 0.0
+    outgoing, incoming = wall & (v > 0.0), wall & (v < 0.0)
+    values[outgoing] = outgoing_speed_density(v[outgoing], restitution)
+    values[incoming] = r * r * outgoing_speed_density(-r * v[incoming], restitution)
+    values[wall & (v == 0.0)] = np.nan
+    inside = ~wall
+    values[inside], errors[inside] = _force_integrals(x[inside], v[inside], restitution)
     return values, errors
 
 
