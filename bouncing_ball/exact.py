@@ -48,6 +48,118 @@ def _which(restitution) -> Fraction:
     return value
 
 
+# QUADPACK's 21-point Gauss-Kronrod rule (dqk21) on [-1, 1]: the Kronrod nodes x >= 0 (the
+# 10-point Gauss rule's at odd index), their Kronrod weights, and the Gauss weights
+_HALF_KRONROD_NODES = (
+    0.995657163025808080735527280689003,
+    0.973906528517171720077964012084452,
+    0.930157491355708226001207180059508,
+    0.865063366688984510732096688423493,
+    0.780817726586416897063717578345042,
+    0.679409568299024406234327365114874,
+    0.562757134668604683339000099272694,
+    0.433395394129247190799265943165784,
+    0.294392862701460198131126603103866,
+    0.148874338981631210884826001129720,
+    0.0,
+)
+_HALF_KRONROD_WEIGHTS = (
+    0.011694638867371874278064396062192,
+    0.032558162307964727478818972459390,
+    0.054755896574351996031381300244580,
+    0.075039674810919952767043140916190,
+    0.093125454583697605535065465083366,
+    0.109387158802297641899210590325805,
+    0.123491976262065851077208814748999,
+    0.134709217311473325928054001771707,
+    0.142775938577060080797094273138717,
+    0.147739104901338491374841515972068,
+    0.149445554002916905664936468389821,
+)
+_HALF_GAUSS_WEIGHTS = (
+    0.066671344308688137593568809893332,
+    0.149451349150580593145776339657697,
+    0.219086362515982043995534934228163,
+    0.269266719309996355091226921569469,
+    0.295524224714752870173892994651338,
+)
+KRONROD_NODES = np.concatenate([np.negative(_HALF_KRONROD_NODES), _HALF_KRONROD_NODES[-2::-1]])
+KRONROD_WEIGHTS = np.concatenate([_HALF_KRONROD_WEIGHTS, _HALF_KRONROD_WEIGHTS[-2::-1]])
+#: the 10-point Gauss rule's weights on KRONROD_NODES (0 at the Kronrod-only nodes)
+GAUSS_WEIGHTS = np.zeros(21)
+GAUSS_WEIGHTS[1:10:2] = _HALF_GAUSS_WEIGHTS
+GAUSS_WEIGHTS[11:21:2] = _HALF_GAUSS_WEIGHTS[::-1]
+
+#: subintervals one integral may be cut into (``_adaptive_gauss_kronrod``)
+MOST_SUBINTERVALS = 10000
+
+
+def _gauss_kronrod(integrand, lower, upper, owner):
+    """The 21-point Gauss-Kronrod rule on every interval [lower, upper] at once: the integrals,
+    their error estimates and the rounding floor of those estimates, as QUADPACK's dqk21 makes
+    them; ``integrand(nodes, owner)`` takes the nodes (intervals x 21) of the integrals
+    ``owner`` (one per interval)."""
+    centre, half = 0.5 * (lower + upper), 0.5 * (upper - lower)
+    f = integrand(centre[:, None] + half[:, None] * KRONROD_NODES, owner)
+    kronrod = f @ KRONROD_WEIGHTS
+    absolute = (np.abs(f) @ KRONROD_WEIGHTS) * half
+    spread = (np.abs(f - 0.5 * kronrod[:, None]) @ KRONROD_WEIGHTS) * half
+    difference = np.abs(kronrod - f @ GAUSS_WEIGHTS) * half
+    both = (spread > 0.0) & (difference > 0.0)
+    ratio = 200.0 * difference / np.where(both, spread, 1.0)
+    error = np.where(both, spread * np.minimum(1.0, ratio**1.5), difference)
+    rounding = 50.0 * np.finfo(float).eps * absolute
+    return kronrod * half, np.maximum(error, rounding), rounding
+
+
+def _adaptive_gauss_kronrod(integrand, lower, upper, relative_tolerance):
+    """Integrals over [lower_i, upper_i] by 21-point Gauss-Kronrod, each bisected adaptively on
+    its own until its error estimate is below ``relative_tolerance`` times its value.
+
+    Every round evaluates all the intervals being refined, of every integral, in one call of
+    ``integrand(nodes, owner)`` (``_gauss_kronrod``).  An integral is refined where an interval's
+    error exceeds its share of the tolerance (in proportion to its length), unless the error
+    is QUADPACK's rounding floor (50 eps int |f|, which bisection does not lower), or the
+    integral has MOST_SUBINTERVALS intervals.  Returns the integrals and their error estimates,
+    the sums over each integral's intervals.
+    """
+    count = len(lower)
+    owner = np.arange(count)
+    lo, hi = np.array(lower, dtype=float), np.array(upper, dtype=float)
+    length = hi - lo
+    value, error, rounding = _gauss_kronrod(integrand, lo, hi, owner)
+    while True:
+        total = np.bincount(owner, value, count)
+        total_error = np.bincount(owner, error, count)
+        refine = (total_error > relative_tolerance * np.abs(total)) & (
+            np.bincount(owner, minlength=count) < MOST_SUBINTERVALS
+        )
+        share = relative_tolerance * np.abs(total[owner]) * (hi - lo) / length[owner]
+        split = refine[owner] & (error > share) & (error > rounding)
+        if not split.any():
+            if np.any(np.bincount(owner, minlength=count) >= MOST_SUBINTERVALS):
+                warnings.warn(
+                    f"an integral needs more than {MOST_SUBINTERVALS} subintervals",
+                    integrate.IntegrationWarning,
+                    stacklevel=3,
+                )
+            return total, total_error
+        middle = 0.5 * (lo[split] + hi[split])
+        halves = (
+            np.concatenate([lo[split], middle]),
+            np.concatenate([middle, hi[split]]),
+            np.tile(owner[split], 2),
+        )
+        new = _gauss_kronrod(integrand, *halves)
+        keep = ~split
+        lo, hi, owner = (
+            np.concatenate([old[keep], fresh]) for old, fresh in zip((lo, hi, owner), halves)
+        )
+        value, error, rounding = (
+            np.concatenate([old[keep], fresh]) for old, fresh in zip((value, error, rounding), new)
+        )
+
+
 def normalization_constant(restitution) -> float:
     """The normalization constant A of P(0, v), eq. (constants).
 
@@ -170,7 +282,7 @@ def position_density(x, restitution):
     Parameters
     ----------
     x : array_like
-        Heights, x >= 0 (P(0) is infinite at r = 1/2).
+        Heights, x >= 0 (P(0) is infinite).
     restitution : float or str
         r = 1/2 or 1/3, a float or a fraction string ("1/2", "1/3").
 
@@ -194,20 +306,28 @@ def position_density(x, restitution):
     x = np.asarray(x, dtype=float)
     if _which(restitution) == Fraction(1, 2):
         return special.k0(np.sqrt(2.0 * x / 3.0)) / 3.0
-    return np.vectorize(_position_density_third)(x)
+    return _position_density_third(x)
 
 
 def _position_density_third(x):
-    # (1/4 pi) int dF F^-1 K_{1/6}(z) e^{-z - F x}, z = 1/(12 F); in ln F
-    def integrand(log_f):
+    """P(x) at r = 1/3 for an array x, eq. (P(x)2): (1/4 pi) int dF F^-1 K_{1/6}(z) e^{-z - F x},
+    z = 1/(12 F), in ln F, all x > 0 at once (``_adaptive_gauss_kronrod``); infinite at x = 0,
+    where the integrand grows as F^(1/6)."""
+    x = np.asarray(x, dtype=float)
+    out = np.full(x.shape, np.inf)
+    inside = x > 0.0
+    heights = x[inside]
+
+    def integrand(log_f, owner):
         f = np.exp(log_f)
         z = 1.0 / (12.0 * f)
-        return special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z - f * x)
+        return special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z - f * heights[owner, None])
 
-    # e^{-2z} cuts off small F; e^{-F x} (or, at x = 0, nothing) large F
-    upper = np.log(60.0 / x) if x > 0.0 else np.inf
-    value, _ = integrate.quad(integrand, -8.0, max(upper, 8.0), limit=400, epsabs=0.0, epsrel=1e-11)
-    return value / (4.0 * np.pi)
+    # e^{-2z} cuts off small F; e^{-F x} large F
+    upper = np.maximum(np.log(60.0 / heights), 8.0)
+    values, _ = _adaptive_gauss_kronrod(integrand, np.full(upper.shape, -8.0), upper, 1e-11)
+    out[inside] = values / (4.0 * np.pi)
+    return out
 
 
 def position_bin_average(lo, hi, restitution):
@@ -246,7 +366,7 @@ def position_bin_average(lo, hi, restitution):
 
         return (primitive(hi) - primitive(lo)) / (hi - lo)
     averages = [
-        integrate.quad(_position_density_third, a, b, epsrel=1e-10)[0] / (b - a)
+        integrate.quad(lambda y: float(_position_density_third(y)), a, b, epsrel=1e-10)[0] / (b - a)
         for a, b in zip(np.atleast_1d(lo), np.atleast_1d(hi))
     ]
     return np.asarray(averages).reshape(np.shape(lo))
@@ -347,15 +467,14 @@ def position_moments(restitution) -> dict:
     >>> print({name: round(float(value), 8) for name, value in moments.items()})
     {'normalization': 1.0, 'mean_x': 6.0, 'delta_x': 10.39230485, 'collision_rate': 0.33333333}
     """
-    moments = []
-    for k in (0, 1, 2):
-        # x = 3 u^2 / 2 makes the decay exp(-u) for both r
-        def integrand(u, k=k):
-            x = 1.5 * u * u
-            return x**k * float(position_density(x, restitution)) * 3.0 * u
 
-        value, _ = integrate.quad(integrand, 0.0, np.inf, limit=400, epsrel=1e-12)
-        moments.append(value)
+    # int x^k P(x) dx for k = 0, 1, 2 (the integrals' ``owner``), in x = 3 u^2 / 2, which makes
+    # the decay exp(-u) for both r: beyond u = 80, x^2 P(x) 3u < 1e-25
+    def integrand(u, k):
+        x = 1.5 * u * u
+        return x ** k[:, None] * position_density(x, restitution) * 3.0 * u
+
+    moments, _ = _adaptive_gauss_kronrod(integrand, np.zeros(3), np.full(3, 80.0), 1e-12)
     norm, first, second = moments
     mean_x = first / norm
     a = normalization_constant(restitution)
@@ -490,118 +609,6 @@ def distribution_by_force_integral(x, v, restitution):
         full_output=1,
     )
     return value, error
-
-
-# QUADPACK's 21-point Gauss-Kronrod rule (dqk21) on [-1, 1]: the Kronrod nodes x >= 0 (the
-# 10-point Gauss rule's at odd index), their Kronrod weights, and the Gauss weights
-_HALF_KRONROD_NODES = (
-    0.995657163025808080735527280689003,
-    0.973906528517171720077964012084452,
-    0.930157491355708226001207180059508,
-    0.865063366688984510732096688423493,
-    0.780817726586416897063717578345042,
-    0.679409568299024406234327365114874,
-    0.562757134668604683339000099272694,
-    0.433395394129247190799265943165784,
-    0.294392862701460198131126603103866,
-    0.148874338981631210884826001129720,
-    0.0,
-)
-_HALF_KRONROD_WEIGHTS = (
-    0.011694638867371874278064396062192,
-    0.032558162307964727478818972459390,
-    0.054755896574351996031381300244580,
-    0.075039674810919952767043140916190,
-    0.093125454583697605535065465083366,
-    0.109387158802297641899210590325805,
-    0.123491976262065851077208814748999,
-    0.134709217311473325928054001771707,
-    0.142775938577060080797094273138717,
-    0.147739104901338491374841515972068,
-    0.149445554002916905664936468389821,
-)
-_HALF_GAUSS_WEIGHTS = (
-    0.066671344308688137593568809893332,
-    0.149451349150580593145776339657697,
-    0.219086362515982043995534934228163,
-    0.269266719309996355091226921569469,
-    0.295524224714752870173892994651338,
-)
-KRONROD_NODES = np.concatenate([np.negative(_HALF_KRONROD_NODES), _HALF_KRONROD_NODES[-2::-1]])
-KRONROD_WEIGHTS = np.concatenate([_HALF_KRONROD_WEIGHTS, _HALF_KRONROD_WEIGHTS[-2::-1]])
-#: the 10-point Gauss rule's weights on KRONROD_NODES (0 at the Kronrod-only nodes)
-GAUSS_WEIGHTS = np.zeros(21)
-GAUSS_WEIGHTS[1:10:2] = _HALF_GAUSS_WEIGHTS
-GAUSS_WEIGHTS[11:21:2] = _HALF_GAUSS_WEIGHTS[::-1]
-
-#: subintervals a point's F integral may be cut into (``_adaptive_gauss_kronrod``)
-MOST_SUBINTERVALS = 10000
-
-
-def _gauss_kronrod(integrand, lower, upper, owner):
-    """The 21-point Gauss-Kronrod rule on every interval [lower, upper] at once: the integrals,
-    their error estimates and the rounding floor of those estimates, as QUADPACK's dqk21 makes
-    them; ``integrand(nodes, owner)`` takes the nodes (intervals x 21) of the integrals
-    ``owner`` (one per interval)."""
-    centre, half = 0.5 * (lower + upper), 0.5 * (upper - lower)
-    f = integrand(centre[:, None] + half[:, None] * KRONROD_NODES, owner)
-    kronrod = f @ KRONROD_WEIGHTS
-    absolute = (np.abs(f) @ KRONROD_WEIGHTS) * half
-    spread = (np.abs(f - 0.5 * kronrod[:, None]) @ KRONROD_WEIGHTS) * half
-    difference = np.abs(kronrod - f @ GAUSS_WEIGHTS) * half
-    both = (spread > 0.0) & (difference > 0.0)
-    ratio = 200.0 * difference / np.where(both, spread, 1.0)
-    error = np.where(both, spread * np.minimum(1.0, ratio**1.5), difference)
-    rounding = 50.0 * np.finfo(float).eps * absolute
-    return kronrod * half, np.maximum(error, rounding), rounding
-
-
-def _adaptive_gauss_kronrod(integrand, lower, upper, relative_tolerance):
-    """Integrals over [lower_i, upper_i] by 21-point Gauss-Kronrod, each bisected adaptively on
-    its own until its error estimate is below ``relative_tolerance`` times its value.
-
-    Every round evaluates all the intervals being refined, of every integral, in one call of
-    ``integrand(nodes, owner)`` (``_gauss_kronrod``).  An integral is refined where an interval's
-    error exceeds its share of the tolerance (in proportion to its length), unless the error
-    is QUADPACK's rounding floor (50 eps int |f|, which bisection does not lower), or the
-    integral has MOST_SUBINTERVALS intervals.  Returns the integrals and their error estimates,
-    the sums over each integral's intervals.
-    """
-    count = len(lower)
-    owner = np.arange(count)
-    lo, hi = np.array(lower, dtype=float), np.array(upper, dtype=float)
-    length = hi - lo
-    value, error, rounding = _gauss_kronrod(integrand, lo, hi, owner)
-    while True:
-        total = np.bincount(owner, value, count)
-        total_error = np.bincount(owner, error, count)
-        refine = (total_error > relative_tolerance * np.abs(total)) & (
-            np.bincount(owner, minlength=count) < MOST_SUBINTERVALS
-        )
-        share = relative_tolerance * np.abs(total[owner]) * (hi - lo) / length[owner]
-        split = refine[owner] & (error > share) & (error > rounding)
-        if not split.any():
-            if np.any(np.bincount(owner, minlength=count) >= MOST_SUBINTERVALS):
-                warnings.warn(
-                    f"an F integral needs more than {MOST_SUBINTERVALS} subintervals",
-                    integrate.IntegrationWarning,
-                    stacklevel=3,
-                )
-            return total, total_error
-        middle = 0.5 * (lo[split] + hi[split])
-        halves = (
-            np.concatenate([lo[split], middle]),
-            np.concatenate([middle, hi[split]]),
-            np.tile(owner[split], 2),
-        )
-        new = _gauss_kronrod(integrand, *halves)
-        keep = ~split
-        lo, hi, owner = (
-            np.concatenate([old[keep], fresh]) for old, fresh in zip((lo, hi, owner), halves)
-        )
-        value, error, rounding = (
-            np.concatenate([old[keep], fresh]) for old, fresh in zip((value, error, rounding), new)
-        )
 
 
 def _airy_ai(z):
@@ -761,21 +768,25 @@ def mean_speed_squared_given_position(x, restitution):
         u = np.sqrt(2.0 * x / 3.0)
         return u * special.k1(u) / (special.k0(u) / 3.0)
 
-    return np.vectorize(_position_tail_third)(x) / position_density(x, restitution)
+    return _position_tail_third(x) / position_density(x, restitution)
 
 
 def _position_tail_third(x):
-    # int_x^inf P(x') dx' at r = 1/3, under the F integral of eq. (P(x)2):
-    # int_x^inf e^{-F x'} dx' = e^{-F x} / F, in ln F as in _position_density_third
-    def integrand(log_f):
+    """int_x^inf P(x') dx' at r = 1/3 for an array x >= 0, under the F integral of
+    eq. (P(x)2): int_x^inf e^{-F x'} dx' = e^{-F x} / F, in ln F as in
+    ``_position_density_third``, all x at once."""
+    x = np.asarray(x, dtype=float)
+    heights = x.ravel()
+
+    def integrand(log_f, owner):
         f = np.exp(log_f)
         z = 1.0 / (12.0 * f)
-        return special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z - f * x) / f
+        return special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z - f * heights[owner, None]) / f
 
     # at x = 0 the integrand decays only as F^(-5/6) in ln F
-    upper = np.log(60.0 / x) if x > 0.0 else np.log(1.0e16)
-    value, _ = integrate.quad(integrand, -8.0, max(upper, 8.0), limit=400, epsabs=0.0, epsrel=1e-11)
-    return value / (4.0 * np.pi)
+    upper = np.maximum(np.log(60.0 / np.where(heights > 0.0, heights, 60.0e-16)), 8.0)
+    values, _ = _adaptive_gauss_kronrod(integrand, np.full(upper.shape, -8.0), upper, 1e-11)
+    return (values / (4.0 * np.pi)).reshape(x.shape)
 
 
 def distribution_table(positions, speeds, restitution):
