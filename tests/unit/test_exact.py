@@ -175,3 +175,21 @@ def test_distribution_arrays_agree_with_one_point_quad(r):
     assert np.all(np.abs(values - theirs) <= errors + their_errors)
     assert np.max(np.abs(values / theirs - 1.0)) < 1e-10
     assert np.max(errors / values) < 1e-9
+
+
+@pytest.mark.parametrize(
+    ("r", "mean_x", "delta_x"),
+    [
+        (Fraction(1, 2), 6.0, 6.0 * np.sqrt(3.0)),
+        (Fraction(1, 3), 35.0 / 9.0, np.sqrt(4781.0) / 9.0),
+    ],
+    ids=str,
+)
+def test_position_moments_are_the_closed_forms(r, mean_x, delta_x):
+    """<x> and Delta x from the moments of P(x), eq. (P(x)2), each to 1e-12 relative: the
+    closed forms of eq. (xandDeltax) (6, 6 3^(1/2); 35/9, 4781^(1/2)/9), to the moments'
+    tolerance (Delta x^2 = <x^2> - <x>^2 loses a factor <x^2>/Delta x^2 < 1.3 of it)."""
+    moments = exact.position_moments(r)
+    assert moments["normalization"] == pytest.approx(1.0, rel=1e-12)
+    assert moments["mean_x"] == pytest.approx(mean_x, rel=2e-12)
+    assert moments["delta_x"] == pytest.approx(delta_x, rel=2e-12)
