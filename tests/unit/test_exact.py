@@ -183,7 +183,7 @@ def test_distribution_arrays_agree_with_one_point_quad(r):
         (Fraction(1, 2), 6.0, 6.0 * np.sqrt(3.0)),
         (Fraction(1, 3), 35.0 / 9.0, np.sqrt(4781.0) / 9.0),
     ],
-    ids=str,
+    ids=["1/2", "1/3"],
 )
 def test_position_moments_are_the_closed_forms(r, mean_x, delta_x):
     """<x> and Delta x from the moments of P(x), eq. (P(x)2), each to 1e-12 relative: the
