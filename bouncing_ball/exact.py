@@ -11,6 +11,7 @@ other r with a ``ValueError``.
 
 import functools
 import math
+import warnings
 from fractions import Fraction
 
 import numpy as np
@@ -45,6 +46,118 @@ def _which(restitution) -> Fraction:
     if value not in EXACT_RESTITUTIONS or abs(float(value) - float(given)) > 1e-12:
         raise ValueError(f"exact solutions exist only for r = 1/2 and 1/3, not r = {restitution}")
     return value
+
+
+# QUADPACK's 21-point Gauss-Kronrod rule (dqk21) on [-1, 1]: the Kronrod nodes x >= 0 (the
+# 10-point Gauss rule's at odd index), their Kronrod weights, and the Gauss weights
+_HALF_KRONROD_NODES = (
+    0.995657163025808080735527280689003,
+    0.973906528517171720077964012084452,
+    0.930157491355708226001207180059508,
+    0.865063366688984510732096688423493,
+    0.780817726586416897063717578345042,
+    0.679409568299024406234327365114874,
+    0.562757134668604683339000099272694,
+    0.433395394129247190799265943165784,
+    0.294392862701460198131126603103866,
+    0.148874338981631210884826001129720,
+    0.0,
+)
+_HALF_KRONROD_WEIGHTS = (
+    0.011694638867371874278064396062192,
+    0.032558162307964727478818972459390,
+    0.054755896574351996031381300244580,
+    0.075039674810919952767043140916190,
+    0.093125454583697605535065465083366,
+    0.109387158802297641899210590325805,
+    0.123491976262065851077208814748999,
+    0.134709217311473325928054001771707,
+    0.142775938577060080797094273138717,
+    0.147739104901338491374841515972068,
+    0.149445554002916905664936468389821,
+)
+_HALF_GAUSS_WEIGHTS = (
+    0.066671344308688137593568809893332,
+    0.149451349150580593145776339657697,
+    0.219086362515982043995534934228163,
+    0.269266719309996355091226921569469,
+    0.295524224714752870173892994651338,
+)
+KRONROD_NODES = np.concatenate([np.negative(_HALF_KRONROD_NODES), _HALF_KRONROD_NODES[-2::-1]])
+KRONROD_WEIGHTS = np.concatenate([_HALF_KRONROD_WEIGHTS, _HALF_KRONROD_WEIGHTS[-2::-1]])
+#: the 10-point Gauss rule's weights on KRONROD_NODES (0 at the Kronrod-only nodes)
+GAUSS_WEIGHTS = np.zeros(21)
+GAUSS_WEIGHTS[1:10:2] = _HALF_GAUSS_WEIGHTS
+GAUSS_WEIGHTS[11:21:2] = _HALF_GAUSS_WEIGHTS[::-1]
+
+#: subintervals one integral may be cut into (``_adaptive_gauss_kronrod``)
+MOST_SUBINTERVALS = 10000
+
+
+def _gauss_kronrod(integrand, lower, upper, owner):
+    """The 21-point Gauss-Kronrod rule on every interval [lower, upper] at once: the integrals,
+    their error estimates and the rounding floor of those estimates, as QUADPACK's dqk21 makes
+    them; ``integrand(nodes, owner)`` takes the nodes (intervals x 21) of the integrals
+    ``owner`` (one per interval)."""
+    centre, half = 0.5 * (lower + upper), 0.5 * (upper - lower)
+    f = integrand(centre[:, None] + half[:, None] * KRONROD_NODES, owner)
+    kronrod = f @ KRONROD_WEIGHTS
+    absolute = (np.abs(f) @ KRONROD_WEIGHTS) * half
+    spread = (np.abs(f - 0.5 * kronrod[:, None]) @ KRONROD_WEIGHTS) * half
+    difference = np.abs(kronrod - f @ GAUSS_WEIGHTS) * half
+    both = (spread > 0.0) & (difference > 0.0)
+    ratio = 200.0 * difference / np.where(both, spread, 1.0)
+    error = np.where(both, spread * np.minimum(1.0, ratio**1.5), difference)
+    rounding = 50.0 * np.finfo(float).eps * absolute
+    return kronrod * half, np.maximum(error, rounding), rounding
+
+
+def _adaptive_gauss_kronrod(integrand, lower, upper, relative_tolerance):
+    """Integrals over [lower_i, upper_i] by 21-point Gauss-Kronrod, each bisected adaptively on
+    its own until its error estimate is below ``relative_tolerance`` times its value.
+
+    Every round evaluates all the intervals being refined, of every integral, in one call of
+    ``integrand(nodes, owner)`` (``_gauss_kronrod``).  An integral is refined where an interval's
+    error exceeds its share of the tolerance (in proportion to its length), unless the error
+    is QUADPACK's rounding floor (50 eps int |f|, which bisection does not lower), or the
+    integral has MOST_SUBINTERVALS intervals.  Returns the integrals and their error estimates,
+    the sums over each integral's intervals.
+    """
+    count = len(lower)
+    owner = np.arange(count)
+    lo, hi = np.array(lower, dtype=float), np.array(upper, dtype=float)
+    length = hi - lo
+    value, error, rounding = _gauss_kronrod(integrand, lo, hi, owner)
+    while True:
+        total = np.bincount(owner, value, count)
+        total_error = np.bincount(owner, error, count)
+        refine = (total_error > relative_tolerance * np.abs(total)) & (
+            np.bincount(owner, minlength=count) < MOST_SUBINTERVALS
+        )
+        share = relative_tolerance * np.abs(total[owner]) * (hi - lo) / length[owner]
+        split = refine[owner] & (error > share) & (error > rounding)
+        if not split.any():
+            if np.any(np.bincount(owner, minlength=count) >= MOST_SUBINTERVALS):
+                warnings.warn(
+                    f"an integral needs more than {MOST_SUBINTERVALS} subintervals",
+                    integrate.IntegrationWarning,
+                    stacklevel=3,
+                )
+            return total, total_error
+        middle = 0.5 * (lo[split] + hi[split])
+        halves = (
+            np.concatenate([lo[split], middle]),
+            np.concatenate([middle, hi[split]]),
+            np.tile(owner[split], 2),
+        )
+        new = _gauss_kronrod(integrand, *halves)
+        keep = ~split
+        lo, hi, owner = (
+            np.concatenate([old[keep], fresh]) for old, fresh in zip((lo, hi, owner), halves)
+        )
+        value, error, rounding = (
+            np.concatenate([old[keep], fresh]) for old, fresh in zip((value, error, rounding), new)
+        )
 
 
 def normalization_constant(restitution) -> float:
@@ -169,7 +282,7 @@ def position_density(x, restitution):
     Parameters
     ----------
     x : array_like
-        Heights, x >= 0 (P(0) is infinite at r = 1/2).
+        Heights, x >= 0 (P(0) is infinite).
     restitution : float or str
         r = 1/2 or 1/3, a float or a fraction string ("1/2", "1/3").
 
@@ -193,20 +306,28 @@ def position_density(x, restitution):
     x = np.asarray(x, dtype=float)
     if _which(restitution) == Fraction(1, 2):
         return special.k0(np.sqrt(2.0 * x / 3.0)) / 3.0
-    return np.vectorize(_position_density_third)(x)
+    return _position_density_third(x)
 
 
 def _position_density_third(x):
-    # (1/4 pi) int dF F^-1 K_{1/6}(z) e^{-z - F x}, z = 1/(12 F); in ln F
-    def integrand(log_f):
+    """P(x) at r = 1/3 for an array x, eq. (P(x)2): (1/4 pi) int dF F^-1 K_{1/6}(z) e^{-z - F x},
+    z = 1/(12 F), in ln F, all x > 0 at once (``_adaptive_gauss_kronrod``); infinite at x = 0,
+    where the integrand grows as F^(1/6)."""
+    x = np.asarray(x, dtype=float)
+    out = np.full(x.shape, np.inf)
+    inside = x > 0.0
+    heights = x[inside]
+
+    def integrand(log_f, owner):
         f = np.exp(log_f)
         z = 1.0 / (12.0 * f)
-        return special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z - f * x)
+        return special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z - f * heights[owner, None])
 
-    # e^{-2z} cuts off small F; e^{-F x} (or, at x = 0, nothing) large F
-    upper = np.log(60.0 / x) if x > 0.0 else np.inf
-    value, _ = integrate.quad(integrand, -8.0, max(upper, 8.0), limit=400, epsabs=0.0, epsrel=1e-11)
-    return value / (4.0 * np.pi)
+    # e^{-2z} cuts off small F; e^{-F x} large F
+    upper = np.maximum(np.log(60.0 / heights), 8.0)
+    values, _ = _adaptive_gauss_kronrod(integrand, np.full(upper.shape, -8.0), upper, 1e-11)
+    out[inside] = values / (4.0 * np.pi)
+    return out
 
 
 def position_bin_average(lo, hi, restitution):
@@ -245,7 +366,7 @@ def position_bin_average(lo, hi, restitution):
 
         return (primitive(hi) - primitive(lo)) / (hi - lo)
     averages = [
-        integrate.quad(_position_density_third, a, b, epsrel=1e-10)[0] / (b - a)
+        integrate.quad(lambda y: float(_position_density_third(y)), a, b, epsrel=1e-10)[0] / (b - a)
         for a, b in zip(np.atleast_1d(lo), np.atleast_1d(hi))
     ]
     return np.asarray(averages).reshape(np.shape(lo))
@@ -346,15 +467,14 @@ def position_moments(restitution) -> dict:
     >>> print({name: round(float(value), 8) for name, value in moments.items()})
     {'normalization': 1.0, 'mean_x': 6.0, 'delta_x': 10.39230485, 'collision_rate': 0.33333333}
     """
-    moments = []
-    for k in (0, 1, 2):
-        # x = 3 u^2 / 2 makes the decay exp(-u) for both r
-        def integrand(u, k=k):
-            x = 1.5 * u * u
-            return x**k * float(position_density(x, restitution)) * 3.0 * u
 
-        value, _ = integrate.quad(integrand, 0.0, np.inf, limit=400, epsrel=1e-12)
-        moments.append(value)
+    # int x^k P(x) dx for k = 0, 1, 2 (the integrals' ``owner``), in x = 3 u^2 / 2, which makes
+    # the decay exp(-u) for both r: beyond u = 80, x^2 P(x) 3u < 1e-25
+    def integrand(u, k):
+        x = 1.5 * u * u
+        return x ** k[:, None] * position_density(x, restitution) * 3.0 * u
+
+    moments, _ = _adaptive_gauss_kronrod(integrand, np.zeros(3), np.full(3, 80.0), 1e-12)
     norm, first, second = moments
     mean_x = first / norm
     a = normalization_constant(restitution)
@@ -435,6 +555,8 @@ def _distribution_integrand(log_force, x, v, weight):
 def distribution_by_force_integral(x, v, restitution):
     """P(x, v) of eqs. (fpsol), (psi), (weightfunc2) by integration over F, and its error.
 
+    One point by scipy's ``quad`` (relative tolerance 1e-10): the cross-check of the arrays
+    ``distribution_with_error`` integrates all at once, over the same range of ln F.
     Converges absolutely for x > 0, and for x = 0 on the incoming side v < 0
     (there the Airy function decays); at x = 0, v > 0 only conditionally.
 
@@ -489,13 +611,55 @@ def distribution_by_force_integral(x, v, restitution):
     return value, error
 
 
+def _airy_ai(z):
+    """Ai(z) for real z: scipy's airy where |z| <= 10, and outside from Bessel functions, which
+    scipy evaluates several times faster there: (z / 3)^(1/2) K_1/3(zeta) / pi (DLMF 9.6.1) and
+    Ai(-t) = (t^(1/2) / 2) (J_1/3(zeta) - Y_1/3(zeta) / 3^(1/2)) (DLMF 9.6.6 with 10.4.7),
+    zeta = (2/3) |z|^(3/2), J and Y from one Hankel function."""
+    out = np.empty(z.shape)
+    middle, below, above = np.abs(z) <= 10.0, z < -10.0, z > 10.0
+    out[middle] = special.airy(z[middle])[0]
+    t = -z[below]
+    hankel = special.hankel1(1.0 / 3.0, (2.0 / 3.0) * t**1.5)
+    out[below] = 0.5 * np.sqrt(t) * (hankel.real - hankel.imag / np.sqrt(3.0))
+    s = z[above]
+    out[above] = np.sqrt(s / 3.0) * special.kv(1.0 / 3.0, (2.0 / 3.0) * s**1.5) / np.pi
+    return out
+
+
+def _force_integrals(x, v, restitution):
+    """P(x, v) at the points x > 0 (1-d arrays x, v), eqs. (fpsol), (psi), (weightfunc2): the
+    integrand of ``distribution_by_force_integral`` on the same range of ln F, all points at
+    once by ``_adaptive_gauss_kronrod`` (relative tolerance 1e-10).  Returns the values and
+    their absolute error estimates."""
+
+    def integrand(log_force, owner):
+        # e^{-v/2} w(F) e^{-F x} psi_{1/4,F}(-v) F, eqs. (fpsol), (psi); dF = F d(ln F)
+        f = np.exp(log_force)
+        xi, vi = x[owner, None], v[owner, None]
+        argument = -np.cbrt(f) * vi + 0.25 * f ** (-2.0 / 3.0)
+        # the points at one x bisect the same interval, so share its nodes: w(F) once per interval
+        key = log_force[:, 0] + 1j * log_force[:, -1]
+        _, first, shared = np.unique(key, return_index=True, return_inverse=True)
+        weight = weight_function(f[first], restitution)[shared.ravel()]
+        return np.exp(-0.5 * vi - f * xi) * weight * f ** (5.0 / 6.0) * _airy_ai(argument)
+
+    if x.size == 0:
+        return np.empty(0), np.empty(0)
+    # as distribution_by_force_integral: w(F) ~ e^{-1/(6F)} below e^-6, e^{-F x} < e^-60 above
+    return _adaptive_gauss_kronrod(integrand, np.full(x.shape, -6.0), np.log(60.0 / x), 1e-10)
+
+
 def distribution_with_error(x, v, restitution):
     """P(x, v) and an estimate of its absolute error, for broadcast arrays x >= 0 and v.
 
     At x = 0 the outgoing side is eq. (P(0,v)) and the incoming side the
     boundary condition eq. (bc), P(0, -v) = r^2 P(0, r v) (the F integral
-    converges only conditionally there); P(0, 0) diverges and is NaN.  Elsewhere P(x, v) is
-    ``distribution_by_force_integral``, eqs. (fpsol), (psi), (weightfunc2).
+    converges only conditionally there); P(0, 0) diverges and is NaN.  Elsewhere P(x, v) is the
+    F integral of eqs. (fpsol), (psi), (weightfunc2) over the same range of ln F as
+    ``distribution_by_force_integral``, to 1e-10 relative, every point at once by an adaptive
+    21-point Gauss-Kronrod rule, each point's intervals bisected on its own
+    (``_force_integrals``).
 
     Parameters
     ----------
@@ -511,8 +675,8 @@ def distribution_with_error(x, v, restitution):
     values : numpy.ndarray
         P(x, v), the broadcast shape.
     errors : numpy.ndarray
-        quad's estimate of the absolute error of each value (0 at x = 0, where the values are
-        in closed form).
+        The adaptive Gauss-Kronrod estimate of the absolute error of each value
+        (``_force_integrals``; 0 at x = 0, where the values are in closed form).
 
     Raises
     ------
@@ -532,17 +696,13 @@ def distribution_with_error(x, v, restitution):
             check_force_integral_point(float(x[index]), float(v[index]))
     values, errors = np.empty(x.shape), np.zeros(x.shape)
     r = float(_which(restitution))
-    for index in np.ndindex(x.shape):
-        xi, vi = float(x[index]), float(v[index])
-        if xi == 0.0:
-            if vi > 0.0:
-                values[index] = outgoing_speed_density(vi, restitution)
-            elif vi < 0.0:
-                values[index] = r * r * outgoing_speed_density(-r * vi, restitution)
-            else:
-                values[index] = np.nan
-            continue
-        values[index], errors[index] = distribution_by_force_integral(xi, vi, restitution)
+    wall = x == 0.0
+    outgoing, incoming = wall & (v > 0.0), wall & (v < 0.0)
+    values[outgoing] = outgoing_speed_density(v[outgoing], restitution)
+    values[incoming] = r * r * outgoing_speed_density(-r * v[incoming], restitution)
+    values[wall & (v == 0.0)] = np.nan
+    inside = ~wall
+    values[inside], errors[inside] = _force_integrals(x[inside], v[inside], restitution)
     return values, errors
 
 
@@ -608,21 +768,25 @@ def mean_speed_squared_given_position(x, restitution):
         u = np.sqrt(2.0 * x / 3.0)
         return u * special.k1(u) / (special.k0(u) / 3.0)
 
-    return np.vectorize(_position_tail_third)(x) / position_density(x, restitution)
+    return _position_tail_third(x) / position_density(x, restitution)
 
 
 def _position_tail_third(x):
-    # int_x^inf P(x') dx' at r = 1/3, under the F integral of eq. (P(x)2):
-    # int_x^inf e^{-F x'} dx' = e^{-F x} / F, in ln F as in _position_density_third
-    def integrand(log_f):
+    """int_x^inf P(x') dx' at r = 1/3 for an array x >= 0, under the F integral of
+    eq. (P(x)2): int_x^inf e^{-F x'} dx' = e^{-F x} / F, in ln F as in
+    ``_position_density_third``, all x at once."""
+    x = np.asarray(x, dtype=float)
+    heights = x.ravel()
+
+    def integrand(log_f, owner):
         f = np.exp(log_f)
         z = 1.0 / (12.0 * f)
-        return special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z - f * x) / f
+        return special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z - f * heights[owner, None]) / f
 
     # at x = 0 the integrand decays only as F^(-5/6) in ln F
-    upper = np.log(60.0 / x) if x > 0.0 else np.log(1.0e16)
-    value, _ = integrate.quad(integrand, -8.0, max(upper, 8.0), limit=400, epsabs=0.0, epsrel=1e-11)
-    return value / (4.0 * np.pi)
+    upper = np.maximum(np.log(60.0 / np.where(heights > 0.0, heights, 60.0e-16)), 8.0)
+    values, _ = _adaptive_gauss_kronrod(integrand, np.full(upper.shape, -8.0), upper, 1e-11)
+    return (values / (4.0 * np.pi)).reshape(x.shape)
 
 
 def distribution_table(positions, speeds, restitution):
@@ -643,7 +807,8 @@ def distribution_table(positions, speeds, restitution):
         P(x, v) for every x in ``positions`` and v in ``speeds``, in long format: columns
         ``x``, ``v``, ``pxv``, x varying slowest.
     worst : float
-        The largest relative error quad estimates for a positive finite P(x, v).
+        The largest estimated relative error of a positive finite P(x, v): a point's error
+        estimate (``distribution_with_error``) over its value.
 
     Raises
     ------

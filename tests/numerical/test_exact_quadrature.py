@@ -6,8 +6,11 @@ from fractions import Fraction
 import numpy as np
 import pytest
 from scipy import integrate
+from workflow_support import REPOSITORY
 
 from bouncing_ball import exact
+from bouncing_ball.bins import linear_grid
+from bouncing_ball.workflow.config import read_config
 
 
 @pytest.mark.parametrize(("lo", "hi"), [(0.0, 1.0e-3), (0.1, 0.158), (30.0, 50.0)])
@@ -24,3 +27,27 @@ def test_bin_averaged_speed_squared_at_one_third_agrees_with_nested_quadrature(l
     denominator = integrate.quad(lambda y: float(exact.position_density(y, r)), lo, hi)[0]
     value = exact.speed_squared_given_position_bin_average(np.array([lo]), np.array([hi]), r)
     assert value[0] == pytest.approx(numerator / denominator, rel=1e-8)
+
+
+@pytest.mark.parametrize("r", [Fraction(1, 2), Fraction(1, 3)], ids=str)
+def test_distribution_table_agrees_with_one_point_quad_everywhere(r):
+    """Every x > 0 point of the pipeline's exact P(x, v) table (config.yaml's exact.positions
+    and exact.speeds), all at once by adaptive Gauss-Kronrod, against scipy's quad one point
+    at a time (distribution_by_force_integral): within the sum of the two error estimates and
+    1e-10 relative."""
+    settings = read_config(REPOSITORY / "config" / "config.yaml")["exact"]
+    table, worst = exact.distribution_table(
+        settings["positions"], linear_grid(settings["speeds"]), r
+    )
+    inside = table[table["x"] > 0.0]
+    _, errors = exact.distribution_with_error(inside["x"], inside["v"], r)
+    theirs, their_errors = np.array(
+        [
+            exact.distribution_by_force_integral(x, v, r)
+            for x, v in zip(inside["x"], inside["v"], strict=True)
+        ]
+    ).T
+    values = inside["pxv"].to_numpy()
+    assert np.all(np.abs(values - theirs) <= errors + their_errors)
+    assert np.max(np.abs(values / theirs - 1.0)) < 1e-10
+    assert worst == pytest.approx(np.max(errors / values))

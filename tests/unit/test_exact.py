@@ -127,3 +127,69 @@ def test_bin_average_of_the_outgoing_density(r, lo, hi):
     )
     closed = exact.outgoing_speed_bin_average(np.array([lo]), np.array([hi]), r)[0]
     assert closed == pytest.approx(direct / (0.5 * (hi * hi - lo * lo)), rel=1e-12)
+
+
+def test_gauss_kronrod_rule_is_exact_to_its_degrees():
+    """The 21-point Kronrod rule integrates x^k over [-1, 1] exactly up to k = 31, its embedded
+    10-point Gauss rule up to k = 19 and not at k = 20: the constants are QUADPACK's dqk21."""
+    nodes = exact.KRONROD_NODES
+
+    def moment(k):
+        return 2.0 / (k + 1) if k % 2 == 0 else 0.0
+
+    for k in range(32):
+        assert np.sum(exact.KRONROD_WEIGHTS * nodes**k) == pytest.approx(moment(k), abs=1e-15)
+    for k in range(20):
+        assert np.sum(exact.GAUSS_WEIGHTS * nodes**k) == pytest.approx(moment(k), abs=1e-15)
+    assert abs(np.sum(exact.GAUSS_WEIGHTS * nodes**20) - moment(20)) > 1e-8
+
+
+def test_airy_function_from_bessel_functions_is_scipys():
+    """Ai(z) of the array path of P(x, v), Bessel functions where |z| > 10, against scipy's airy,
+    relative to the envelope |z|^(-1/4) on the oscillating side and to Ai where it decays:
+    within 10 rounding errors of the phase (2/3) |z|^(3/2), which neither can beat."""
+    from scipy import special
+
+    z = np.concatenate([np.linspace(-3000.0, -10.0, 2001), np.linspace(-10.0, 60.0, 701)])
+    ours, theirs = exact._airy_ai(z), special.airy(z)[0]
+    envelope = np.where(z < 0.0, np.maximum(np.abs(z), 1.0) ** -0.25, np.abs(theirs))
+    phase = (2.0 / 3.0) * np.abs(z) ** 1.5
+    assert np.all(np.abs(ours - theirs) <= 10.0 * np.finfo(float).eps * (1.0 + phase) * envelope)
+
+
+# (x, v) where the F integral is smooth (v < 0), turns over (v ~ 0) and oscillates (v > 0,
+# small x: hundreds of periods at x = 0.001, v = 6)
+SAMPLE_POINTS = [(0.001, 6.0), (0.001, 0.5), (0.001, -3.0), (0.01, 4.5), (0.1, -0.05), (2.0, 1.0)]
+
+
+@pytest.mark.parametrize("r", EXACT, ids=str)
+def test_distribution_arrays_agree_with_one_point_quad(r):
+    """P(x, v) for arrays (every point at once, adaptive Gauss-Kronrod) against
+    distribution_by_force_integral (scipy's quad, one point): within the sum of the two error
+    estimates and 1e-10 relative, each estimate below 1e-9 relative."""
+    x, v = np.array(SAMPLE_POINTS).T
+    values, errors = exact.distribution_with_error(x, v, r)
+    theirs, their_errors = np.array(
+        [exact.distribution_by_force_integral(xi, vi, r) for xi, vi in SAMPLE_POINTS]
+    ).T
+    assert np.all(np.abs(values - theirs) <= errors + their_errors)
+    assert np.max(np.abs(values / theirs - 1.0)) < 1e-10
+    assert np.max(errors / values) < 1e-9
+
+
+@pytest.mark.parametrize(
+    ("r", "mean_x", "delta_x"),
+    [
+        (Fraction(1, 2), 6.0, 6.0 * np.sqrt(3.0)),
+        (Fraction(1, 3), 35.0 / 9.0, np.sqrt(4781.0) / 9.0),
+    ],
+    ids=["1/2", "1/3"],
+)
+def test_position_moments_are_the_closed_forms(r, mean_x, delta_x):
+    """<x> and Delta x from the moments of P(x), eq. (P(x)2), each to 1e-12 relative: the
+    closed forms of eq. (xandDeltax) (6, 6 3^(1/2); 35/9, 4781^(1/2)/9), to the moments'
+    tolerance (Delta x^2 = <x^2> - <x>^2 loses a factor <x^2>/Delta x^2 < 1.3 of it)."""
+    moments = exact.position_moments(r)
+    assert moments["normalization"] == pytest.approx(1.0, rel=1e-12)
+    assert moments["mean_x"] == pytest.approx(mean_x, rel=2e-12)
+    assert moments["delta_x"] == pytest.approx(delta_x, rel=2e-12)
