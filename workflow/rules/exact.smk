@@ -9,7 +9,8 @@ rule exact_solution:
         summary="results/exact/r{r}/summary.parquet",
     log:
         "logs/exact/r{r}.log",
-    # started first: the r = 1/3 solution (about 15 s, quadratures) ends the quick look
+    # started with the solver jobs, on the cores the first batch leaves while it compiles the
+    # shard loop (common.smk, batch_priority)
     priority: 10
     conda:
         "../envs/bouncing-ball.yaml"
