@@ -41,6 +41,19 @@ def simulate_batch(restitution: float, seed: int, label: str, shards, settings):
         yield shard, simulate_shard(restitution, shard_seed_sequence(seed, label, shard), settings)
 
 
+def _arrow_array(values: np.ndarray, kind: pa.DataType) -> pa.Array:
+    """``values`` as an Arrow array of ``kind`` (int64, float64 or large_string) made from its
+    buffers: ``pyarrow.array`` would import pandas to look at its argument."""
+    if kind == pa.large_string():
+        encoded = [str(value).encode() for value in values]
+        offsets = np.zeros(len(encoded) + 1, dtype=np.int64)
+        np.cumsum([len(value) for value in encoded], out=offsets[1:])
+        buffers = [None, pa.py_buffer(offsets), pa.py_buffer(b"".join(encoded))]
+    else:
+        buffers = [None, pa.py_buffer(np.ascontiguousarray(values, dtype=kind.to_pandas_dtype()))]
+    return pa.Array.from_buffers(kind, len(values), buffers)
+
+
 def batch_to_table(batch: dict[int, ShardTallies]) -> pa.Table:
     """The table of a batch, ``{shard: tallies}``, in the order of the shards (``BATCH_SCHEMA``)."""
     if not batch:
@@ -52,7 +65,10 @@ def batch_to_table(batch: dict[int, ShardTallies]) -> pa.Table:
         ),
         **{key: np.concatenate([part[key] for part in parts.values()]) for key in COLUMNS},
     }
-    return pa.table(columns, schema=BATCH_SCHEMA)
+    return pa.Table.from_arrays(
+        [_arrow_array(columns[field.name], field.type) for field in BATCH_SCHEMA],
+        schema=BATCH_SCHEMA,
+    )
 
 
 def batch_to_frame(batch: dict[int, ShardTallies]) -> "pd.DataFrame":
