@@ -2,20 +2,14 @@
 of Fig. 6 -> results/solver/time_averages.parquet (I is infinite below r_c)."""
 
 import logging
-import os
 import time
 
-# one BLAS thread, set before numpy loads OpenBLAS: eq. (inteq) is solved at every r of the grid,
-# each a small LU factorisation, between which OpenBLAS's other threads spin; and its last bits
-# differ between one thread and several, so one makes the same table on any machine
-os.environ["OPENBLAS_NUM_THREADS"] = "1"
+import pandas as pd
 
-import pandas as pd  # noqa: E402
-
-from bouncing_ball import solver  # noqa: E402
-from bouncing_ball.bins import linear_grid  # noqa: E402
-from bouncing_ball.workflow.io import write_table  # noqa: E402
-from bouncing_ball.workflow.jobs import job_log  # noqa: E402
+from bouncing_ball import solver
+from bouncing_ball.bins import linear_grid
+from bouncing_ball.workflow.io import write_table
+from bouncing_ball.workflow.jobs import job_log
 
 COLUMNS = [
     "r",
