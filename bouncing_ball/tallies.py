@@ -406,8 +406,9 @@ COLUMNS = ("tally", "lo", "hi", "lo2", "hi2", "value")
 
 
 def tallies_to_columns(tallies: ShardTallies) -> dict:
-    """A shard's tallies as the columns of its long table, the layout of the module's
-    docstring, without pandas (a simulation job writes them as they are).
+    """A shard's tallies as the columns of its long table, without pandas.
+
+    The layout of the module's docstring; a simulation job writes the columns as they are.
 
     Parameters
     ----------
@@ -472,8 +473,7 @@ def _on_bins(values, expected):
 
 
 def tallies_from_columns(columns, settings, source: str = "shard") -> ShardTallies:
-    """A shard's tallies from the columns of its table: the inverse of
-    ``tallies_to_columns``.
+    """A shard's tallies from the columns of its table: the inverse of ``tallies_to_columns``.
 
     Parameters
     ----------
