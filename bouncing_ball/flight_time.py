@@ -143,7 +143,7 @@ import pandas as pd
 from scipy import integrate, special
 
 from .asymptotics import large_speed_decay_rate, large_speed_exponent
-from .kernel import TAIL, TIME_MOMENT_TAU_NODES, return_speed_kernel
+from .kernel import TAIL, TIME_MOMENT_TAU_NODES, return_speed_kernel_matrix
 from .solver import coordinate_of_speed, speed_of_coordinate
 
 __all__ = [
@@ -1366,7 +1366,10 @@ def return_speed_bin_probabilities(
     v_lower, v_upper = np.asarray(v_lower, dtype=float), np.asarray(v_upper, dtype=float)
     lo, hi, owner = _speed_sub_bins(v_lower, v_upper)
     v, v_weights = _log_gauss(lo, hi)  # (n_sub, 16)
-    kernel = return_speed_kernel(v[None, None, :, :], u[:, :, None, None])
+    # G_g(v, u) of every pair as [u-bin, u point, v sub-bin, v point] (the matrix is [v, u]: a
+    # copy of its transpose costs less than broadcasting the pairs)
+    kernel = np.ascontiguousarray(return_speed_kernel_matrix(v.ravel(), u.ravel()).T)
+    kernel = kernel.reshape(*u.shape, *v.shape)
     sub = np.einsum("ab,abcd,cd->ac", flux, kernel, v * v_weights) / flux.sum(axis=1)[:, None]
     cells = np.zeros((flux.shape[0], v_lower.size))
     np.add.at(cells.T, owner, sub.T)

@@ -56,12 +56,15 @@ A shard's tallies round-trip through its table; two shards merge to their sum:
 """
 
 from dataclasses import dataclass, fields, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from .bins import LinearBins, LogBins
 from .settings import RETURN_LAW_SPEED_BINS
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = [
     "HISTOGRAMS",
@@ -79,6 +82,9 @@ __all__ = [
     "tally_seed_sequence",
     "ShardTallies",
     "merge_shards",
+    "COLUMNS",
+    "tallies_to_columns",
+    "tallies_from_columns",
     "tallies_to_frame",
     "tallies_from_frame",
 ]
@@ -395,7 +401,53 @@ def merge_shards(shards) -> ShardTallies:
     return total
 
 
-def tallies_to_frame(tallies: ShardTallies) -> pd.DataFrame:
+#: The columns of a shard's long table, in order (the module's docstring).
+COLUMNS = ("tally", "lo", "hi", "lo2", "hi2", "value")
+
+
+def tallies_to_columns(tallies: ShardTallies) -> dict:
+    """A shard's tallies as the columns of its long table, without pandas.
+
+    The layout of the module's docstring; a simulation job writes the columns as they are.
+
+    Parameters
+    ----------
+    tallies : ShardTallies
+
+    Returns
+    -------
+    dict
+        ``COLUMNS`` -> 1-d numpy.ndarray: ``tally`` the names (object), the rest float64; a
+        row per bin of each histogram (a 2-D one's second variable fastest), then a row per
+        scalar of ``SCALARS``.
+    """
+    names, lo, hi, lo2, hi2, value = [], [], [], [], [], []
+    for name, (bins_attr, values_attr, _) in HISTOGRAMS.items():
+        bins = _bins(tallies, bins_attr)
+        names.append(np.full(bins.n + 2, name, dtype=object))
+        lo.append(bins.lower)
+        hi.append(bins.upper)
+        lo2.append(np.full(bins.n + 2, np.nan))
+        hi2.append(np.full(bins.n + 2, np.nan))
+        value.append(np.asarray(getattr(tallies, values_attr), dtype=float))
+    for name, ((first, second), values_attr, _) in HISTOGRAMS_2D.items():
+        outer, inner = getattr(tallies, first), getattr(tallies, second)
+        n_inner = inner.n + 2
+        names.append(np.full((outer.n + 2) * n_inner, name, dtype=object))
+        lo.append(np.repeat(outer.lower, n_inner))
+        hi.append(np.repeat(outer.upper, n_inner))
+        lo2.append(np.tile(inner.lower, outer.n + 2))
+        hi2.append(np.tile(inner.upper, outer.n + 2))
+        value.append(np.asarray(getattr(tallies, values_attr), dtype=float).ravel())
+    names.append(np.array(SCALARS, dtype=object))
+    for column in (lo, hi, lo2, hi2):
+        column.append(np.full(len(SCALARS), np.nan))
+    value.append(np.array([float(getattr(tallies, s)) for s in SCALARS]))
+    columns = (names, lo, hi, lo2, hi2, value)
+    return {key: np.concatenate(parts) for key, parts in zip(COLUMNS, columns, strict=True)}
+
+
+def tallies_to_frame(tallies: ShardTallies) -> "pd.DataFrame":
     """A shard's tallies as its long table, the layout of the module's docstring.
 
     Parameters
@@ -405,65 +457,92 @@ def tallies_to_frame(tallies: ShardTallies) -> pd.DataFrame:
     Returns
     -------
     pandas.DataFrame
-        Columns ``tally``, ``lo``, ``hi``, ``lo2``, ``hi2``, ``value``: a row per bin of each
-        histogram (a 2-D one's second variable fastest), then a row per scalar of
-        ``SCALARS``.
+        The columns of ``tallies_to_columns``.
 
     Examples
     --------
     See the module's example.
     """
-    parts = []
-    for name, (bins_attr, values_attr, _) in HISTOGRAMS.items():
-        bins = _bins(tallies, bins_attr)
-        parts.append(
-            pd.DataFrame(
-                {
-                    "tally": name,
-                    "lo": bins.lower,
-                    "hi": bins.upper,
-                    "lo2": np.nan,
-                    "hi2": np.nan,
-                    "value": np.asarray(getattr(tallies, values_attr), dtype=float),
-                }
-            )
-        )
-    for name, ((first, second), values_attr, _) in HISTOGRAMS_2D.items():
-        outer, inner = getattr(tallies, first), getattr(tallies, second)
-        n_inner = inner.n + 2
-        parts.append(
-            pd.DataFrame(
-                {
-                    "tally": name,
-                    "lo": np.repeat(outer.lower, n_inner),
-                    "hi": np.repeat(outer.upper, n_inner),
-                    "lo2": np.tile(inner.lower, outer.n + 2),
-                    "hi2": np.tile(inner.upper, outer.n + 2),
-                    "value": np.asarray(getattr(tallies, values_attr), dtype=float).ravel(),
-                }
-            )
-        )
-    parts.append(
-        pd.DataFrame(
-            {
-                "tally": list(SCALARS),
-                "lo": np.nan,
-                "hi": np.nan,
-                "lo2": np.nan,
-                "hi2": np.nan,
-                "value": [float(getattr(tallies, s)) for s in SCALARS],
-            }
-        )
-    )
-    return pd.concat(parts, ignore_index=True)
+    import pandas as pd  # here: a simulation job writes its tallies without pandas
+
+    return pd.DataFrame(tallies_to_columns(tallies))
 
 
-def _on_bins(rows, column, expected):
-    values = rows[column].to_numpy()
+def _on_bins(values, expected):
     return len(values) == len(expected) and np.allclose(values, expected, equal_nan=True)
 
 
-def tallies_from_frame(frame: pd.DataFrame, settings, source: str = "shard") -> ShardTallies:
+def tallies_from_columns(columns, settings, source: str = "shard") -> ShardTallies:
+    """A shard's tallies from the columns of its table: the inverse of ``tallies_to_columns``.
+
+    Parameters
+    ----------
+    columns : mapping
+        ``COLUMNS`` -> 1-d arrays (a dict of arrays, a pandas.DataFrame), the table's rows in
+        their order.
+    settings : settings.ShardSettings
+        Anything with the four bins of ``BINS``; the table's bins must be these.
+    source : str, optional
+        Where the table comes from (a file), named in errors.
+
+    Returns
+    -------
+    ShardTallies
+
+    Raises
+    ------
+    ValueError
+        Naming ``source``, if a column is missing, a tally is not on the bins of ``settings``,
+        or a scalar is missing or repeated.
+    """
+    missing = set(COLUMNS) - set(columns)
+    if missing:
+        raise ValueError(f"{source}: missing columns {sorted(missing)}")
+    lo, lo2, value = (np.asarray(columns[key]) for key in ("lo", "lo2", "value"))
+    # each row's tally as an index of the names: one pass over the strings, then integer masks
+    names = [*HISTOGRAMS, *HISTOGRAMS_2D, *SCALARS]
+    index = {name: k for k, name in enumerate(names)}
+    codes = np.fromiter(
+        (index.get(name, -1) for name in np.asarray(columns["tally"], dtype=object)),
+        dtype=np.int64,
+        count=len(lo),
+    )
+    rows = {name: np.flatnonzero(codes == k) for k, name in enumerate(names)}
+    values = {name: getattr(settings, name) for name in BINS}
+    for name, (bins_attr, values_attr, integer) in HISTOGRAMS.items():
+        selected = rows[name]
+        bins = _bins(settings, bins_attr)
+        if not _on_bins(lo[selected], bins.lower):
+            raise ValueError(
+                f"{source}: tally '{name}' is not on the configured bins "
+                f"({len(selected)} rows, expected {bins.n + 2}); re-run the shard"
+            )
+        column = value[selected]
+        values[values_attr] = column.astype(np.int64) if integer else column
+    for name, ((first, second), values_attr, integer) in HISTOGRAMS_2D.items():
+        selected = rows[name]
+        outer, inner = getattr(settings, first), getattr(settings, second)
+        shape = (outer.n + 2, inner.n + 2)
+        if not (
+            _on_bins(lo[selected], np.repeat(outer.lower, shape[1]))
+            and _on_bins(lo2[selected], np.tile(inner.lower, shape[0]))
+        ):
+            raise ValueError(
+                f"{source}: tally '{name}' is not on the configured bins "
+                f"({len(selected)} rows, expected {shape[0] * shape[1]}); re-run the shard"
+            )
+        column = value[selected].reshape(shape)
+        values[values_attr] = column.astype(np.int64) if integer else column
+    for name in SCALARS:
+        selected = rows[name]
+        if len(selected) != 1:
+            raise ValueError(f"{source}: expected one '{name}' row, found {len(selected)}")
+        scalar = float(value[selected[0]])
+        values[name] = int(scalar) if name in _INTEGER else scalar
+    return ShardTallies(**values)
+
+
+def tallies_from_frame(frame: "pd.DataFrame", settings, source: str = "shard") -> ShardTallies:
     """A shard's tallies from its table: the inverse of ``tallies_to_frame``.
 
     Parameters
@@ -489,38 +568,6 @@ def tallies_from_frame(frame: pd.DataFrame, settings, source: str = "shard") -> 
     --------
     See the module's example.
     """
-    missing = {"tally", "lo", "hi", "lo2", "hi2", "value"} - set(frame.columns)
-    if missing:
-        raise ValueError(f"{source}: missing columns {sorted(missing)}")
-    values = {name: getattr(settings, name) for name in BINS}
-    for name, (bins_attr, values_attr, integer) in HISTOGRAMS.items():
-        rows = frame[frame["tally"] == name]
-        bins = _bins(settings, bins_attr)
-        if not _on_bins(rows, "lo", bins.lower):
-            raise ValueError(
-                f"{source}: tally '{name}' is not on the configured bins "
-                f"({len(rows)} rows, expected {bins.n + 2}); re-run the shard"
-            )
-        column = rows["value"].to_numpy()
-        values[values_attr] = column.astype(np.int64) if integer else column
-    for name, ((first, second), values_attr, integer) in HISTOGRAMS_2D.items():
-        rows = frame[frame["tally"] == name]
-        outer, inner = getattr(settings, first), getattr(settings, second)
-        shape = (outer.n + 2, inner.n + 2)
-        if not (
-            _on_bins(rows, "lo", np.repeat(outer.lower, shape[1]))
-            and _on_bins(rows, "lo2", np.tile(inner.lower, shape[0]))
-        ):
-            raise ValueError(
-                f"{source}: tally '{name}' is not on the configured bins "
-                f"({len(rows)} rows, expected {shape[0] * shape[1]}); re-run the shard"
-            )
-        column = rows["value"].to_numpy().reshape(shape)
-        values[values_attr] = column.astype(np.int64) if integer else column
-    for name in SCALARS:
-        rows = frame.loc[frame["tally"] == name, "value"]
-        if len(rows) != 1:
-            raise ValueError(f"{source}: expected one '{name}' row, found {len(rows)}")
-        value = float(rows.iloc[0])
-        values[name] = int(value) if name in _INTEGER else value
-    return ShardTallies(**values)
+    return tallies_from_columns(
+        {key: frame[key].to_numpy() for key in COLUMNS if key in frame.columns}, settings, source
+    )

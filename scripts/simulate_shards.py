@@ -7,7 +7,7 @@ import time
 
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 from bouncing_ball.settings import ShardSettings
-from bouncing_ball.workflow.batches import batch_to_frame, simulate_batch
+from bouncing_ball.workflow.batches import batch_to_table, simulate_batch
 from bouncing_ball.workflow.io import write_table
 from bouncing_ball.workflow.jobs import job_log
 
@@ -54,7 +54,7 @@ with job_log(snakemake.log[0]):
     # included
     if getattr(snakemake.params, "record_cpu_seconds", False):
         provenance["cpu_seconds"] = cpu_seconds
-    write_table(batch_to_frame(batch), snakemake.output[0], provenance)
+    write_table(batch_to_table(batch), snakemake.output[0], provenance)
     logging.info(
         "r=%s: %d shards (%d-%d) in %.1f s (%.1f CPU s; the first shard includes loading or "
         "compiling the loop)",

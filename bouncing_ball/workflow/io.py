@@ -1,7 +1,9 @@
 """Parquet tables with provenance, written atomically, read with clear errors.
 
 Provenance (r, the rule's parameters, seed, package version) is stored as
-JSON under the key ``bouncing_ball`` of the Parquet key-value metadata.
+JSON under the key ``bouncing_ball`` of the Parquet key-value metadata.  A table is a pandas
+frame or a pyarrow table (a simulation job's batch of shards, written and read without
+pandas).
 """
 
 import json
@@ -10,13 +12,16 @@ import tempfile
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
 from .. import __version__
 from ..restitution import parse_restitution
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 METADATA_KEY = b"bouncing_ball"
 
@@ -73,8 +78,10 @@ def _umask() -> int:
     return mask
 
 
-def _with_provenance(frame: pd.DataFrame, provenance: dict) -> pa.Table:
-    table = pa.Table.from_pandas(frame, preserve_index=False)
+def _with_provenance(frame, provenance: dict) -> pa.Table:
+    table = (
+        frame if isinstance(frame, pa.Table) else pa.Table.from_pandas(frame, preserve_index=False)
+    )
     metadata = dict(table.schema.metadata or {})
     metadata[METADATA_KEY] = json.dumps(
         {"package_version": __version__, **provenance}, sort_keys=True, default=str
@@ -91,8 +98,9 @@ def write_tables(frames: dict, provenance: dict) -> None:
             pq.write_table(table, temporary)
 
 
-def write_table(frame: pd.DataFrame, path, provenance: dict) -> None:
-    """Write ``frame`` to ``path`` with ``provenance``; atomic (temp file, then rename)."""
+def write_table(frame, path, provenance: dict) -> None:
+    """Write ``frame`` (a pandas frame or a pyarrow table) to ``path`` with ``provenance``;
+    atomic (temp file, then rename)."""
     write_tables({path: frame}, provenance)
 
 
@@ -203,32 +211,43 @@ def read_provenance(path) -> dict:
     return _provenance(path, _read_parquet(pq.read_schema, path))
 
 
-def read_table(
+def read_arrow_table(
     path, kind: TableKind | None = None, label: str | None = None
-) -> tuple[pd.DataFrame, dict]:
-    """The frame and provenance of a table written by ``write_table``; with ``kind``,
+) -> tuple[pa.Table, dict]:
+    """The pyarrow table and provenance of a table written by ``write_table``; with ``kind``,
     refused (naming the file) unless that kind's rule wrote it with its columns; with
     ``label``, unless it was made for the r of that label (``restitution_label``)."""
     path = Path(path)
     table = _read_parquet(pq.read_table, path)
-    frame, provenance = table.to_pandas(), _provenance(path, table.schema)
+    provenance = _provenance(path, table.schema)
     if kind is not None:
         if provenance.get("rule") != kind.rule:
             raise UnreadableFileError(
                 f"{path}: not a {kind.name} table: written by rule {provenance.get('rule')}, "
                 f"not {kind.rule}"
             )
-        require_columns(frame, path, kind.columns)
+        require_columns(table, path, kind.columns)
     if label is not None and provenance.get("r_label") != label:
         raise UnreadableFileError(
             f"{path}: made for r = {provenance.get('r_label')}, not r = {label}"
         )
-    return frame, provenance
+    return table, provenance
 
 
-def require_columns(frame: pd.DataFrame, path, columns) -> pd.DataFrame:
-    """``frame`` if it has ``columns``; otherwise an error naming the file and what is missing."""
-    missing = [column for column in columns if column not in frame.columns]
+def read_table(
+    path, kind: TableKind | None = None, label: str | None = None
+) -> tuple["pd.DataFrame", dict]:
+    """``read_arrow_table`` as a pandas frame: the frame and provenance of a table written by
+    ``write_table``, checked as there."""
+    table, provenance = read_arrow_table(path, kind, label)
+    return table.to_pandas(), provenance
+
+
+def require_columns(frame, path, columns):
+    """``frame`` (a pandas frame or a pyarrow table) if it has ``columns``; otherwise an error
+    naming the file and what is missing."""
+    names = frame.column_names if isinstance(frame, pa.Table) else frame.columns
+    missing = [column for column in columns if column not in names]
     if missing:
         raise UnreadableFileError(
             f"{path}: not the expected table, it lacks the columns {', '.join(missing)}"
@@ -236,7 +255,7 @@ def require_columns(frame: pd.DataFrame, path, columns) -> pd.DataFrame:
     return frame
 
 
-def read_tables_of_one_restitution(*paths, kinds=None) -> list[tuple[pd.DataFrame, dict]]:
+def read_tables_of_one_restitution(*paths, kinds=None) -> list[tuple["pd.DataFrame", dict]]:
     """``read_table`` of each path (with its kind of ``kinds``), refused unless all were
     made for the same r (e.g. the simulation, solver and fits one figure panel compares)."""
     kinds = [None] * len(paths) if kinds is None else kinds
@@ -276,7 +295,7 @@ def comparison_panels(solver_paths, simulation_paths, exact_paths, kinds) -> lis
     return panels
 
 
-def write_csv_and_markdown(table: pd.DataFrame, csv_path, markdown_path, markdown: str) -> None:
+def write_csv_and_markdown(table: "pd.DataFrame", csv_path, markdown_path, markdown: str) -> None:
     """A results table as CSV (12 significant digits) and its Markdown rendering, each atomic."""
     with atomic_paths(csv_path, markdown_path) as (csv_temporary, markdown_temporary):
         table.to_csv(csv_temporary, index=False, float_format="%.12g")

@@ -5,8 +5,8 @@ from ..asymptotics import CRITICAL_RESTITUTION
 from ..restitution import parse_restitution
 from ..settings import ShardSettings
 from .audit import differences, stale_message
-from .batches import batch_from_frame
-from .io import UnreadableFileError, read_provenance, read_table
+from .batches import batch_from_table
+from .io import UnreadableFileError, read_arrow_table, read_provenance
 
 
 def _provenance_shards(path, provenance) -> list[int]:
@@ -71,7 +71,7 @@ def read_shards(paths, label, expected: dict | None = None):
         check_batch_provenance(paths, expected)
     shards, provenances, first_file = [], [], {}
     for path in paths:
-        frame, provenance = read_table(path, label=label)
+        table, provenance = read_arrow_table(path, label=label)
         named = _provenance_shards(path, provenance)
         if provenances and any(
             provenance.get(key) != provenances[0].get(key)
@@ -81,8 +81,8 @@ def read_shards(paths, label, expected: dict | None = None):
                 f"{path}: made with other settings than {paths[0]}; rerun the stale batches"
             )
         try:
-            batch = batch_from_frame(
-                frame, ShardSettings.from_mapping(provenance), source=str(path)
+            batch = batch_from_table(
+                table, ShardSettings.from_mapping(provenance), source=str(path)
             )
         except (KeyError, TypeError, ValueError) as error:
             raise UnreadableFileError(f"{path}: malformed batch of shards ({error})") from None

@@ -1,6 +1,9 @@
-"""A job's log: its messages, and the traceback when it fails."""
+"""A job's log: its messages, and the traceback when it fails; what a job imports."""
 
 import logging
+import subprocess
+import sys
+from pathlib import Path
 
 import pandas as pd
 import pytest
@@ -11,6 +14,8 @@ from bouncing_ball.workflow.io import (
     write_table,
 )
 from bouncing_ball.workflow.jobs import job_log
+
+REPOSITORY = Path(__file__).resolve().parents[2]
 
 
 def test_a_failing_job_leaves_its_traceback_in_its_log(tmp_path):
@@ -33,3 +38,46 @@ def test_tables_of_two_r_are_refused_together(tmp_path):
     assert [provenance["r"] for _, provenance in both] == ["1/2", "1/2"]
     with pytest.raises(UnreadableFileError, match="c.parquet"):
         read_tables_of_one_restitution(tmp_path / "a.parquet", tmp_path / "c.parquet")
+
+
+def _modules_after(code: str) -> set[str]:
+    """The modules a fresh interpreter holds after running ``code`` in the repository."""
+    script = f"import sys\n{code}\nprint(' '.join(sys.modules))"
+    result = subprocess.run(
+        [sys.executable, "-c", script],
+        cwd=REPOSITORY,
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    return set(result.stdout.split())
+
+
+def test_a_simulation_job_writes_its_batch_without_importing_pandas(tmp_path):
+    # what scripts/simulate_shards.py imports and does after its loop, on one empty shard
+    code = f"""
+from bouncing_ball.bins import LogBins
+from bouncing_ball.restitution import parse_restitution, restitution_label
+from bouncing_ball.settings import ShardSettings
+from bouncing_ball.tallies import ShardTallies
+from bouncing_ball.workflow.batches import batch_to_table
+from bouncing_ball.workflow.io import write_table
+from bouncing_ball.workflow.jobs import job_log
+settings = ShardSettings(
+    shard_time=1.0, equilibration_time=0.0, criterion_c=5, min_step_divisor=10,
+    max_steps=100, speed_bins=LogBins(0.1, 10.0, 1),
+)
+shard = ShardTallies.from_loop(settings, ShardTallies.loop_arrays(settings))
+write_table(batch_to_table({{0: shard}}), {str(tmp_path / "batch.parquet")!r}, {{"r": "1/2"}})
+"""
+    assert "pandas" not in _modules_after(code)
+
+
+def test_a_merge_job_does_not_import_scipy_stats():
+    # the modules scripts/merge_shards.py imports
+    code = (
+        "import bouncing_ball.equilibration, bouncing_ball.histograms, "
+        "bouncing_ball.workflow.shards, bouncing_ball.workflow.io"
+    )
+    modules = _modules_after(code)
+    assert "scipy.special" in modules and "scipy.stats" not in modules
