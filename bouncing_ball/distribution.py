@@ -393,6 +393,44 @@ def _airy_oscillating(z):
     return out
 
 
+def airy_ai(z):
+    """Ai(z) for real z, from Bessel functions where |z| > 10 (scipy evaluates them several
+    times faster there than its airy).
+
+    scipy's airy where |z| <= 10; (z / 3)^(1/2) K_1/3(zeta) / pi (DLMF 9.6.1) above,
+    (t^(1/2) / 2) (J_1/3(zeta) - Y_1/3(zeta) / 3^(1/2)) at z = -t below (DLMF 9.6.6 with
+    10.4.7), zeta = (2/3) |z|^(3/2), J and Y from one Hankel function.  Where the Airy
+    function oscillates, neither this nor scipy's airy can beat a few rounding errors of the
+    phase zeta.
+
+    Parameters
+    ----------
+    z : array_like
+        Real arguments.
+
+    Returns
+    -------
+    numpy.ndarray
+        Ai(z), the shape of ``z``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from scipy import special
+    >>> from bouncing_ball.distribution import airy_ai
+    >>> z = np.array([-50.0, -1.0, 0.0, 2.0, 30.0])
+    >>> bool(np.allclose(airy_ai(z), special.airy(z)[0], rtol=1e-12, atol=0.0))
+    True
+    """
+    z = np.asarray(z, dtype=float)
+    out = np.empty(z.shape)
+    middle, below, above = np.abs(z) <= 10.0, z < -10.0, z > 10.0
+    out[middle] = special.airy(z[middle])[0]
+    out[below] = _airy_oscillating(-z[below])
+    out[above] = _airy_scaled(z[above]) * np.exp(-(2.0 / 3.0) * z[above] ** 1.5)
+    return out
+
+
 def _log_psi(force, v):
     """ln psi_F(v) of eq. (psi) where its argument F^(1/3) v + F^(-2/3)/4 is >= 0 (psi > 0 there)."""
     argument = force ** (1.0 / 3.0) * v + 0.25 * force ** (-2.0 / 3.0)

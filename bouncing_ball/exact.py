@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 from scipy import integrate, special
 
-from .distribution import check_force_integral_point
+from .distribution import airy_ai, check_force_integral_point
 from .restitution import EXACT_RESTITUTIONS, parse_restitution
 
 __all__ = [
@@ -611,22 +611,6 @@ def distribution_by_force_integral(x, v, restitution):
     return value, error
 
 
-def _airy_ai(z):
-    """Ai(z) for real z: scipy's airy where |z| <= 10, and outside from Bessel functions, which
-    scipy evaluates several times faster there: (z / 3)^(1/2) K_1/3(zeta) / pi (DLMF 9.6.1) and
-    Ai(-t) = (t^(1/2) / 2) (J_1/3(zeta) - Y_1/3(zeta) / 3^(1/2)) (DLMF 9.6.6 with 10.4.7),
-    zeta = (2/3) |z|^(3/2), J and Y from one Hankel function."""
-    out = np.empty(z.shape)
-    middle, below, above = np.abs(z) <= 10.0, z < -10.0, z > 10.0
-    out[middle] = special.airy(z[middle])[0]
-    t = -z[below]
-    hankel = special.hankel1(1.0 / 3.0, (2.0 / 3.0) * t**1.5)
-    out[below] = 0.5 * np.sqrt(t) * (hankel.real - hankel.imag / np.sqrt(3.0))
-    s = z[above]
-    out[above] = np.sqrt(s / 3.0) * special.kv(1.0 / 3.0, (2.0 / 3.0) * s**1.5) / np.pi
-    return out
-
-
 def _force_integrals(x, v, restitution):
     """P(x, v) at the points x > 0 (1-d arrays x, v), eqs. (fpsol), (psi), (weightfunc2): the
     integrand of ``distribution_by_force_integral`` on the same range of ln F, all points at
@@ -642,7 +626,7 @@ def _force_integrals(x, v, restitution):
         key = log_force[:, 0] + 1j * log_force[:, -1]
         _, first, shared = np.unique(key, return_index=True, return_inverse=True)
         weight = weight_function(f[first], restitution)[shared.ravel()]
-        return np.exp(-0.5 * vi - f * xi) * weight * f ** (5.0 / 6.0) * _airy_ai(argument)
+        return np.exp(-0.5 * vi - f * xi) * weight * f ** (5.0 / 6.0) * airy_ai(argument)
 
     if x.size == 0:
         return np.empty(0), np.empty(0)

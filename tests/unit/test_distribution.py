@@ -236,3 +236,15 @@ def test_slack_sums_meet_their_accuracy(r, built):
         density, v, *rules, distribution._TAU_LIMITS, slack=distribution.LARGEST_SLACK
     )
     assert np.max(np.abs(loose - full) / np.maximum(np.abs(full), 1e-16 * magnitude)) < 1e-4
+
+
+def test_airy_function_from_bessel_functions_is_scipys():
+    """airy_ai (Bessel functions where |z| > 10) against scipy's airy, relative to the envelope |z|^(-1/4) on the oscillating side and to Ai where it decays:
+    within 10 rounding errors of the phase (2/3) |z|^(3/2), which neither can beat."""
+    from scipy import special
+
+    z = np.concatenate([np.linspace(-3000.0, -10.0, 2001), np.linspace(-10.0, 60.0, 701)])
+    ours, theirs = distribution.airy_ai(z), special.airy(z)[0]
+    envelope = np.where(z < 0.0, np.maximum(np.abs(z), 1.0) ** -0.25, np.abs(theirs))
+    phase = (2.0 / 3.0) * np.abs(z) ** 1.5
+    assert np.all(np.abs(ours - theirs) <= 10.0 * np.finfo(float).eps * (1.0 + phase) * envelope)

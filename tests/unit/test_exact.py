@@ -144,19 +144,6 @@ def test_gauss_kronrod_rule_is_exact_to_its_degrees():
     assert abs(np.sum(exact.GAUSS_WEIGHTS * nodes**20) - moment(20)) > 1e-8
 
 
-def test_airy_function_from_bessel_functions_is_scipys():
-    """Ai(z) of the array path of P(x, v), Bessel functions where |z| > 10, against scipy's airy,
-    relative to the envelope |z|^(-1/4) on the oscillating side and to Ai where it decays:
-    within 10 rounding errors of the phase (2/3) |z|^(3/2), which neither can beat."""
-    from scipy import special
-
-    z = np.concatenate([np.linspace(-3000.0, -10.0, 2001), np.linspace(-10.0, 60.0, 701)])
-    ours, theirs = exact._airy_ai(z), special.airy(z)[0]
-    envelope = np.where(z < 0.0, np.maximum(np.abs(z), 1.0) ** -0.25, np.abs(theirs))
-    phase = (2.0 / 3.0) * np.abs(z) ** 1.5
-    assert np.all(np.abs(ours - theirs) <= 10.0 * np.finfo(float).eps * (1.0 + phase) * envelope)
-
-
 # (x, v) where the F integral is smooth (v < 0), turns over (v ~ 0) and oscillates (v > 0,
 # small x: hundreds of periods at x = 0.001, v = 6)
 SAMPLE_POINTS = [(0.001, 6.0), (0.001, 0.5), (0.001, -3.0), (0.01, 4.5), (0.1, -0.05), (2.0, 1.0)]
