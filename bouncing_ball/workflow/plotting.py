@@ -13,6 +13,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
 from .. import __version__  # noqa: E402
@@ -65,6 +66,26 @@ def _styled(function):
     return wrapper
 
 
+def _laid_out_bounding_box(figure, dpi):
+    """Lay the figure out at ``dpi`` (its layout engine, which is then removed) and return
+    the box ``savefig(bbox_inches="tight")`` crops to, in inches.
+
+    One Agg renderer serves the layout and the box, so text is measured once; without a
+    layout engine, ``savefig`` draws the figure once per format, with no layout draw first.
+    """
+    canvas = FigureCanvasAgg(figure)
+    shown_dpi = figure.dpi
+    figure.set_dpi(dpi)
+    try:
+        if figure.get_layout_engine() is not None:
+            figure.get_layout_engine().execute(figure)
+        figure.set_layout_engine(None)
+        pad = matplotlib.rcParams["savefig.pad_inches"]
+        return figure.get_tightbbox(canvas.get_renderer()).padded(pad)
+    finally:
+        figure.set_dpi(shown_dpi)
+
+
 def save_figure(figure, pdf, png, dpi, provenance: dict) -> None:
     """Write the figure as PDF and PNG, atomically and together (temporary names, renamed
     when both are complete: ``io.atomic_paths``).
@@ -84,11 +105,11 @@ def save_figure(figure, pdf, png, dpi, provenance: dict) -> None:
         {"Software": f"bouncing_ball {__version__}", "Description": description},
     )
     with atomic_paths(pdf, png) as (pdf_temporary, png_temporary), matplotlib.rc_context(STYLE):
-        figure.savefig(png_temporary, metadata=png_metadata, dpi=dpi)
-        # laid out by now: the PDF keeps that layout instead of computing it again (a sixth
-        # of the figure's time)
-        figure.set_layout_engine("none")
-        figure.savefig(pdf_temporary, metadata=pdf_metadata)
+        # laid out and cropped once, at the PNG's resolution: both formats keep that layout
+        # and that box (the PDF's page is the PNG's, to a pixel)
+        crop = _laid_out_bounding_box(figure, dpi)
+        figure.savefig(png_temporary, metadata=png_metadata, dpi=dpi, bbox_inches=crop)
+        figure.savefig(pdf_temporary, metadata=pdf_metadata, bbox_inches=crop)
     logging.info("wrote %s and %s", pdf, png)
 
 
