@@ -48,6 +48,16 @@ def restitution_text(value) -> str:
     return rf"$r = {float(value):.6g}$"
 
 
+def panel_title(axis, text):
+    """A panel's title, at the top of the axes.
+
+    Placed there rather than by matplotlib's automatic placement, which looks for tick labels
+    above the axes (there are none: the ticks point inward, labelled below and left) and
+    measures the y axis again at every draw.
+    """
+    axis.set_title(text, fontsize=10, y=1.0)
+
+
 def new_figure(rows=1, columns=1, width=6.4, height=4.0, **subplots):
     with matplotlib.rc_context(STYLE):
         figure = Figure(figsize=(width, height), layout="constrained")
@@ -227,7 +237,7 @@ def exact_distribution_figure(panels):
         axis.set_ylim(0.0, top)
         axis.set_xlim(distribution.v.min(), distribution.v.max())
         axis.set_xlabel(r"$v$")
-        axis.set_title(restitution_text(restitution), fontsize=10)
+        panel_title(axis, restitution_text(restitution))
         axis.legend(loc="upper right")
     axes[0, 0].set_ylabel(r"$P(x, v)$")
     return figure
@@ -253,7 +263,7 @@ def _finish_outgoing_speed_panel(axis, bins, restitution):
     positive = bins.p0v[bins.p0v > 0]
     axis.set_ylim(positive.min() / 5, positive.max() * 5)
     axis.set_xlabel(r"$v$")
-    axis.set_title(restitution_text(restitution), fontsize=10)
+    panel_title(axis, restitution_text(restitution))
     axis.legend(loc="lower left")
 
 
@@ -493,7 +503,7 @@ def joint_distribution_figure(panels):
         axis.set_xlim(solver.v.min(), solver.v.max())
         axis.set_xlabel(r"$v$")
         axis.set_ylabel(r"$P(x, v)$")
-        axis.set_title(restitution_text(panel["restitution"]), fontsize=10)
+        panel_title(axis, restitution_text(panel["restitution"]))
         axis.legend(loc="upper right")
     return figure
 
@@ -538,7 +548,7 @@ def position_density_figure(panels):
             axis.set_xlim(bins.x_lo.min(), bins.x_hi.max())
         axis.set_xlabel(r"$x$")
         axis.set_ylabel(r"$P(x)$")
-        axis.set_title(restitution_text(panel["restitution"]), fontsize=10)
+        panel_title(axis, restitution_text(panel["restitution"]))
         axis.legend(loc="lower left")
     return figure
 
@@ -601,7 +611,7 @@ def flight_time_figure(panels):
             axis.set_ylim(max(shown.min() / 10, shown.max() * 1e-20), shown.max() * 5)
         axis.set_xlabel(r"$T$")
         axis.set_ylabel(r"$\rho(T)$" if per_flight else r"$\nu(T)$")
-        axis.set_title(restitution_text(panel["restitution"]), fontsize=10)
+        panel_title(axis, restitution_text(panel["restitution"]))
         axis.legend(loc="lower left")
     return figure
 
@@ -643,7 +653,7 @@ def return_speed_figure(panels, outgoing_speeds):
             )
             if len(row):
                 u_lo, u_hi = float(row.u_lo.iloc[0]), float(row.u_hi.iloc[0])
-                axis.set_title(rf"${u_lo:.3g} \leq u < {u_hi:.3g}$", fontsize=10)
+                panel_title(axis, rf"${u_lo:.3g} \leq u < {u_hi:.3g}$")
         axis.set_xscale("log")
         axis.set_yscale("log")
         # four decades below the peak: where the law and the data can be told apart

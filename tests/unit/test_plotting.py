@@ -135,3 +135,15 @@ def test_figures_are_laid_out_once_and_drawn_once_per_format(exponents, tmp_path
     width, height = float(page[1]), float(page[2])  # points, 72 per inch
     assert width == pytest.approx(written.shape[1] * 72 / 60, abs=72 / 60)
     assert height == pytest.approx(written.shape[0] * 72 / 60, abs=72 / 60)
+
+
+def test_panel_titles_sit_where_matplotlib_would_place_them():
+    figure, axes = plotting.new_figure(1, 2)
+    for axis in axes[0]:
+        axis.loglog([1e-3, 1e3], [1e-8, 10.0])
+    plotting.panel_title(axes[0, 0], "$r = 1/3$")
+    with matplotlib.rc_context(plotting.STYLE):
+        axes[0, 1].set_title("$r = 1/3$", fontsize=10)  # placed automatically
+        figure.draw_without_rendering()
+    placed, automatic = (axis.title.get_window_extent().bounds for axis in axes[0])
+    assert placed[1:] == pytest.approx(automatic[1:], abs=1e-9)  # same height and size
