@@ -87,8 +87,9 @@ def _laid_out_bounding_box(figure, dpi):
     """Lay the figure out at ``dpi`` (its layout engine, which is then removed) and return
     the box ``savefig(bbox_inches="tight")`` crops to, in inches.
 
-    One Agg renderer serves the layout and the box, so text is measured once; without a
-    layout engine, ``savefig`` draws the figure once per format, with no layout draw first.
+    The layout and the box share one Agg renderer (and its text measurements); without a
+    layout engine, ``savefig`` draws the figure once per format, with no draw to find the
+    layout or the box first.
     """
     canvas = FigureCanvasAgg(figure)
     shown_dpi = figure.dpi
