@@ -10,9 +10,10 @@ from fractions import Fraction
 import numpy as np
 import pandas as pd
 
-from . import exact
-from .fits import LARGE_SPEED, SMALL_SPEED, bin_averages_of_curve, usable_curve
-from .histograms import outgoing_speed_density
+from .restitution import EXACT_RESTITUTIONS
+
+# exact, fits and histograms (scipy, numba) are imported by the functions that use them: the
+# moments and position tables need none of them
 
 __all__ = [
     "moment_rows",
@@ -237,6 +238,8 @@ def outgoing_speed_residuals(simulated: pd.DataFrame, solver_curve: pd.DataFrame
         Columns v, v_lo, v_hi, residual, count, reference (the solver's bin average) and bin
         (the bin's position in ``simulated``).
     """
+    from .fits import bin_averages_of_curve, usable_curve
+
     speeds, density = usable_curve(solver_curve.v.to_numpy(), solver_curve.p0v.to_numpy())
     inside = (
         (simulated.v_lo >= speeds[0])
@@ -278,6 +281,8 @@ def exact_outgoing_speed_residuals(simulated: pd.DataFrame, restitution) -> pd.D
         Columns v, residual, reference (the exact bin average) and bin (the bin's position in
         ``simulated``).
     """
+    from . import exact
+
     usable = (
         (simulated.v_lo > 0.0)
         & np.isfinite(simulated.v_hi)
@@ -335,7 +340,6 @@ VALIDATION_CHECKS = {
 QUALITY_SPEEDS = (0.01, 5.0)
 # the heights over which P(x) and <v^2>_x are held against eqs. (P(x)2), (moment2)
 POSITION_RANGE = (1.0e-3, 50.0)
-FIT_SIDES = (SMALL_SPEED, LARGE_SPEED)
 
 
 # the sign-flip test of the chi^2/n rows: this many random flips, from a fixed seed, so that
@@ -458,6 +462,8 @@ def shard_ratios(shards) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         the x bin over the time times the bin's width; ``v2_given_x``, the integral of
         v^2 dt in the bin over the time spent there (eq. (moment2)).
     """
+    from .histograms import outgoing_speed_density
+
     speeds, heights = shards[0].speed_bins, shards[0].position_bins
     times = np.array([s.time for s in shards], dtype=float)[:, None]
     in_bin = np.stack([s.position_time for s in shards])
@@ -589,7 +595,7 @@ def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None, per
 
 def _outgoing_speed_rows(quantity, simulated, restitution, shards, solver_curve, per_shard):
     """The rows of ``outgoing_speed_checks`` of the table's p0v, p0v_err, named ``quantity``."""
-    if Fraction(restitution) in exact.EXACT_RESTITUTIONS:
+    if Fraction(restitution) in EXACT_RESTITUTIONS:
         reference = "exact"
         residuals = exact_outgoing_speed_residuals(simulated, restitution)
     else:
@@ -655,8 +661,10 @@ def position_checks(position, restitution, shards, per_shard=None):
         worst z over the bins inside 1e-3 <= x <= 50 that have an error, for P(x) and for
         <v^2>_x; no rows for another r (no exact P(x) there).
     """
-    if Fraction(restitution) not in exact.EXACT_RESTITUTIONS:
+    if Fraction(restitution) not in EXACT_RESTITUTIONS:
         return []
+    from . import exact
+
     low, high = POSITION_RANGE
     inside = (
         (position.x_lo >= low * (1.0 - 1e-9))
@@ -702,9 +710,11 @@ def fit_checks(fits):
     list of dict
         Two rows per window, without r; a window without a usable fit gives NaN values.
     """
+    from .fits import LARGE_SPEED, SMALL_SPEED
+
     chosen = fits[(fits.source == "simulation") & (fits.fit == "free_exponents")]
     rows = []
-    for side in FIT_SIDES:
+    for side in (SMALL_SPEED, LARGE_SPEED):
         window = chosen[chosen.window == side]
         if window.empty:
             continue

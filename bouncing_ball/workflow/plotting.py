@@ -13,6 +13,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
 from .. import __version__  # noqa: E402
@@ -47,6 +48,23 @@ def restitution_text(value) -> str:
     return rf"$r = {float(value):.6g}$"
 
 
+def panel_title(axis, text):
+    """Give a panel its title, at the top of its axes.
+
+    Placed there rather than by matplotlib's automatic placement, which looks for tick labels
+    above the axes (there are none: the ticks point inward, labelled below and left) and
+    measures the y axis again at every draw and layout pass.
+
+    Parameters
+    ----------
+    axis : matplotlib.axes.Axes
+        The panel.
+    text : str
+        The title (mathtext allowed), drawn at 10 points.
+    """
+    axis.set_title(text, fontsize=10, y=1.0)
+
+
 def new_figure(rows=1, columns=1, width=6.4, height=4.0, **subplots):
     with matplotlib.rc_context(STYLE):
         figure = Figure(figsize=(width, height), layout="constrained")
@@ -63,6 +81,27 @@ def _styled(function):
 
     wrapper.__doc__, wrapper.__name__ = function.__doc__, function.__name__
     return wrapper
+
+
+def _laid_out_bounding_box(figure, dpi):
+    """Lay the figure out at ``dpi`` (its layout engine, which is then removed) and return
+    the box ``savefig(bbox_inches="tight")`` crops to, in inches.
+
+    The layout and the box share one Agg renderer (and its text measurements); without a
+    layout engine, ``savefig`` draws the figure once per format, with no draw to find the
+    layout or the box first.
+    """
+    canvas = FigureCanvasAgg(figure)
+    shown_dpi = figure.dpi
+    figure.set_dpi(dpi)
+    try:
+        if figure.get_layout_engine() is not None:
+            figure.get_layout_engine().execute(figure)
+        figure.set_layout_engine(None)
+        pad = matplotlib.rcParams["savefig.pad_inches"]
+        return figure.get_tightbbox(canvas.get_renderer()).padded(pad)
+    finally:
+        figure.set_dpi(shown_dpi)
 
 
 def save_figure(figure, pdf, png, dpi, provenance: dict) -> None:
@@ -84,11 +123,11 @@ def save_figure(figure, pdf, png, dpi, provenance: dict) -> None:
         {"Software": f"bouncing_ball {__version__}", "Description": description},
     )
     with atomic_paths(pdf, png) as (pdf_temporary, png_temporary), matplotlib.rc_context(STYLE):
-        figure.savefig(png_temporary, metadata=png_metadata, dpi=dpi)
-        # laid out by now: the PDF keeps that layout instead of computing it again (a sixth
-        # of the figure's time)
-        figure.set_layout_engine("none")
-        figure.savefig(pdf_temporary, metadata=pdf_metadata)
+        # laid out and cropped once, at the PNG's resolution: both formats keep that layout
+        # and that box (the PDF's page is the PNG's, to a pixel)
+        crop = _laid_out_bounding_box(figure, dpi)
+        figure.savefig(png_temporary, metadata=png_metadata, dpi=dpi, bbox_inches=crop)
+        figure.savefig(pdf_temporary, metadata=pdf_metadata, bbox_inches=crop)
     logging.info("wrote %s and %s", pdf, png)
 
 
@@ -206,7 +245,7 @@ def exact_distribution_figure(panels):
         axis.set_ylim(0.0, top)
         axis.set_xlim(distribution.v.min(), distribution.v.max())
         axis.set_xlabel(r"$v$")
-        axis.set_title(restitution_text(restitution), fontsize=10)
+        panel_title(axis, restitution_text(restitution))
         axis.legend(loc="upper right")
     axes[0, 0].set_ylabel(r"$P(x, v)$")
     return figure
@@ -232,7 +271,7 @@ def _finish_outgoing_speed_panel(axis, bins, restitution):
     positive = bins.p0v[bins.p0v > 0]
     axis.set_ylim(positive.min() / 5, positive.max() * 5)
     axis.set_xlabel(r"$v$")
-    axis.set_title(restitution_text(restitution), fontsize=10)
+    panel_title(axis, restitution_text(restitution))
     axis.legend(loc="lower left")
 
 
@@ -472,7 +511,7 @@ def joint_distribution_figure(panels):
         axis.set_xlim(solver.v.min(), solver.v.max())
         axis.set_xlabel(r"$v$")
         axis.set_ylabel(r"$P(x, v)$")
-        axis.set_title(restitution_text(panel["restitution"]), fontsize=10)
+        panel_title(axis, restitution_text(panel["restitution"]))
         axis.legend(loc="upper right")
     return figure
 
@@ -517,7 +556,7 @@ def position_density_figure(panels):
             axis.set_xlim(bins.x_lo.min(), bins.x_hi.max())
         axis.set_xlabel(r"$x$")
         axis.set_ylabel(r"$P(x)$")
-        axis.set_title(restitution_text(panel["restitution"]), fontsize=10)
+        panel_title(axis, restitution_text(panel["restitution"]))
         axis.legend(loc="lower left")
     return figure
 
@@ -580,7 +619,7 @@ def flight_time_figure(panels):
             axis.set_ylim(max(shown.min() / 10, shown.max() * 1e-20), shown.max() * 5)
         axis.set_xlabel(r"$T$")
         axis.set_ylabel(r"$\rho(T)$" if per_flight else r"$\nu(T)$")
-        axis.set_title(restitution_text(panel["restitution"]), fontsize=10)
+        panel_title(axis, restitution_text(panel["restitution"]))
         axis.legend(loc="lower left")
     return figure
 
@@ -622,7 +661,7 @@ def return_speed_figure(panels, outgoing_speeds):
             )
             if len(row):
                 u_lo, u_hi = float(row.u_lo.iloc[0]), float(row.u_hi.iloc[0])
-                axis.set_title(rf"${u_lo:.3g} \leq u < {u_hi:.3g}$", fontsize=10)
+                panel_title(axis, rf"${u_lo:.3g} \leq u < {u_hi:.3g}$")
         axis.set_xscale("log")
         axis.set_yscale("log")
         # four decades below the peak: where the law and the data can be told apart

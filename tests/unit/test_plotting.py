@@ -1,10 +1,14 @@
 """The figures: what each one shows, and that they are written whole or not at all."""
 
+import re
 from fractions import Fraction
 
+import matplotlib
 import numpy as np
 import pandas as pd
 import pytest
+from matplotlib.figure import Figure
+from PIL import Image
 
 from bouncing_ball import exact
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION, exponents_table
@@ -111,3 +115,35 @@ def test_figures_are_written_reproducibly_and_atomically(exponents, tmp_path):
     with pytest.raises(RuntimeError, match="disk full"):
         plotting.save_figure(figure, tmp_path / "new.pdf", tmp_path / "new.png", 60, {})
     assert sorted(path.name for path in tmp_path.iterdir()) == ["fig2.pdf", "fig2.png"]
+
+
+def test_figures_are_laid_out_once_and_drawn_once_per_format(exponents, tmp_path, monkeypatch):
+    """The PNG is the one savefig(bbox_inches="tight") writes, the PDF's page is the PNG's
+    box, and the figure is drawn twice in all (no layout draw, no second layout)."""
+    with matplotlib.rc_context(plotting.STYLE):
+        reference = tmp_path / "reference.png"
+        plotting.decay_rate_figure(exponents).savefig(reference, dpi=60)
+    draws = []
+    draw = Figure.draw
+    monkeypatch.setattr(Figure, "draw", lambda self, renderer: draws.append(draw(self, renderer)))
+    pdf, png = tmp_path / "fig2.pdf", tmp_path / "fig2.png"
+    plotting.save_figure(plotting.decay_rate_figure(exponents), pdf, png, 60, {"figure": "fig2"})
+    assert len(draws) == 2
+    written = np.asarray(Image.open(png))
+    assert np.array_equal(written, np.asarray(Image.open(reference)))
+    page = re.search(rb"/MediaBox \[ 0 0 ([0-9.]+) ([0-9.]+) \]", pdf.read_bytes())
+    width, height = float(page[1]), float(page[2])  # points, 72 per inch
+    assert width == pytest.approx(written.shape[1] * 72 / 60, abs=72 / 60)
+    assert height == pytest.approx(written.shape[0] * 72 / 60, abs=72 / 60)
+
+
+def test_panel_titles_sit_where_matplotlib_would_place_them():
+    figure, axes = plotting.new_figure(1, 2)
+    for axis in axes[0]:
+        axis.loglog([1e-3, 1e3], [1e-8, 10.0])
+    plotting.panel_title(axes[0, 0], "$r = 1/3$")
+    with matplotlib.rc_context(plotting.STYLE):
+        axes[0, 1].set_title("$r = 1/3$", fontsize=10)  # placed automatically
+        figure.draw_without_rendering()
+    placed, automatic = (axis.title.get_window_extent().bounds for axis in axes[0])
+    assert placed[1:] == pytest.approx(automatic[1:], abs=1e-9)  # same height and size
