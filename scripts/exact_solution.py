@@ -11,7 +11,7 @@ from bouncing_ball.restitution import exact_string, parse_restitution, restituti
 from bouncing_ball.workflow.io import write_tables
 from bouncing_ball.workflow.jobs import job_log
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     settings, outputs = snakemake.params.settings, snakemake.output
     value = parse_restitution(snakemake.params.restitution)
     label = restitution_label(value)

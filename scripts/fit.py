@@ -12,7 +12,7 @@ from bouncing_ball.workflow.io import SOLVER_P0V, UnreadableFileError, read_tabl
 from bouncing_ball.workflow.jobs import job_log
 from bouncing_ball.workflow.shards import read_shards
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     settings = snakemake.params.settings
     value = parse_restitution(snakemake.params.restitution)
     label, r = restitution_label(value), float(value)

@@ -21,7 +21,7 @@ from bouncing_ball.workflow.io import write_tables
 from bouncing_ball.workflow.jobs import job_log
 from bouncing_ball.workflow.shards import read_shards
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     exact = parse_restitution(snakemake.params.restitution)
     label = restitution_label(exact)
     shards, provenances = read_shards(list(snakemake.input), label, snakemake.params.batch)

@@ -17,7 +17,7 @@ from bouncing_ball.workflow.io import (
 )
 from bouncing_ball.workflow.jobs import job_log
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     exact = {}
     for path in snakemake.input.exact:
         summary, provenance = read_table(path, EXACT_SUMMARY)

@@ -6,7 +6,7 @@ from bouncing_ball.comparison import position_asymptotics_markdown, position_asy
 from bouncing_ball.workflow.io import SOLVER_SUMMARY, read_table, write_csv_and_markdown
 from bouncing_ball.workflow.jobs import job_log
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     summaries = []
     for path, label in zip(snakemake.input, snakemake.params.labels, strict=True):
         summary, _ = read_table(path, SOLVER_SUMMARY, label=label)

@@ -11,7 +11,7 @@ from bouncing_ball.workflow.batches import batch_to_table, simulate_batch
 from bouncing_ball.workflow.io import write_table
 from bouncing_ball.workflow.jobs import job_log
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     exact = parse_restitution(snakemake.params.restitution)
     label = restitution_label(exact)
     shards, seed = list(snakemake.params.shards), snakemake.params.seed

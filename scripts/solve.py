@@ -17,7 +17,7 @@ from bouncing_ball.restitution import exact_string, parse_restitution
 from bouncing_ball.workflow.io import write_tables
 from bouncing_ball.workflow.jobs import job_log
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     settings = snakemake.params.settings
     exact = parse_restitution(snakemake.params.restitution)
     started = time.perf_counter()

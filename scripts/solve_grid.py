@@ -20,7 +20,7 @@ COLUMNS = [
     "energy_balance_residual",
 ]
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     grid, step = snakemake.params.grid, snakemake.params.step
     started = time.perf_counter()
     rows = [

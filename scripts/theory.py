@@ -8,7 +8,7 @@ from bouncing_ball.bins import linear_grid
 from bouncing_ball.workflow.io import write_table
 from bouncing_ball.workflow.jobs import job_log
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     grid = snakemake.params.grid
     table = exponents_table(linear_grid(grid))
     provenance = {

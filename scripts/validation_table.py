@@ -25,7 +25,7 @@ from bouncing_ball.workflow.io import (
 from bouncing_ball.workflow.jobs import job_log
 from bouncing_ball.workflow.shards import read_shards
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     rows = []
     inputs = zip(
         snakemake.input.p0v,

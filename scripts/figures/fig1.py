@@ -5,7 +5,7 @@ from bouncing_ball.workflow import plotting
 from bouncing_ball.workflow.io import EXPONENTS, read_table
 from bouncing_ball.workflow.jobs import job_log
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     exponents, _ = read_table(snakemake.input.exponents, EXPONENTS)
     figure = plotting.exponents_figure(exponents, CRITICAL_RESTITUTION)
     plotting.save_figure(

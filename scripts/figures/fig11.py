@@ -11,7 +11,7 @@ from bouncing_ball.workflow.io import (
 )
 from bouncing_ball.workflow.jobs import job_log
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     panels = []
     for paths in zip(snakemake.input.solver, snakemake.input.simulation, strict=True):
         (solved, provenance), (simulated, _) = read_tables_of_one_restitution(

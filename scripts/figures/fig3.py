@@ -6,7 +6,7 @@ from bouncing_ball.workflow import plotting
 from bouncing_ball.workflow.io import EXACT_DISTRIBUTION, read_table
 from bouncing_ball.workflow.jobs import job_log
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     panels = []
     for path in snakemake.input.distributions:
         distribution, provenance = read_table(path, EXACT_DISTRIBUTION)

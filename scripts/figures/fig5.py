@@ -6,7 +6,7 @@ from bouncing_ball.workflow import plotting
 from bouncing_ball.workflow.io import EXACT_P0V, SIMULATED_P0V, read_tables_of_one_restitution
 from bouncing_ball.workflow.jobs import job_log
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     panels = []
     for paths in zip(snakemake.input.simulation, snakemake.input.exact, strict=True):
         (simulated, provenance), (solution, _) = read_tables_of_one_restitution(

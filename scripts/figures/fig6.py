@@ -15,7 +15,7 @@ def rows(paths, kind):
     return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
 
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     solved, _ = read_table(snakemake.input.grid, TIME_AVERAGES)
     simulated, exact = (
         rows(snakemake.input.simulation, SIMULATED_SUMMARY),

@@ -9,7 +9,7 @@ from bouncing_ball.workflow import plotting
 from bouncing_ball.workflow.io import SIMULATED_P0V, SOLVER_P0V, read_tables_of_one_restitution
 from bouncing_ball.workflow.jobs import job_log
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     panels = []
     for paths in zip(snakemake.input.simulation, snakemake.input.solver, strict=True):
         (simulated, provenance), (solved, _) = read_tables_of_one_restitution(

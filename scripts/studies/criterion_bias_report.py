@@ -12,7 +12,7 @@ from bouncing_ball.workflow.studies import (
     read_runs,
 )
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     runs = snakemake.params.runs
     shards = read_runs(snakemake.input.shards, runs)
     table = criterion_bias_table(

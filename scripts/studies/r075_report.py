@@ -14,7 +14,7 @@ from bouncing_ball.workflow.io import (
 from bouncing_ball.workflow.jobs import job_log
 from bouncing_ball.workflow.studies import r075_markdown, r075_rows, read_runs
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0], exit_when_done=True):
     runs = snakemake.params.runs
     solved, provenance = read_table(snakemake.input.solver, SOLVER_SUMMARY)
     label = runs[0]["r_label"]

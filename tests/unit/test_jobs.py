@@ -1,4 +1,5 @@
-"""A job's log: its messages, and the traceback when it fails; what a job imports."""
+"""A job's log: its messages, and the traceback when it fails; how a job ends; what a job
+imports."""
 
 import logging
 import subprocess
@@ -27,6 +28,37 @@ def test_a_failing_job_leaves_its_traceback_in_its_log(tmp_path):
     text = log.read_text()
     assert "started" in text and "Traceback (most recent call last)" in text
     assert "ZeroDivisionError" in text
+
+
+def _run_job(log, body):
+    """A process that runs ``body`` as a job (``job_log(log, exit_when_done=True)``), with an
+    exit handler that prints "teardown"."""
+    code = f"""
+import atexit, logging
+from bouncing_ball.workflow.jobs import job_log
+atexit.register(lambda: print("teardown", flush=True))
+with job_log({str(log)!r}, exit_when_done=True):
+    logging.info("started")
+    print("output", end="")
+    {body}
+"""
+    return subprocess.run(
+        [sys.executable, "-c", code], cwd=REPOSITORY, capture_output=True, text=True
+    )
+
+
+def test_a_job_that_succeeds_ends_its_process_at_once_with_its_output_flushed(tmp_path):
+    done = _run_job(tmp_path / "job.log", "pass")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == "output"  # flushed, and no interpreter teardown (no exit handler)
+    assert (tmp_path / "job.log").read_text() == "started\n"
+
+
+def test_a_job_that_fails_ends_as_python_does_with_its_traceback_logged(tmp_path):
+    failed = _run_job(tmp_path / "job.log", "1 / 0")
+    assert failed.returncode == 1
+    assert failed.stdout == "outputteardown\n" and "ZeroDivisionError" in failed.stderr
+    assert "Traceback (most recent call last)" in (tmp_path / "job.log").read_text()
 
 
 def test_tables_of_two_r_are_refused_together(tmp_path):
