@@ -91,6 +91,13 @@ import numpy as np
 import pandas as pd
 from scipy import integrate, optimize, special
 
+from .airy import (
+    LARGEST_AIRY_PHASE,
+    check_force_integral_point,
+    force_integral_phase,
+    oscillating_airy_ai,
+    scaled_airy_ai,
+)
 from .asymptotics import large_speed_decay_rate, large_speed_exponent, small_speed_exponent
 from .jit import njit
 from .kernel import TAIL as KERNEL_TAIL
@@ -112,7 +119,6 @@ __all__ = [
     "WEDGE_CLEAN",
     "PANEL_CHEBYSHEV_NODES",
     "NOISE_TOLERANCE",
-    "LARGEST_AIRY_PHASE",
     "CELL_SPEED_NODES",
     "EXPONENT_TOLERANCES",
     "DISTRIBUTION_NOISE",
@@ -133,7 +139,6 @@ __all__ = [
     "position_averages",
     "position_bin_average",
     "speed_squared_given_position_bin_average",
-    "check_force_integral_point",
     "distribution_by_force_integral",
     "distribution_cell_average",
     "distribution_with_error",
@@ -259,18 +264,6 @@ _WEDGE_ANGLES = (
 )
 
 
-#: On the outgoing side v > 0 the Airy factor of the F integral of eq. (fpsol) oscillates; up to
-#: F = 60 / x its phase (2/3) F^(1/2) v^(3/2) reaches (2/3) (60 / x)^(1/2) v^(3/2).  quad follows
-#: it to ~4e4 (against P(0, v) as x -> 0: 1e-7 at (x, v) = (1e-8, 0.8), (1e-7, 1.7)) and fails
-#: beyond (1e-5 wrong at (1e-6, 6), phase 7.6e4; a negative density at (1e-8, 2), phase 1.5e5).
-LARGEST_AIRY_PHASE = 4.0e4
-
-
-def _airy_phase(x, v):
-    """(2/3) (60 / x)^(1/2) v^(3/2): the phase of the Airy factor at the F integral's end."""
-    return (2.0 / 3.0) * np.sqrt(60.0 / x) * np.maximum(v, 0.0) ** 1.5
-
-
 def check_restitution(restitution) -> float:
     """r as a float, if w(F), P(x) and P(x, v) are computed to the solver's accuracy there.
 
@@ -357,86 +350,12 @@ def outgoing_speed_solution(restitution, step=DEFAULT_STEP):
 # special functions
 
 
-#: Ai from K_1/3 (``_airy_scaled``) where |arg z| is below this (the formula holds up to 2 pi / 3).
-BESSEL_AIRY_PHASE = 2.0
-
-
-def _airy_scaled(z):
-    """Ai(z) exp((2/3) z^(3/2)) (scipy's airye), with its leading asymptotic form where |z| > 1e6
-    (scipy returns NaN there); for 0 < |z| <= 1e6 with |arg z| < BESSEL_AIRY_PHASE from the
-    scaled Bessel function, (z / 3)^(1/2) kve(1/3, (2/3) z^(3/2)) / pi (DLMF 9.6.1: the same to
-    ~5e-15, and as close to mpmath's, three to nine times faster)."""
-    z = np.asarray(z)
-    big = np.abs(z) > 1e6
-    far = np.where(big, z, 1e6)
-    asymptotic = far**-0.25 / (2.0 * np.sqrt(np.pi)) * (1.0 - 5.0 / (48.0 * far**1.5))
-    bessel = (z != 0.0) & (np.abs(np.angle(z)) < BESSEL_AIRY_PHASE) & ~big
-    out = np.where(big, asymptotic, 0.0 * z)
-    out[bessel] = (
-        np.sqrt(z[bessel] / 3.0) * special.kve(1.0 / 3.0, (2.0 / 3.0) * z[bessel] ** 1.5) / np.pi
-    )
-    rest = ~bessel & ~big
-    out[rest] = special.airye(z[rest])[0]
-    return out
-
-
-def _airy_oscillating(z):
-    """Ai(-z) for real z >= 0 from the Hankel function, (z^(1/2) / 2) (J_1/3 - Y_1/3 / 3^(1/2))
-    at (2/3) z^(3/2) (DLMF 9.6.6 with J_-1/3 = (J_1/3 - 3^(1/2) Y_1/3) / 2: as close to mpmath's
-    as scipy's airy up to z = 120, and several times faster), scipy's airy where z < 1e-3."""
-    z = np.asarray(z, dtype=float)
-    out = np.empty(z.shape)
-    small = z < 1e-3
-    out[small] = special.airy(-z[small])[0]
-    hankel = special.hankel1(1.0 / 3.0, (2.0 / 3.0) * z[~small] ** 1.5)
-    out[~small] = 0.5 * np.sqrt(z[~small]) * (hankel.real - hankel.imag / np.sqrt(3.0))
-    return out
-
-
-def airy_ai(z):
-    """Ai(z) for real z, from Bessel functions where |z| > 10 (scipy evaluates them several
-    times faster there than its airy).
-
-    scipy's airy where |z| <= 10; (z / 3)^(1/2) K_1/3(zeta) / pi (DLMF 9.6.1) above,
-    (t^(1/2) / 2) (J_1/3(zeta) - Y_1/3(zeta) / 3^(1/2)) at z = -t below (DLMF 9.6.6 with
-    10.4.7), zeta = (2/3) |z|^(3/2), J and Y from one Hankel function.  Where the Airy
-    function oscillates, neither this nor scipy's airy can beat a few rounding errors of the
-    phase zeta.
-
-    Parameters
-    ----------
-    z : array_like
-        Real arguments.
-
-    Returns
-    -------
-    numpy.ndarray
-        Ai(z), the shape of ``z``.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from scipy import special
-    >>> from bouncing_ball.distribution import airy_ai
-    >>> z = np.array([-50.0, -1.0, 0.0, 2.0, 30.0])
-    >>> bool(np.allclose(airy_ai(z), special.airy(z)[0], rtol=1e-12, atol=0.0))
-    True
-    """
-    z = np.asarray(z, dtype=float)
-    out = np.empty(z.shape)
-    middle, below, above = np.abs(z) <= 10.0, z < -10.0, z > 10.0
-    out[middle] = special.airy(z[middle])[0]
-    out[below] = _airy_oscillating(-z[below])
-    out[above] = _airy_scaled(z[above]) * np.exp(-(2.0 / 3.0) * z[above] ** 1.5)
-    return out
-
-
 def _log_psi(force, v):
     """ln psi_F(v) of eq. (psi) where its argument F^(1/3) v + F^(-2/3)/4 is >= 0 (psi > 0 there)."""
     argument = force ** (1.0 / 3.0) * v + 0.25 * force ** (-2.0 / 3.0)
     return (
         -np.log(force) / 6.0
-        + np.log(_airy_scaled(argument))
+        + np.log(scaled_airy_ai(argument))
         - (2.0 / 3.0) * np.maximum(argument, 0.0) ** 1.5
     )
 
@@ -459,7 +378,7 @@ def _log_psi_omega(force, v):
     return (
         np.log(-OMEGA)
         - np.log(force) / 6.0
-        + np.log(_airy_scaled(z).astype(complex))
+        + np.log(scaled_airy_ai(z).astype(complex))
         - (2.0 / 3.0) * z**1.5
     )
 
@@ -1917,56 +1836,8 @@ def _distribution_integrand(log_force, x, v, weight, width=0.0):
     if argument <= 0.0 or (argument < 30.0 and abs(log_rest) < 600.0):
         # (Ai alone: scipy's airy is half the cost of airye; Ai(30) ~ 1e-48 is still a double)
         return special.airy(argument)[0] * math.exp(log_rest)
-    airy = special.airye(argument)[0] if argument < 1e6 else float(_airy_scaled(argument))
+    airy = special.airye(argument)[0] if argument < 1e6 else float(scaled_airy_ai(argument))
     return airy * math.exp(log_rest - (2.0 / 3.0) * argument**1.5)
-
-
-def check_force_integral_point(x: float, v: float) -> None:
-    """Refuse an (x, v) at which the F integral of eq. (fpsol) diverges or quad cannot follow it.
-
-    The integral converges and quad evaluates it at x > 0 where the phase of psi_F(-v) stays
-    below ``LARGEST_AIRY_PHASE`` (any x > 0 where v <= 0; x >= 1e-4 up to v = 18), and at x = 0
-    only with v < 0.
-
-    Parameters
-    ----------
-    x : float
-        The height.
-    v : float
-        The velocity.
-
-    Returns
-    -------
-    None
-
-    Raises
-    ------
-    ValueError
-        Naming x (and the smallest x it can be at this v), elsewhere.
-
-    Examples
-    --------
-    >>> from bouncing_ball.distribution import check_force_integral_point
-    >>> check_force_integral_point(0.0, -1.0)
-    >>> check_force_integral_point(0.0, 1.0)
-    Traceback (most recent call last):
-    ...
-    ValueError: x = 0.0: the F integral of eq. (fpsol) needs x > 0, or x = 0 with v < 0 (v = 1.0)
-    >>> check_force_integral_point(1e-8, 2.0)
-    Traceback (most recent call last):
-    ...
-    ValueError: x = 1e-08: at v = 2.0 the F integral of eq. (fpsol) ... below x = 1.3e-07; ...
-    """
-    if not x >= 0.0 or (x == 0.0 and not v < 0.0):
-        raise ValueError(
-            f"x = {x}: the F integral of eq. (fpsol) needs x > 0, or x = 0 with v < 0 (v = {v})"
-        )
-    if x > 0.0 and _airy_phase(x, v) > LARGEST_AIRY_PHASE:
-        smallest = 60.0 * ((2.0 / 3.0) * v**1.5 / LARGEST_AIRY_PHASE) ** 2
-        raise ValueError(
-            f"x = {x}: at v = {v} the F integral of eq. (fpsol) oscillates too fast to evaluate "
-            f"below x = {smallest:.2g}; use x = 0 (P(0, v)) or a larger x"
-        )
 
 
 def distribution_by_force_integral(x, v, weight):
@@ -2082,8 +1953,8 @@ def _force_rule_sum(x, speeds, log_rest_grid, y_grid, decay, phase, nodes, weigh
     log_rest = weight.log(force) + (5.0 / 6.0) * y - force * x - 0.5 * v
     positive = argument > 0.0
     airy = np.empty(argument.size)
-    airy[positive] = _airy_scaled(argument[positive])
-    airy[~positive] = _airy_oscillating(-argument[~positive])
+    airy[positive] = scaled_airy_ai(argument[positive])
+    airy[~positive] = oscillating_airy_ai(-argument[~positive])
     terms = w * airy * np.exp(log_rest - (2.0 / 3.0) * np.maximum(argument, 0.0) ** 1.5)
     return np.bincount(which, terms, minlength=speeds.size)
 
@@ -2209,7 +2080,7 @@ def distribution_cell_average(x_lo, x_hi, v_lo, v_hi, weight, speed_nodes=CELL_S
     )
     if np.any(~(x_lo > 0.0) | ~(x_hi > x_lo) | ~(v_hi > v_lo) | ~np.isfinite(x_hi + v_lo + v_hi)):
         raise ValueError("cells need 0 < x_lo < x_hi < inf and finite v_lo < v_hi")
-    if np.any(_airy_phase(x_lo, v_hi) > LARGEST_AIRY_PHASE):
+    if np.any(force_integral_phase(x_lo, v_hi) > LARGEST_AIRY_PHASE):
         raise ValueError(
             "x_lo: a cell reaches an x and v > 0 at which the F integral of eq. (fpsol) "
             "oscillates too fast to evaluate (check_force_integral_point)"

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 from scipy import integrate, special
 
-from .distribution import airy_ai, check_force_integral_point
+from .airy import airy_ai, check_force_integral_point
 from .restitution import EXACT_RESTITUTIONS, parse_restitution
 
 __all__ = [
@@ -579,7 +579,7 @@ def distribution_by_force_integral(x, v, restitution):
     Raises
     ------
     ValueError
-        If x < 0, or x = 0 with v >= 0 (``distribution.check_force_integral_point``), or r is
+        If x < 0, or x = 0 with v >= 0 (``airy.check_force_integral_point``), or r is
         not 1/2 or 1/3.
 
     Examples

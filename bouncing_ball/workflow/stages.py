@@ -42,6 +42,7 @@ READ_SHARDS = (
 )
 MERGE = (*READ_SHARDS, "equilibration")
 SOLVER = (
+    "airy",
     "asymptotics",
     "bins",
     "distribution",
@@ -52,13 +53,13 @@ SOLVER = (
     "restitution",
     "solver",
 )
-EXACT = ("bins", "exact")
+EXACT = ("airy", "bins", "exact")
 THEORY = ("asymptotics", "bins")
 FITS = (*READ_SHARDS, "asymptotics", "fits")
 PLOTTING = ("workflow.io", "workflow.plotting", "restitution")
 COMPARISON = ("comparison", "fits", "workflow.io", "restitution")
 # the studies' reports (workflow/rules/studies.smk); their shards are SIMULATION's
-STUDIES = (*READ_SHARDS, "comparison", "exact", "fits", "workflow.studies")
+STUDIES = (*READ_SHARDS, "airy", "comparison", "exact", "fits", "workflow.studies")
 # results/tables/validation: the comparison, the exact bin averages, the solver curve's bin
 # averages, and the shards read back for the sign-flip p-values
-VALIDATION = (*READ_SHARDS, "comparison", "exact", "fits")
+VALIDATION = (*READ_SHARDS, "airy", "comparison", "exact", "fits")

@@ -10,7 +10,7 @@ import pytest
 from distribution_support import build
 from scipy import integrate
 
-from bouncing_ball import distribution, exact
+from bouncing_ball import airy, distribution, exact
 
 EXACT = [Fraction(1, 2), Fraction(1, 3)]
 # the checks at any r (0.15, 0.25, 0.6, 0.75, 0.9) are in test_distribution_any_r.py: each r
@@ -239,12 +239,12 @@ def test_slack_sums_meet_their_accuracy(r, built):
 
 
 def test_airy_function_from_bessel_functions_is_scipys():
-    """airy_ai (Bessel functions where |z| > 10) against scipy's airy, relative to the envelope |z|^(-1/4) on the oscillating side and to Ai where it decays:
-    within 10 rounding errors of the phase (2/3) |z|^(3/2), which neither can beat."""
+    """airy_ai (Bessel functions where |z| > 10) against scipy's airy, relative to the
+    envelope |z|^(-1/4) on the oscillating side and to Ai where it decays: within 10 rounding errors of the phase (2/3) |z|^(3/2), which neither can beat."""
     from scipy import special
 
     z = np.concatenate([np.linspace(-3000.0, -10.0, 2001), np.linspace(-10.0, 60.0, 701)])
-    ours, theirs = distribution.airy_ai(z), special.airy(z)[0]
+    ours, theirs = airy.airy_ai(z), special.airy(z)[0]
     envelope = np.where(z < 0.0, np.maximum(np.abs(z), 1.0) ** -0.25, np.abs(theirs))
     phase = (2.0 / 3.0) * np.abs(z) ** 1.5
     assert np.all(np.abs(ours - theirs) <= 10.0 * np.finfo(float).eps * (1.0 + phase) * envelope)
