@@ -44,18 +44,18 @@ def force_integral_phase(x, v):
     return (2.0 / 3.0) * np.sqrt(60.0 / x) * np.maximum(v, 0.0) ** 1.5
 
 
-#: Ai from K_1/3 (``scaled_airy_ai``) where |arg z| is below this (the formula holds up to
-#: 2 pi / 3).
+#: Ai from ``K_1/3`` (``scaled_airy_ai``) where ``|arg z|`` is below this (the formula holds up
+#: to 2 pi / 3).
 BESSEL_AIRY_PHASE = 2.0
 
 
 def scaled_airy_ai(z):
     """Ai(z) exp((2/3) z^(3/2)), the Airy function without its decay, for complex z.
 
-    scipy's airye, with its leading asymptotic form where |z| > 1e6 (scipy returns NaN
-    there); for 0 < |z| <= 1e6 with |arg z| < BESSEL_AIRY_PHASE from the scaled Bessel
-    function, (z / 3)^(1/2) kve(1/3, (2/3) z^(3/2)) / pi (DLMF 9.6.1: the same to ~5e-15, and
-    as close to mpmath's, three to nine times faster).
+    scipy's airye, with its leading asymptotic form where ``|z| > 1e6`` (scipy returns NaN
+    there); for ``0 < |z| <= 1e6`` with ``|arg z| < BESSEL_AIRY_PHASE`` from the scaled Bessel
+    function, ``(z / 3)^(1/2) kve(1/3, (2/3) z^(3/2)) / pi`` (DLMF 9.6.1: the same to ~5e-15,
+    and as close to mpmath's, three to nine times faster).
 
     Parameters
     ----------
@@ -84,9 +84,10 @@ def scaled_airy_ai(z):
 def oscillating_airy_ai(z):
     """Ai(-z) for real z >= 0, where the Airy function oscillates.
 
-    From the Hankel function, (z^(1/2) / 2) (J_1/3 - Y_1/3 / 3^(1/2)) at (2/3) z^(3/2)
-    (DLMF 9.6.6 with J_-1/3 = (J_1/3 - 3^(1/2) Y_1/3) / 2: as close to mpmath's as scipy's
-    airy up to z = 120, and several times faster); scipy's airy where z < 1e-3.
+    From the Hankel function: ``(z^(1/2) / 2) (J_1/3 - Y_1/3 / 3^(1/2))`` at
+    ``zeta = (2/3) z^(3/2)`` (DLMF 9.6.6 with ``J_-1/3 = (J_1/3 - 3^(1/2) Y_1/3) / 2``: as
+    close to mpmath's as scipy's airy up to z = 120, and several times faster); scipy's airy
+    where z < 1e-3.
 
     Parameters
     ----------
@@ -108,13 +109,14 @@ def oscillating_airy_ai(z):
 
 
 def airy_ai(z):
-    """Ai(z) for real z, from Bessel functions where |z| > 10.
+    """Ai(z) for real z, from Bessel functions where ``|z| > 10``.
 
-    scipy evaluates those several times faster there than its airy.  scipy's airy where |z| <= 10; (z / 3)^(1/2) K_1/3(zeta) / pi (DLMF 9.6.1) above,
-    (t^(1/2) / 2) (J_1/3(zeta) - Y_1/3(zeta) / 3^(1/2)) at z = -t below (DLMF 9.6.6 with
-    10.4.7), zeta = (2/3) |z|^(3/2), J and Y from one Hankel function.  Where the Airy
-    function oscillates, neither this nor scipy's airy can beat a few rounding errors of the
-    phase zeta.
+    scipy evaluates those several times faster there than its airy.  scipy's airy where
+    ``|z| <= 10``; ``(z / 3)^(1/2) K_1/3(zeta) / pi`` above (DLMF 9.6.1);
+    ``(t^(1/2) / 2) (J_1/3(zeta) - Y_1/3(zeta) / 3^(1/2))`` at ``z = -t`` below (DLMF 9.6.6
+    with 10.4.7), where ``zeta = (2/3) |z|^(3/2)`` and J and Y come from one Hankel function.
+    Where the Airy function oscillates, neither this nor scipy's airy can beat a few rounding
+    errors of the phase zeta.
 
     Parameters
     ----------
