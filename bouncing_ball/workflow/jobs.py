@@ -3,13 +3,17 @@
 Every script under ``scripts/`` runs its work inside
 ``job_log(snakemake.log[0], exit_when_done=True)``, so a failing job leaves its exception,
 with the traceback, in its rule's log (the file Snakemake points to), not only on the console;
-and a job that succeeds ends its process at once.
+a job collects garbage seldom, and a job that succeeds ends its process at once.
 """
 
+import gc
 import logging
 import os
 import sys
 from contextlib import contextmanager
+
+#: gc thresholds in a job (``job_log(..., exit_when_done=True)``): Python's are 700, 10, 10.
+JOB_GC_THRESHOLDS = (100_000, 50, 100)
 
 
 @contextmanager
@@ -21,13 +25,21 @@ def job_log(path, exit_when_done=False):
     path : str or pathlib.Path
         The log file.
     exit_when_done : bool, optional
-        End the process as soon as the block succeeds: the log and the standard streams are
-        flushed, then ``os._exit(0)``.  That skips the interpreter's teardown of its modules,
-        a quarter of a second or more of CPU in a process that has loaded numpy, pandas,
-        scipy and matplotlib, which every job of a run would pay.  Only for a process that
-        is a job and nothing else (a script under ``scripts/``), never in one that goes on
-        (a test, a notebook).  A failing block ends the process as Python does.
+        For a process that is a job and nothing else (a script under ``scripts/``), never
+        for one that goes on (a test, a notebook).  The block collects garbage seldom: the
+        objects its imports made are frozen out of every collection (``gc.freeze``) and a
+        collection waits for ``JOB_GC_THRESHOLDS`` allocations, where a numba compile or a
+        matplotlib draw would otherwise run thousands of them (a tenth of a second or more
+        of CPU per job, a second in the shard loop's compile, for a few percent more
+        memory).  And the process ends as soon as the block succeeds: the log and the
+        standard streams are flushed, then ``os._exit(0)``.  That skips the interpreter's
+        teardown of its modules, a quarter of a second or more of CPU in a process that has
+        loaded numpy, pandas, scipy and matplotlib.  A failing block ends the process as
+        Python does.
     """
+    if exit_when_done:
+        gc.freeze()
+        gc.set_threshold(*JOB_GC_THRESHOLDS)
     logging.basicConfig(filename=str(path), level=logging.INFO, format="%(message)s", force=True)
     try:
         yield

@@ -61,6 +61,23 @@ def test_a_job_that_fails_ends_as_python_does_with_its_traceback_logged(tmp_path
     assert "Traceback (most recent call last)" in (tmp_path / "job.log").read_text()
 
 
+def test_a_job_collects_garbage_seldom_and_a_process_that_goes_on_keeps_pythons_setting(tmp_path):
+    code = f"""
+import gc
+from bouncing_ball.workflow.jobs import JOB_GC_THRESHOLDS, job_log
+default = gc.get_threshold()
+with job_log({str(tmp_path / "a.log")!r}):
+    kept = gc.get_threshold() == default
+with job_log({str(tmp_path / "b.log")!r}, exit_when_done=True):
+    print(kept, gc.get_threshold() == JOB_GC_THRESHOLDS, gc.get_freeze_count() > 0, end="")
+"""
+    done = subprocess.run(
+        [sys.executable, "-c", code], cwd=REPOSITORY, capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == "True True True"
+
+
 def test_tables_of_two_r_are_refused_together(tmp_path):
     frame = pd.DataFrame({"v": [1.0]})
     write_table(frame, tmp_path / "a.parquet", {"r": "1/2"})
