@@ -100,3 +100,12 @@ rule studies:
     input:
         STUDY_TARGETS,
     localrule: True
+
+
+# the run ends when its last job does, not when Snakemake's job-rate timer runs out
+onsuccess:
+    end_pending_timers()
+
+
+onerror:
+    end_pending_timers()

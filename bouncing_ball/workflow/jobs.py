@@ -1,15 +1,19 @@
-"""The edges of a workflow job: its log file, with the traceback when it fails, and its end.
+"""The edges of a workflow job: its log file, with the traceback when it fails, and its end;
+and the end of the run.
 
 Every script under ``scripts/`` runs its work inside
 ``job_log(snakemake.log[0], exit_when_done=True)``, so a failing job leaves its exception,
 with the traceback, in its rule's log (the file Snakemake points to), not only on the console;
-a job collects garbage seldom, and a job that succeeds ends its process at once.
+a job collects garbage seldom, and a job that succeeds ends its process at once.  The
+Snakefile's ``onsuccess`` and ``onerror`` handlers call ``end_pending_timers``, so the run ends
+when its last job does.
 """
 
 import gc
 import logging
 import os
 import sys
+import threading
 from contextlib import contextmanager
 
 #: gc thresholds in a job (``job_log(..., exit_when_done=True)``): Python's are 700, 10, 10.
@@ -52,3 +56,27 @@ def job_log(path, exit_when_done=False):
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(0)
+
+
+def end_pending_timers() -> int:
+    """Cancel every ``threading.Timer`` still waiting in this process; return how many.
+
+    For Snakemake's own process, from the workflow's ``onsuccess`` and ``onerror`` handlers,
+    when every job has ended.  Snakemake's job-rate limiter (``--max-jobs-per-timespan``, at
+    least one second) starts a timer at each round of scheduling to wake the scheduler again,
+    and the interpreter waits for the last one before it exits: without this, a run ends up to
+    a second after its last job.  Nothing is left for a timer to wake by then.
+
+    Returns
+    -------
+    int
+        The timers cancelled.
+    """
+    pending = [
+        thread
+        for thread in threading.enumerate()
+        if isinstance(thread, threading.Timer) and thread.is_alive()
+    ]
+    for timer in pending:
+        timer.cancel()
+    return len(pending)

@@ -1,9 +1,11 @@
 """A job's log: its messages, and the traceback when it fails; how a job ends; what a job
-imports."""
+imports; how the run ends."""
 
 import logging
 import subprocess
 import sys
+import threading
+import time
 from pathlib import Path
 
 import pandas as pd
@@ -14,7 +16,7 @@ from bouncing_ball.workflow.io import (
     read_tables_of_one_restitution,
     write_table,
 )
-from bouncing_ball.workflow.jobs import job_log
+from bouncing_ball.workflow.jobs import end_pending_timers, job_log
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 
@@ -35,7 +37,7 @@ def _run_job(log, body):
     exit handler that prints "teardown"."""
     code = f"""
 import atexit, logging
-from bouncing_ball.workflow.jobs import job_log
+from bouncing_ball.workflow.jobs import end_pending_timers, job_log
 atexit.register(lambda: print("teardown", flush=True))
 with job_log({str(log)!r}, exit_when_done=True):
     logging.info("started")
@@ -111,7 +113,7 @@ from bouncing_ball.settings import ShardSettings
 from bouncing_ball.tallies import ShardTallies
 from bouncing_ball.workflow.batches import batch_to_table
 from bouncing_ball.workflow.io import write_table
-from bouncing_ball.workflow.jobs import job_log
+from bouncing_ball.workflow.jobs import end_pending_timers, job_log
 settings = ShardSettings(
     shard_time=1.0, equilibration_time=0.0, criterion_c=5, min_step_divisor=10,
     max_steps=100, speed_bins=LogBins(0.1, 10.0, 1),
@@ -130,3 +132,19 @@ def test_a_merge_job_does_not_import_scipy_stats():
     )
     modules = _modules_after(code)
     assert "scipy.special" in modules and "scipy.stats" not in modules
+
+
+def test_the_run_ends_without_waiting_for_a_pending_timer():
+    # Snakemake's job-rate limiter leaves such a timer behind at every round of scheduling
+    fired = threading.Event()
+    timer = threading.Timer(60.0, fired.set)
+    timer.start()
+    other = threading.Thread(target=time.sleep, args=(0.2,))
+    other.start()
+    started = time.perf_counter()
+    assert end_pending_timers() == 1
+    timer.join(5.0)
+    assert not timer.is_alive() and time.perf_counter() - started < 5.0
+    assert not fired.is_set()
+    other.join()  # a thread that is not a timer runs to its end
+    assert end_pending_timers() == 0

@@ -15,6 +15,7 @@ from bouncing_ball.workflow.config import (
     shard_count,
     shard_settings,
 )
+from bouncing_ball.workflow.jobs import end_pending_timers
 from bouncing_ball.restitution import (
     EXACT_RESTITUTIONS,
     check_solver_restitution,
