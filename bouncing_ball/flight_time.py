@@ -178,6 +178,7 @@ __all__ = [
     "return_speed_table",
     "flight_rate_bin_integrals",
     "flight_time_bin_average",
+    "return_speed_bin_law",
     "return_speed_bin_probabilities",
 ]
 
@@ -1331,8 +1332,94 @@ def _speed_sub_bins(lower, upper, panels=10, efolds=40.0):
     return np.array(lo), np.array(hi), np.array(owner, dtype=int)
 
 
+#: Chebyshev nodes per panel in ln u of ``return_speed_bin_law(..., interpolated=True)``.
+LAW_PANEL_NODES = 24
+
+
+def _law_panel_edges():
+    """The panels in ln u on which ``return_speed_bin_law`` interpolates: from 1e-12 to 1e5,
+    each min(1, 2 u^(-1/2)) wide at its lower end u (the law of a ball leaving at speed
+    u >> 1 varies over |v - u| ~ u^(1/2)).  One fixed set, whatever the points, so that a
+    point's value does not depend on which others are asked for."""
+    edges = [np.log(1e-12)]
+    while edges[-1] < np.log(1e5):
+        edges.append(edges[-1] + min(1.0, 2.0 * np.exp(-0.5 * edges[-1])))
+    return np.array(edges)
+
+
+_LAW_PANEL_EDGES = _law_panel_edges()
+_LAW_PANEL_X = np.cos(np.pi * (np.arange(LAW_PANEL_NODES) + 0.5) / LAW_PANEL_NODES)
+_LAW_PANEL_VANDERMONDE = np.polynomial.chebyshev.chebvander(_LAW_PANEL_X, LAW_PANEL_NODES - 1)
+
+
+def _direct_return_speed_bin_law(u, v_lower, v_upper):
+    """M_j(u) of ``return_speed_bin_law`` at each u, Gauss-Legendre in ln v on each finite
+    v-bin (its sub-bins, ``_speed_sub_bins``); the overflow bin left at 0."""
+    lo, hi, owner = _speed_sub_bins(v_lower, v_upper)
+    v, v_weights = _log_gauss(lo, hi)  # (n_sub, 16)
+    # G_g(v, u) of every pair as [u, v sub-bin, v point] (the matrix is [v, u]: a copy of its
+    # transpose costs less than broadcasting the pairs)
+    kernel = np.ascontiguousarray(return_speed_kernel_matrix(v.ravel(), u).T)
+    sub = np.einsum("acd,cd->ac", kernel.reshape(u.size, *v.shape), v * v_weights)
+    cells = np.zeros((u.size, v_lower.size))
+    np.add.at(cells.T, owner, sub.T)
+    return cells
+
+
+def return_speed_bin_law(u, v_lower, v_upper, interpolated=False):
+    """M_j(u) = int_(v-bin j) dv v G_g(v, u): the return-speed law of eq. (kernel3) in v-bins.
+
+    The probability that a ball leaving the floor at speed u comes back with a speed in
+    v-bin j.  A v-bin may start at 0 (underflow) or end at inf (overflow: 1 minus the rest,
+    by eq. (normG)).  Gauss-Legendre in ln v.
+
+    Parameters
+    ----------
+    u : array_like
+        Outgoing speeds, 1-d, > 0.
+    v_lower, v_upper : array_like
+        The v-bins' edges.
+    interpolated : bool, optional
+        M_j computed at ``LAW_PANEL_NODES`` Chebyshev nodes on each panel in ln u that holds
+        a u (panels of fixed edges, one e-fold wide, narrower above u = 4) and interpolated,
+        where that takes fewer kernel evaluations: for many u close together.  M_j is
+        analytic in ln u on that scale, and the interpolation agrees with the direct
+        evaluation to rounding (a few 1e-15, ``tests/unit/test_flight_time.py``).
+
+    Returns
+    -------
+    numpy.ndarray, shape (u, v-bins)
+        Each row sums to 1 where the v-bins cover [0, inf).
+    """
+    u = np.ascontiguousarray(u, dtype=float)
+    v_lower, v_upper = np.asarray(v_lower, dtype=float), np.asarray(v_upper, dtype=float)
+    s = np.log(u)
+    panel = np.searchsorted(_LAW_PANEL_EDGES, s, side="right") - 1
+    used = np.unique(panel)
+    inside = used.size and used[0] >= 0 and used[-1] < _LAW_PANEL_EDGES.size - 1
+    if interpolated and inside and used.size * LAW_PANEL_NODES < u.size:
+        middle = 0.5 * (_LAW_PANEL_EDGES[used + 1] + _LAW_PANEL_EDGES[used])
+        half = 0.5 * (_LAW_PANEL_EDGES[used + 1] - _LAW_PANEL_EDGES[used])
+        nodes = np.exp(middle[:, None] + half[:, None] * _LAW_PANEL_X[None, :])
+        at_nodes = _direct_return_speed_bin_law(nodes.ravel(), v_lower, v_upper)
+        coefficients = np.linalg.solve(
+            _LAW_PANEL_VANDERMONDE, at_nodes.reshape(used.size, LAW_PANEL_NODES, -1)
+        )
+        k = np.searchsorted(used, panel)
+        x = (s - middle[k]) / half[k]
+        vandermonde = np.polynomial.chebyshev.chebvander(x, LAW_PANEL_NODES - 1)
+        cells = np.einsum("pn,pnj->pj", vandermonde, coefficients[k])
+    else:
+        cells = _direct_return_speed_bin_law(u, v_lower, v_upper)
+    overflow = np.flatnonzero(~np.isfinite(v_upper))
+    if overflow.size:
+        cells[:, overflow[0]] = 0.0
+        cells[:, overflow[0]] = 1.0 - cells.sum(axis=1)
+    return cells
+
+
 def return_speed_bin_probabilities(
-    outgoing_density, u_lower, u_upper, v_lower, v_upper, outgoing_points=16
+    outgoing_density, u_lower, u_upper, v_lower, v_upper, outgoing_points=16, interpolated=False
 ):
     """The return-speed law v G_g(v, u) of eq. (kernel3) between bins of u and of v.
 
@@ -1343,7 +1430,8 @@ def return_speed_bin_probabilities(
 
     ``outgoing_density`` is P(0, u) as a function of an array (e.g. the solver's
     ``outgoing_speed_density``).  u-bins must be finite; a v-bin may start at 0 (underflow) or end
-    at inf (overflow: 1 minus the rest, by eq. (normG)).  Gauss-Legendre in ln u and ln v.
+    at inf (overflow: 1 minus the rest, by eq. (normG)).  Gauss-Legendre in ln u and ln v
+    (``return_speed_bin_law``).
 
     Parameters
     ----------
@@ -1355,6 +1443,9 @@ def return_speed_bin_probabilities(
         The v-bins' edges.
     outgoing_points : int, optional
         Gauss-Legendre points in ln u per u-bin (16; fewer suffice for narrow u-bins).
+    interpolated : bool, optional
+        The law at those points interpolated in ln u (``return_speed_bin_law``): for many
+        narrow u-bins.
 
     Returns
     -------
@@ -1362,18 +1453,6 @@ def return_speed_bin_probabilities(
         Each row sums to 1 where the v-bins cover [0, inf).
     """
     u, u_weights = _log_gauss(u_lower, u_upper, outgoing_points)
-    flux = u * outgoing_density(u) * u_weights  # (n_u, 16)
-    v_lower, v_upper = np.asarray(v_lower, dtype=float), np.asarray(v_upper, dtype=float)
-    lo, hi, owner = _speed_sub_bins(v_lower, v_upper)
-    v, v_weights = _log_gauss(lo, hi)  # (n_sub, 16)
-    # G_g(v, u) of every pair as [u-bin, u point, v sub-bin, v point] (the matrix is [v, u]: a
-    # copy of its transpose costs less than broadcasting the pairs)
-    kernel = np.ascontiguousarray(return_speed_kernel_matrix(v.ravel(), u.ravel()).T)
-    kernel = kernel.reshape(*u.shape, *v.shape)
-    sub = np.einsum("ab,abcd,cd->ac", flux, kernel, v * v_weights) / flux.sum(axis=1)[:, None]
-    cells = np.zeros((flux.shape[0], v_lower.size))
-    np.add.at(cells.T, owner, sub.T)
-    overflow = np.flatnonzero(~np.isfinite(v_upper))
-    if overflow.size:
-        cells[:, overflow[0]] = 1.0 - cells.sum(axis=1)
-    return cells
+    flux = u * outgoing_density(u) * u_weights  # (n_u, points)
+    law = return_speed_bin_law(u.ravel(), v_lower, v_upper, interpolated)
+    return np.einsum("ab,abj->aj", flux, law.reshape(*u.shape, -1)) / flux.sum(axis=1)[:, None]

@@ -292,6 +292,32 @@ def test_return_speed_bins():
         assert cells[3, j] == pytest.approx(expected, rel=1e-6, abs=0.0)
 
 
+@pytest.mark.parametrize("restitution", [0.1, 0.5, 0.95])
+def test_interpolated_return_speed_law_is_the_direct_one_to_rounding(restitution):
+    # the return-law control's case: four points in each of the fine 2.3 % bins of the
+    # outgoing speeds, from 1e-10 to 1000, on a simulation's speed bins / r
+    fine = np.geomspace(1e-10, 1e3, 1301)
+    u, _ = ft._log_gauss(fine[:-1], fine[1:], 4)
+    speed_edges = np.geomspace(1e-4, 100.0, 61) / restitution
+    v_lower = np.concatenate([[0.0], speed_edges])
+    v_upper = np.concatenate([speed_edges, [np.inf]])
+    direct = ft.return_speed_bin_law(u.ravel(), v_lower, v_upper)
+    interpolated = ft.return_speed_bin_law(u.ravel(), v_lower, v_upper, interpolated=True)
+    np.testing.assert_allclose(direct.sum(axis=1), 1.0, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(interpolated, direct, rtol=0, atol=1e-14)
+    # each point's value whatever the others asked for (fixed panels): a few points, every
+    # other point
+    np.testing.assert_array_equal(
+        ft.return_speed_bin_law(u.ravel()[::2], v_lower, v_upper, interpolated=True),
+        interpolated[::2],
+    )
+    few = u.ravel()[1000:1010]
+    np.testing.assert_array_equal(
+        ft.return_speed_bin_law(few, v_lower, v_upper, interpolated=True),
+        ft.return_speed_bin_law(few, v_lower, v_upper),
+    )
+
+
 def _simulated_flights(u, count, dt, seed):
     """Flight times and return speeds by the exact Gaussian step of (x, v) (eqs. (xstep),
     (vstep)), the crossing placed by linear interpolation within the step."""
