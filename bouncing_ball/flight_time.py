@@ -1419,7 +1419,7 @@ def return_speed_bin_law(u, v_lower, v_upper, interpolated=False):
 
 
 def return_speed_bin_probabilities(
-    outgoing_density, u_lower, u_upper, v_lower, v_upper, outgoing_points=16, interpolated=False
+    outgoing_density, u_lower, u_upper, v_lower, v_upper, outgoing_points=16
 ):
     """The return-speed law v G_g(v, u) of eq. (kernel3) between bins of u and of v.
 
@@ -1430,8 +1430,9 @@ def return_speed_bin_probabilities(
 
     ``outgoing_density`` is P(0, u) as a function of an array (e.g. the solver's
     ``outgoing_speed_density``).  u-bins must be finite; a v-bin may start at 0 (underflow) or end
-    at inf (overflow: 1 minus the rest, by eq. (normG)).  Gauss-Legendre in ln u and ln v
-    (``return_speed_bin_law``).
+    at inf (overflow: 1 minus the rest, by eq. (normG)).  Gauss-Legendre in ln u and ln v, the
+    law at the points of u interpolated in ln u where that takes fewer kernel evaluations
+    (``return_speed_bin_law``, the same values to rounding).
 
     Parameters
     ----------
@@ -1443,9 +1444,6 @@ def return_speed_bin_probabilities(
         The v-bins' edges.
     outgoing_points : int, optional
         Gauss-Legendre points in ln u per u-bin (16; fewer suffice for narrow u-bins).
-    interpolated : bool, optional
-        The law at those points interpolated in ln u (``return_speed_bin_law``): for many
-        narrow u-bins.
 
     Returns
     -------
@@ -1454,5 +1452,5 @@ def return_speed_bin_probabilities(
     """
     u, u_weights = _log_gauss(u_lower, u_upper, outgoing_points)
     flux = u * outgoing_density(u) * u_weights  # (n_u, points)
-    law = return_speed_bin_law(u.ravel(), v_lower, v_upper, interpolated)
+    law = return_speed_bin_law(u.ravel(), v_lower, v_upper, interpolated=True)
     return np.einsum("ab,abj->aj", flux, law.reshape(*u.shape, -1)) / flux.sum(axis=1)[:, None]

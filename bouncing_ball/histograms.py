@@ -343,13 +343,7 @@ def return_law_prediction(shards: list[ShardTallies], restitution: float, outgoi
     r = float(restitution)
     with np.errstate(invalid="ignore"):  # a bin where P(0, u) underflows: NaN, redone below
         law = return_speed_bin_probabilities(
-            outgoing_density,
-            lower,
-            upper,
-            bins.lower / r,
-            bins.upper / r,
-            RETURN_LAW_POINTS,
-            interpolated=True,
+            outgoing_density, lower, upper, bins.lower / r, bins.upper / r, RETURN_LAW_POINTS
         )
     lost = ~np.all(np.isfinite(law), axis=1)  # P(0, u) of 0 all over a bin: weigh ln u evenly
     if np.any(lost):
