@@ -29,6 +29,20 @@ def test_bin_averaged_speed_squared_at_one_third_agrees_with_nested_quadrature(l
     assert value[0] == pytest.approx(numerator / denominator, rel=1e-8)
 
 
+def test_bin_averaged_position_density_at_one_third_agrees_with_quadrature_of_p_of_x():
+    """P(x) averaged over bins at r = 1/3, all at once with the x integral done under the F
+    integral of eq. (P(x)2), against quadrature of P(x) over each bin."""
+    r = Fraction(1, 3)
+    lo = np.array([0.0, 1.0e-3, 0.1, 2.0, 30.0])
+    hi = np.array([1.0e-3, 2.0e-3, 0.158, 3.0, 50.0])
+    expected = [
+        integrate.quad(lambda y: float(exact.position_density(y, r)), a, b, epsrel=1e-11)[0]
+        / (b - a)
+        for a, b in zip(lo, hi, strict=True)
+    ]
+    np.testing.assert_allclose(exact.position_bin_average(lo, hi, r), expected, rtol=1e-9)
+
+
 @pytest.mark.parametrize("r", [Fraction(1, 2), Fraction(1, 3)], ids=str)
 def test_distribution_table_agrees_with_one_point_quad_everywhere(r):
     """Every x > 0 point of the pipeline's exact P(x, v) table (config.yaml's exact.positions
