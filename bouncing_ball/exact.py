@@ -309,24 +309,37 @@ def position_density(x, restitution):
     return _position_density_third(x)
 
 
-def _position_density_third(x):
-    """P(x) at r = 1/3 for an array x, eq. (P(x)2): (1/4 pi) int dF F^-1 K_{1/6}(z) e^{-z - F x},
-    z = 1/(12 F), in ln F, all x > 0 at once (``_adaptive_gauss_kronrod``); infinite at x = 0,
-    where the integrand grows as F^(1/6)."""
-    x = np.asarray(x, dtype=float)
-    out = np.full(x.shape, np.inf)
-    inside = x > 0.0
-    heights = x[inside]
+def _force_integrals_third(lo, power, width=None):
+    """The integrals over F of eq. (P(x)2) at r = 1/3, all at once (``_adaptive_gauss_kronrod``):
+
+        (1/4 pi) int dF F^-1 K_{1/6}(z) e^{-z} e^{-F lo_i} F^-power (1 - e^{-F width_i}),
+
+    z = 1/(12 F), in ln F, the last factor 1 without ``width``.  P(x) is power 0 at lo = x;
+    int_x^inf P(x') dx' power 1; int over a bin [lo, lo + width) of P power 1 and of the tail
+    power 2.  e^{-2z} cuts off small F, e^{-F lo} large F; at lo = 0 the integrand decays only
+    as F^(1/6 - power) in ln F, so it runs to F = 1e16 / width."""
+    lo = np.asarray(lo, dtype=float)
+    scale = np.ones_like(lo) if width is None else np.asarray(width, dtype=float)
 
     def integrand(log_f, owner):
         f = np.exp(log_f)
         z = 1.0 / (12.0 * f)
-        return special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z - f * heights[owner, None])
+        value = special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z - f * lo[owner, None]) / f**power
+        return value if width is None else value * -np.expm1(-f * scale[owner, None])
 
-    # e^{-2z} cuts off small F; e^{-F x} large F
-    upper = np.maximum(np.log(60.0 / heights), 8.0)
+    with np.errstate(divide="ignore"):
+        upper = np.maximum(np.where(lo > 0.0, np.log(60.0 / lo), np.log(1.0e16 / scale)), 8.0)
     values, _ = _adaptive_gauss_kronrod(integrand, np.full(upper.shape, -8.0), upper, 1e-11)
-    out[inside] = values / (4.0 * np.pi)
+    return values / (4.0 * np.pi)
+
+
+def _position_density_third(x):
+    """P(x) at r = 1/3 for an array x, eq. (P(x)2) (``_force_integrals_third``); infinite at
+    x = 0, where the integrand grows as F^(1/6)."""
+    x = np.asarray(x, dtype=float)
+    out = np.full(x.shape, np.inf)
+    inside = x > 0.0
+    out[inside] = _force_integrals_third(x[inside], 0)
     return out
 
 
@@ -416,26 +429,10 @@ def speed_squared_given_position_bin_average(lo, hi, restitution):
 
 
 def _bin_integrals_third(lo, hi, power):
-    """At r = 1/3, for every bin [lo, hi) at once (``_adaptive_gauss_kronrod``): with power 1,
-    int_lo^hi P(x) dx; with power 2, int_lo^hi dx int_x^inf P(x') dx'.  Both integrals over x
-    are done under the integral over F of eq. (P(x)2): (1/4 pi) int dF F^-1 K_{1/6}(z) e^{-z}
-    (e^{-F lo} - e^{-F hi}) / F^power, z = 1/(12 F), in ln F as in _position_density_third."""
+    """At r = 1/3, for every bin [lo, hi): with power 1, int_lo^hi P(x) dx; with power 2,
+    int_lo^hi dx int_x^inf P(x') dx' (``_force_integrals_third``)."""
     lo, hi = np.broadcast_arrays(np.asarray(lo, dtype=float), np.asarray(hi, dtype=float))
-    flat_lo, flat_hi = lo.ravel(), hi.ravel()
-
-    def integrand(log_f, owner):
-        f = np.exp(log_f)
-        z = 1.0 / (12.0 * f)
-        a, width = flat_lo[owner, None], (flat_hi - flat_lo)[owner, None]
-        difference = np.exp(-f * a) * -np.expm1(-f * width)
-        return special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z) * difference / f**power
-
-    # e^{-F lo} cuts off large F; at lo = 0 the integrand decays only as F^(1/6 - power) in ln F
-    with np.errstate(divide="ignore"):
-        upper = np.where(flat_lo > 0.0, np.log(60.0 / flat_lo), np.log(1.0e16 / flat_hi))
-    upper = np.maximum(upper, 8.0)
-    values, _ = _adaptive_gauss_kronrod(integrand, np.full(upper.shape, -8.0), upper, 1e-11)
-    return (values / (4.0 * np.pi)).reshape(lo.shape)
+    return _force_integrals_third(lo.ravel(), power, (hi - lo).ravel()).reshape(lo.shape)
 
 
 def position_moments(restitution) -> dict:
@@ -758,21 +755,9 @@ def mean_speed_squared_given_position(x, restitution):
 
 
 def _position_tail_third(x):
-    """int_x^inf P(x') dx' at r = 1/3 for an array x >= 0, under the F integral of
-    eq. (P(x)2): int_x^inf e^{-F x'} dx' = e^{-F x} / F, in ln F as in
-    ``_position_density_third``, all x at once."""
+    """int_x^inf P(x') dx' at r = 1/3 for an array x >= 0 (``_force_integrals_third``)."""
     x = np.asarray(x, dtype=float)
-    heights = x.ravel()
-
-    def integrand(log_f, owner):
-        f = np.exp(log_f)
-        z = 1.0 / (12.0 * f)
-        return special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z - f * heights[owner, None]) / f
-
-    # at x = 0 the integrand decays only as F^(-5/6) in ln F
-    upper = np.maximum(np.log(60.0 / np.where(heights > 0.0, heights, 60.0e-16)), 8.0)
-    values, _ = _adaptive_gauss_kronrod(integrand, np.full(upper.shape, -8.0), upper, 1e-11)
-    return (values / (4.0 * np.pi)).reshape(x.shape)
+    return _force_integrals_third(x.ravel(), 1).reshape(x.shape)
 
 
 def distribution_table(positions, speeds, restitution):
