@@ -545,29 +545,10 @@ def tallies_from_columns(columns, settings, source: str = "shard") -> ShardTalli
 def tallies_from_frame(frame: "pd.DataFrame", settings, source: str = "shard") -> ShardTallies:
     """A shard's tallies from its table: the inverse of ``tallies_to_frame``.
 
-    Parameters
-    ----------
-    frame : pandas.DataFrame
-        The table of ``tallies_to_frame``.
-    settings : settings.ShardSettings
-        Anything with the four bins of ``BINS``; the table's bins must be these.
-    source : str, optional
-        Where the table comes from (a file), named in errors.
-
-    Returns
-    -------
-    ShardTallies
-
-    Raises
-    ------
-    ValueError
-        Naming ``source``, if a column is missing, a tally is not on the bins of ``settings``,
-        or a scalar is missing or repeated.
+    ``tallies_from_columns`` of the frame's columns (the same parameters, checks and errors).
 
     Examples
     --------
     See the module's example.
     """
-    return tallies_from_columns(
-        {key: frame[key].to_numpy() for key in COLUMNS if key in frame.columns}, settings, source
-    )
+    return tallies_from_columns(frame, settings, source)

@@ -22,7 +22,7 @@ def fake_measurements():
     return measurements
 
 
-def test_one_row_per_observable_and_r_with_the_issue_keys():
+def test_one_row_per_observable_and_r_with_the_documented_keys():
     rows = efficiency_rows(fake_measurements())
     assert [(row["observable"], row["r"]) for row in rows] == [
         (name, r) for name in OBSERVABLES for r in (0.25, 0.75)
