@@ -545,7 +545,18 @@ def tallies_from_columns(columns, settings, source: str = "shard") -> ShardTalli
 def tallies_from_frame(frame: "pd.DataFrame", settings, source: str = "shard") -> ShardTallies:
     """A shard's tallies from its table: the inverse of ``tallies_to_frame``.
 
-    ``tallies_from_columns`` of the frame's columns (the same parameters, checks and errors).
+    ``tallies_from_columns`` of the frame's columns: the same checks and errors.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        The table of ``tallies_to_frame``.
+    settings, source
+        As for ``tallies_from_columns``.
+
+    Returns
+    -------
+    ShardTallies
 
     Examples
     --------
