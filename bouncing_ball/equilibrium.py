@@ -6,9 +6,13 @@ methods, so that one can stand in for the other.
 (``distribution.outgoing_speed_solution``: its nodes reach where P(0, v) falls to e^-690, as
 w(F) at small F needs), and builds the weight function w(F) of eq. (weightfunc) from that
 solution (``distribution``) the first time a position-dependent quantity is asked for (P(x),
-<v^2>_x, P(x, v), w(F): about a second).  It is the workflow's solve rule (scripts/solve.py
-writes its tables to ``results/solver/r{r}/``), so every number is the one the rule writes for
-the same settings.  Above ``restitution.DISTRIBUTION_RESTITUTION_RANGE`` (up to
+<v^2>_x, P(x, v), w(F)).  The solve and w(F) are shared by every ``Equilibrium`` of the same r
+and settings in a process, and kept for as long as any of them lives (and for the last
+``KEPT_SOLVES`` asked for besides).  The settings are held to where the 1e-8 accuracy target is
+met (``QUADRATURE_STEP_RANGE``, ``WEIGHT_PANEL_NODES_RANGE``, ``check_solver_settings``; the
+config's ``solver`` section is checked by the same function).  It is the workflow's solve rule
+(scripts/solve.py writes its tables to ``results/solver/r{r}/``), so every number is the one
+the rule writes for the same settings.  Above ``restitution.DISTRIBUTION_RESTITUTION_RANGE`` (up to
 ``SOLVER_RESTITUTION_RANGE``) it gives P(0, v), the time averages, the flight times and the
 exponents, and its position-dependent methods raise ValueError naming r and the range.
 
@@ -21,14 +25,23 @@ whole w(F) route).
 Every method takes arrays and broadcasts like numpy (a scalar in, a numpy scalar out).  Input
 that has no answer (a negative height, a NaN, shapes that do not broadcast) raises ValueError
 naming the argument; nothing returns a silent NaN.
+
+Both classes pickle and copy (``copy.copy``, ``copy.deepcopy``), so they cross process
+boundaries (multiprocessing, joblib): an ``Equilibrium`` travels with its solve and whatever it
+has computed from it (kilobytes), and the copy answers the same numbers without solving again.
+
+Importing this module loads neither scipy nor numba (the config check of every workflow start
+uses ``check_solver_settings``); the solver loads them on first use.
 """
 
+import collections
 import functools
 import math
+import numbers
+import weakref
 from fractions import Fraction
 
 import numpy as np
-from scipy import integrate
 
 from .restitution import (
     DISTRIBUTION_RESTITUTION_RANGE,
@@ -40,11 +53,119 @@ from .restitution import (
     restitution_label,
 )
 
-__all__ = ["Equilibrium", "ExactEquilibrium"]
+__all__ = [
+    "Equilibrium",
+    "ExactEquilibrium",
+    "QUADRATURE_STEP_RANGE",
+    "WEIGHT_PANEL_NODES_RANGE",
+    "KEPT_SOLVES",
+    "check_solver_settings",
+]
+
+#: The solver's trapezoidal step h in s = ln v + v^(1/2) that ``Equilibrium`` and rule solve
+#: accept (the config's ``solver.quadrature_step``), bounds included.  Up to 0.3 P(0, v)
+#: (``Equilibrium.accuracy``) and P(x) (``Equilibrium.position_accuracy``) meet the 1e-8 target
+#: at every r of ``DISTRIBUTION_RESTITUTION_RANGE``; the error grows like exp(-2 pi^2 / (3 h))
+#: and misses it from 0.4 on (2e-5 at 0.5).  Below 0.1 the error is already at rounding, while
+#: the solver's dense matrices grow like h^-2 (h = 1e-3 exhausts the memory).
+QUADRATURE_STEP_RANGE = (0.1, 0.3)
+#: The Chebyshev nodes per panel of ln F of the interpolated w(F) that ``Equilibrium`` and rule
+#: solve accept (the config's ``solver.weight_panel_nodes``), bounds included.  From 10, P(x)
+#: meets the 1e-8 target at every r of ``DISTRIBUTION_RESTITUTION_RANGE`` with a margin of more
+#: than ten (``position_accuracy`` and P(x) against 16 nodes, r from 0.02 to 0.9 in steps of
+#: 0.02); at 9 the margin is 2.5, at 8 P(x) misses it (3e-8 at r = 0.15).  Above 40 the cost
+#: grows with nothing to gain.
+WEIGHT_PANEL_NODES_RANGE = (10, 40)
 
 
 # ---------------------------------------------------------------------------------------------
 # input checks
+
+
+def _why_outside(value, bounds, above: str, below: str) -> str:
+    """Why a number outside a setting's ``bounds`` is refused (nothing for another value)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        return ""
+    low, high = bounds
+    return f": {above}" if value > high else f": {below}" if value < low else ""
+
+
+def check_solver_settings(quadrature_step=None, weight_panel_nodes=None, where: str = ""):
+    """The solver settings of ``Equilibrium`` and of rule solve, checked: the step within
+    ``QUADRATURE_STEP_RANGE``, the panel nodes a whole number within
+    ``WEIGHT_PANEL_NODES_RANGE``, where P(0, v) of eq. (inteq) and P(x) of eq. (P(x)1) meet the
+    1e-8 accuracy target.  The config check (``workflow.config.check_config``) calls it on the
+    config's ``solver`` section.
+
+    Parameters
+    ----------
+    quadrature_step : float, optional
+        The solver's trapezoidal step in s = ln v + v^(1/2), 0.1 <= step <= 0.3 (None:
+        ``solver.DEFAULT_STEP``).
+    weight_panel_nodes : int, optional
+        Chebyshev nodes per panel of the interpolated w(F), 10 to 40 (None:
+        ``distribution.PANEL_CHEBYSHEV_NODES``).
+    where : str, optional
+        Put before the names in errors (``"solver."`` for the config).
+
+    Returns
+    -------
+    quadrature_step : float
+    weight_panel_nodes : int
+
+    Raises
+    ------
+    ValueError
+        Naming the setting, its value and its range.
+
+    Examples
+    --------
+    >>> from bouncing_ball.equilibrium import check_solver_settings
+    >>> check_solver_settings(0.25, 12)
+    (0.25, 12)
+    >>> check_solver_settings(0.25, 4, where="solver.")
+    Traceback (most recent call last):
+    ...
+    ValueError: solver.weight_panel_nodes must be a whole number from 10 to 40, got 4: with fewer, ...
+    """
+    if quadrature_step is None:
+        from . import solver
+
+        quadrature_step = solver.DEFAULT_STEP
+    if weight_panel_nodes is None:
+        from . import distribution
+
+        weight_panel_nodes = distribution.PANEL_CHEBYSHEV_NODES
+    step, nodes = quadrature_step, weight_panel_nodes
+    low, high = QUADRATURE_STEP_RANGE
+    if isinstance(step, bool) or not isinstance(step, numbers.Real) or not low <= step <= high:
+        raise ValueError(
+            f"{where}quadrature_step must be a number from {low} to {high}, got {step!r}"
+            + _why_outside(
+                step,
+                QUADRATURE_STEP_RANGE,
+                "above, P(0, v) misses the 1e-8 accuracy target",
+                "below, the solver's matrices outgrow the memory with nothing to gain",
+            )
+            + " (equilibrium.QUADRATURE_STEP_RANGE)"
+        )
+    low, high = WEIGHT_PANEL_NODES_RANGE
+    if (
+        isinstance(nodes, bool)
+        or not isinstance(nodes, numbers.Integral)
+        or not low <= nodes <= high
+    ):
+        raise ValueError(
+            f"{where}weight_panel_nodes must be a whole number from {low} to {high}, got {nodes!r}"
+            + _why_outside(
+                nodes,
+                WEIGHT_PANEL_NODES_RANGE,
+                "more cost more with nothing to gain",
+                "with fewer, P(x) of eq. (P(x)1) misses the 1e-8 accuracy target",
+            )
+            + " (equilibrium.WEIGHT_PANEL_NODES_RANGE)"
+        )
+    return float(step), int(nodes)
 
 
 def _real_array(value, name: str) -> np.ndarray:
@@ -392,10 +513,8 @@ class _EquilibriumState:
 # any r: the solver
 
 
-@functools.lru_cache(maxsize=8)
 def _solution(exact: Fraction, step: float):
-    """P(0, v) of eq. (inteq) at r = ``exact``, trapezoidal step ``step``: solved once per process
-    and (r, step).  Where the whole distribution is computed (``DISTRIBUTION_RESTITUTION_RANGE``)
+    """P(0, v) of eq. (inteq) at r = ``exact``, trapezoidal step ``step``.  Where the whole distribution is computed (``DISTRIBUTION_RESTITUTION_RANGE``)
     its nodes reach where P(0, v) falls to e^-690, as w(F) at small F needs
     (``distribution.outgoing_speed_solution``); above, up to the solver's own highest node
     (``solver.solve_outgoing_speed_density``), which holds P(0, v) and the time averages."""
@@ -406,22 +525,67 @@ def _solution(exact: Fraction, step: float):
     return solver.solve_outgoing_speed_density(exact, step=step)
 
 
-@functools.lru_cache(maxsize=8)
-def _accuracy(exact: Fraction, step: float) -> float:
-    """``solver.accuracy_estimate`` of ``_solution(exact, step)`` (a second, finer solve)."""
-    from . import solver
-
-    return solver.accuracy_estimate(_solution(exact, step))
+#: How many solves a process keeps besides those a live ``Equilibrium`` holds: the last ones
+#: asked for, so that an ``Equilibrium`` made again after the last one of its r was dropped (a
+#: notebook cell run again, a test module after another) is not solved again.
+KEPT_SOLVES = 8
 
 
-@functools.lru_cache(maxsize=8)
-def _weight_function(exact: Fraction, step: float, panel_nodes: int):
-    """The interpolated w(F) of ``_solution(exact, step)``: built once per process."""
-    from . import distribution
+class _Solve:
+    """One solve of eq. (inteq) at one (r, step), and what is computed from it on first use:
+    its accuracy estimate (``solver.accuracy_estimate``, a second, finer solve) and the
+    interpolated w(F) of eq. (weightfunc) for each number of panel nodes
+    (``distribution.interpolated_weight_function``).  Kilobytes: P(0, v) at a few hundred
+    nodes, w(F) as Chebyshev series."""
 
-    return distribution.interpolated_weight_function(
-        _solution(exact, step), panel_nodes=panel_nodes
-    )
+    def __init__(self, solution):
+        self.solution = solution
+        self.accuracy = None
+        self.weight_functions = {}
+
+    def accuracy_estimate(self) -> float:
+        if self.accuracy is None:
+            from . import solver
+
+            self.accuracy = float(solver.accuracy_estimate(self.solution))
+        return self.accuracy
+
+    def weight_function(self, panel_nodes: int):
+        if panel_nodes not in self.weight_functions:
+            from . import distribution
+
+            self.weight_functions[panel_nodes] = distribution.interpolated_weight_function(
+                self.solution, panel_nodes=panel_nodes
+            )
+        return self.weight_functions[panel_nodes]
+
+
+# the solves of the process by (r, step): each kept while anything holds it (every live
+# Equilibrium holds its own), and the last KEPT_SOLVES asked for held here besides
+_LIVE_SOLVES = weakref.WeakValueDictionary()
+_RECENT_SOLVES = collections.OrderedDict()
+
+
+def _shared_solve(exact: Fraction, step: float) -> _Solve:
+    """The process's solve at (r, step): the one a live ``Equilibrium`` or the recent ones
+    hold, else a new one."""
+    key = (exact, step)
+    solve = _LIVE_SOLVES.get(key)
+    if solve is None:
+        solve = _Solve(_solution(exact, step))
+        _LIVE_SOLVES[key] = solve
+    _RECENT_SOLVES[key] = solve
+    _RECENT_SOLVES.move_to_end(key)
+    while len(_RECENT_SOLVES) > KEPT_SOLVES:
+        _RECENT_SOLVES.popitem(last=False)
+    return solve
+
+
+def _restored(cls, state):
+    """An ``Equilibrium`` from its pickled state (``Equilibrium.__reduce__``)."""
+    restored = object.__new__(cls)
+    restored.__dict__.update(state)
+    return restored
 
 
 def _solver_restitution(r) -> Fraction:
@@ -447,7 +611,9 @@ class Equilibrium(_EquilibriumState):
     ----------
     r : float or str
         The coefficient of restitution, eq. (restitution): a decimal (read as written: 0.3 is
-        3/10) or an exact fraction string such as ``"1/3"``, within the solver's range
+        3/10; a numpy float as the shortest decimal that gives it back, so np.float32(0.1) is
+        1/10), a whole number, or an exact fraction string such as ``"1/3"`` or a
+        ``Fraction``, within the solver's range
         (``restitution.SOLVER_RESTITUTION_RANGE``).  The position-dependent quantities (P(x),
         <v^2>_x, P(x, v), w(F)) are computed in ``restitution.DISTRIBUTION_RESTITUTION_RANGE``;
         above it they raise ValueError, and P(0, v), the time averages, the flight times and the
@@ -456,10 +622,12 @@ class Equilibrium(_EquilibriumState):
         If True, return the paper's exact solution, ``ExactEquilibrium(r)`` (r = 1/2 or 1/3).
     quadrature_step : float, optional
         The trapezoidal step of the solver in s = ln v + v^(1/2) (``solver.DEFAULT_STEP``; the
-        config's ``solver.quadrature_step``), 0 < step <= ``solver.LARGEST_STEP``.
+        config's ``solver.quadrature_step``), 0.1 <= step <= 0.3 (``QUADRATURE_STEP_RANGE``,
+        where the 1e-8 accuracy target is met).
     weight_panel_nodes : int, optional
         Chebyshev nodes per panel of the interpolated w(F) (``distribution.PANEL_CHEBYSHEV_NODES``;
-        the config's ``solver.weight_panel_nodes``).
+        the config's ``solver.weight_panel_nodes``), 10 to 40 (``WEIGHT_PANEL_NODES_RANGE``,
+        where P(x) meets the 1e-8 accuracy target).
 
     Attributes
     ----------
@@ -479,7 +647,8 @@ class Equilibrium(_EquilibriumState):
         (v -> inf, eqs. (asym4)-(asym6)).
     accuracy : float
         The solver's error estimate: the largest relative change of P(0, v) over
-        1e-3 <= v <= 20 against a finer solve (computed on first use: a second solve).
+        1e-3 <= v <= 20 against a finer solve (computed on first use: a second solve; then
+        kept with the solve).
     position_accuracy : float
         The largest of ``|int P dx - 1|`` and the relative differences of <x>, Delta x from P(x)
         (eq. (P(x)1)) and from the Ito identities (builds w(F) on first use).
@@ -488,9 +657,19 @@ class Equilibrium(_EquilibriumState):
         P(x, v) and w(F) are computed.
     solution : solver.OutgoingSpeedSolution
         P(0, v) at the solver's nodes: the one solve everything here is computed from (the
-        workflow's solve rule writes the same numbers).
+        workflow's solve rule writes the same numbers), shared by the ``Equilibrium`` objects
+        of this r and step in the process.
     quadrature_step : float
     weight_panel_nodes : int
+
+    Notes
+    -----
+    The solve, its accuracy estimate and w(F) are built once per process and (r, settings),
+    and kept for as long as any ``Equilibrium`` of that r and step lives, so a sweep over many
+    r built once answers each again at no cost; the last ``KEPT_SOLVES`` made are kept besides,
+    after their objects are dropped.  A pickle or a copy carries the solve and what has been
+    computed from it (kilobytes), so the copy answers the same numbers, to the bit, in another
+    process without solving again.
 
     Examples
     --------
@@ -520,33 +699,28 @@ class Equilibrium(_EquilibriumState):
     def __init__(
         self, r, *, exact=False, quadrature_step=None, weight_panel_nodes=None
     ):  # exact=True is handled by __new__
-        from . import distribution, flight_time, solver
+        from . import flight_time, solver
 
         self._set_restitution(_solver_restitution(r))
-        step = solver.DEFAULT_STEP if quadrature_step is None else quadrature_step
-        nodes = (
-            distribution.PANEL_CHEBYSHEV_NODES if weight_panel_nodes is None else weight_panel_nodes
+        self.quadrature_step, self.weight_panel_nodes = check_solver_settings(
+            quadrature_step, weight_panel_nodes
         )
-        if (
-            isinstance(step, bool)
-            or not isinstance(step, (int, float))
-            or not 0.0 < step <= solver.LARGEST_STEP
-        ):
-            raise ValueError(
-                f"quadrature_step must be a number in (0, {solver.LARGEST_STEP}], got {step!r}"
-            )
-        if isinstance(nodes, bool) or not isinstance(nodes, int) or nodes < 2:
-            raise ValueError(f"weight_panel_nodes must be a whole number >= 2, got {nodes!r}")
-        self.quadrature_step = float(step)
-        self.weight_panel_nodes = nodes
         self.distribution_available = in_range(self.restitution, DISTRIBUTION_RESTITUTION_RANGE)
-        self.solution = _solution(self.restitution, self.quadrature_step)
+        self._solve = _shared_solve(self.restitution, self.quadrature_step)
+        self.solution = self._solve.solution
         averages = solver.time_averages(self.solution)
         self.collision_rate = float(averages["collision_rate"])
         self.mean_x = float(averages["mean_x"])
         self.delta_x = float(averages["delta_x"])
         self.mean_flight_time = float(flight_time.mean_flight_time(self.solution))
         self.flight_time_second_moment = float(flight_time.flight_time_second_moment(self.solution))
+
+    def __reduce__(self):
+        """Pickled and copied as its state: r, the settings, the solve and what has been
+        computed from it (kilobytes; rebuilding them would cost a solve and w(F), and could
+        differ in the last bits on another machine).  ``__new__`` needs r, so the state is
+        restored on an object made without it (``_restored``)."""
+        return (_restored, (type(self), dict(self.__dict__)))
 
     def _check_distribution(self, what: str) -> None:
         if not self.distribution_available:
@@ -563,16 +737,17 @@ class Equilibrium(_EquilibriumState):
     @property
     def accuracy(self) -> float:
         """The solver's error estimate (``solver.accuracy_estimate``): the largest relative
-        change of P(0, v) over 1e-3 <= v <= 20 against a finer solve (computed on first use)."""
-        return _accuracy(self.restitution, self.quadrature_step)
+        change of P(0, v) over 1e-3 <= v <= 20 against a finer solve (computed on first use,
+        then kept with the solve)."""
+        return self._solve.accuracy_estimate()
 
     @property
     def weight_function(self):
         """w(F) of eq. (weightfunc), interpolated from ``solution``
-        (``distribution.WeightFunction``); built on first use (about a second), then kept for
-        the process."""
+        (``distribution.WeightFunction``); built on first use, then kept with the solve: for as
+        long as any ``Equilibrium`` of this r and step lives (``KEPT_SOLVES``)."""
         self._check_distribution("weight_function")
-        return _weight_function(self.restitution, self.quadrature_step, self.weight_panel_nodes)
+        return self._solve.weight_function(self.weight_panel_nodes)
 
     @functools.cached_property
     def _position_averages(self) -> dict:
@@ -669,10 +844,12 @@ class Equilibrium(_EquilibriumState):
         return dict(self._summary)
 
     def check(self, tables) -> None:
-        """The solve rule's checks of its tables and of ``summary()``: no NaN where a value is
-        defined, int P dx = 1 and the moments from P(x) equal the Ito moments within the
-        accuracy estimate, the measured exponents within their tolerance of the predicted ones
-        (``distribution.check_solve_tables``, held to ``solver.ACCURACY_TARGET``).
+        """The solve rule's checks of its tables and of ``summary()``, held to the accuracy
+        target ``solver.ACCURACY_TARGET`` (1e-8): ``accuracy`` (P(0, v) against a finer solve)
+        and ``position_accuracy`` (int P dx = 1, and <x>, Delta x from P(x) of eq. (P(x)1)
+        against the Ito identities) within it; then ``distribution.check_solve_tables``: no
+        NaN where a value is defined, the moments from P(x) equal the Ito ones, the measured
+        exponents within their tolerance of the predicted ones.
 
         Parameters
         ----------
@@ -683,7 +860,8 @@ class Equilibrium(_EquilibriumState):
         Raises
         ------
         ValueError
-            Naming r and every check that fails.
+            Naming r and every check that fails: first ``accuracy`` and ``position_accuracy``
+            beyond the target (with the settings), then the tables'.
 
         Examples
         --------
@@ -693,7 +871,23 @@ class Equilibrium(_EquilibriumState):
         """
         from . import distribution, solver
 
-        distribution.check_solve_tables(self.label, self.summary(), tables, solver.ACCURACY_TARGET)
+        target = solver.ACCURACY_TARGET
+        misses = [
+            f"{name} = {value:.1e}"
+            for name, value in (
+                ("accuracy", self.accuracy),
+                ("position_accuracy", self.position_accuracy),
+            )
+            if not value <= target
+        ]
+        if misses:
+            raise ValueError(
+                f"r = {self.label}: the solve misses the {target:.0e} accuracy target: "
+                + ", ".join(misses)
+                + f" (quadrature_step = {self.quadrature_step:g}, weight_panel_nodes = "
+                f"{self.weight_panel_nodes}; docs/distribution.md#where-it-degrades)"
+            )
+        distribution.check_solve_tables(self.label, self.summary(), tables, target)
 
     def p0v_table(self, speeds):
         """P(0, v) of eq. (inteq) as a table (``results/solver/r{r}/p0v``).
@@ -942,6 +1136,8 @@ class ExactEquilibrium(_EquilibriumState):
 
     def _flight_moment(self, k: int) -> float:
         """int du u P(0, u) E[T^k | u], eqs. (meanT), (meanT2), by adaptive quadrature."""
+        from scipy import integrate
+
         from . import exact, flight_time
 
         given_speed = {
@@ -987,6 +1183,8 @@ class ExactEquilibrium(_EquilibriumState):
         """nu(T) = int du u P(0, u) f(T | u), eq. (rate): adaptive quadrature in ln u from
         1e-7 T^(1/2) (below, the integrand is u^(5/2 - beta) and is summed in closed form) to
         where P(0, u) and f(T | u) have both fallen by e^-60."""
+        from scipy import integrate
+
         from . import exact, flight_time
 
         def integrand(log_u, t):

@@ -2,10 +2,13 @@
 
 Config gives r as a decimal (0.25) or an exact fraction string ("1/3").  The
 exact value is kept as a ``Fraction`` (a decimal is read as written, so
-0.3 is 3/10).  Output paths use a canonical label: the value with 6
-significant digits, trailing zeros dropped ("0.25", "0.333333").
+0.3 is 3/10; a float of any precision, numpy's included, as the shortest decimal
+that gives it back, so np.float32(0.1) is 1/10).  Output paths use a canonical label:
+the value with 6 significant digits, trailing zeros dropped ("0.25", "0.333333").
 """
 
+import math
+import numbers
 from fractions import Fraction
 
 __all__ = [
@@ -70,12 +73,17 @@ def in_range(exact, bounds) -> bool:
 def parse_restitution(value, where: str = "restitution") -> Fraction:
     """The exact value of r, eq. (restitution), from a config entry or a label.
 
-    A decimal is read as written (0.3 is 3/10, not the binary float nearest 0.3).
+    A decimal is read as written (0.3 is 3/10, not the binary float nearest 0.3).  A float
+    of any precision (Python's, numpy's float16/32/64 and longdouble) is read the same way, as
+    the shortest decimal that gives it back at its own precision: np.float32(0.1) is 1/10, as
+    0.1 is, not the float32 nearest 0.1 (1/10 + 1.5e-9).  A whole number (Python's or
+    numpy's) is itself.
 
     Parameters
     ----------
     value : float, int, str or fractions.Fraction
-        r as a decimal (0.25), a fraction string ("1/3") or a ``Fraction``.
+        r as a decimal (0.25; a numpy float or integer scalar too), a fraction string
+        ("1/3") or a ``Fraction``.  Not a bool, a complex number, NaN or an infinity.
     where : str, optional
         What ``value`` is (a config key, an argument), named in errors.
 
@@ -87,31 +95,21 @@ def parse_restitution(value, where: str = "restitution") -> Fraction:
     Raises
     ------
     ValueError
-        If ``value`` is not a number, not in (0, 1), or has a label (``restitution_label``)
-        outside (0, 1); the message names ``where``.
+        If ``value`` is not a finite real number, not in (0, 1), or has a label
+        (``restitution_label``) outside (0, 1); the message names ``where``.
 
     Examples
     --------
+    >>> import numpy as np
     >>> from bouncing_ball.restitution import parse_restitution
-    >>> parse_restitution(0.3), parse_restitution("1/3")
-    (Fraction(3, 10), Fraction(1, 3))
+    >>> parse_restitution(0.3), parse_restitution("1/3"), parse_restitution(np.float32(0.1))
+    (Fraction(3, 10), Fraction(1, 3), Fraction(1, 10))
     >>> parse_restitution(1.5, "r")
     Traceback (most recent call last):
     ...
     ValueError: r: r = 1.5 is outside the allowed range 0 < r < 1
     """
-    if isinstance(value, bool) or not isinstance(value, (int, float, str, Fraction)):
-        raise ValueError(
-            f'{where}: {value!r} is not a number; give a decimal such as 0.25 or a fraction such as "1/3"'
-        )
-    try:
-        exact = Fraction(str(value).strip()) if not isinstance(value, Fraction) else value
-    except ZeroDivisionError:
-        raise ValueError(f"{where}: {value!r} divides by zero; r must lie in (0, 1)") from None
-    except ValueError:
-        raise ValueError(
-            f'{where}: {value!r} is not a number; give a decimal such as 0.25 or a fraction such as "1/3"'
-        ) from None
+    exact = _exact_number(value, where)
     if not 0 < exact < 1:
         raise ValueError(f"{where}: r = {value!r} is outside the allowed range 0 < r < 1")
     label = restitution_label(exact)
@@ -122,6 +120,27 @@ def parse_restitution(value, where: str = "restitution") -> Fraction:
             + ("label stays below 1 (at most 0.9999994)" if exact > 0.5 else "label is not 0")
         )
     return exact
+
+
+def _exact_number(value, where: str) -> Fraction:
+    """``value`` as a Fraction, as ``parse_restitution`` reads it (no range check)."""
+    advice = 'give a decimal such as 0.25 or a fraction such as "1/3"'
+    if isinstance(value, Fraction):
+        return value
+    if isinstance(value, numbers.Integral) and not isinstance(value, bool):
+        return Fraction(int(value))  # numpy's integers too
+    if isinstance(value, numbers.Real) and not isinstance(value, bool):
+        if not math.isfinite(value):
+            raise ValueError(f"{where}: {value!r} is not a finite number; {advice}")
+        return Fraction(str(value))  # the shortest decimal of the float at its own precision
+    if not isinstance(value, str):  # bool, numpy.bool_, complex, None, a list, ...
+        raise ValueError(f"{where}: {value!r} is not a number; {advice}")
+    try:
+        return Fraction(value.strip())
+    except ZeroDivisionError:
+        raise ValueError(f"{where}: {value!r} divides by zero; r must lie in (0, 1)") from None
+    except ValueError:
+        raise ValueError(f"{where}: {value!r} is not a number; {advice}") from None
 
 
 def check_solver_restitution(value, where: str = "restitution") -> Fraction:

@@ -20,6 +20,7 @@ import jsonschema
 import yaml
 
 from ..bins import linear_bins, log_bins
+from ..equilibrium import check_solver_settings
 from ..restitution import (
     EXACT_RESTITUTIONS,
     SOLVER_RESTITUTION_RANGE,
@@ -177,6 +178,10 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
             "theory.restitution_grid: need 0 < min < max < 1, "
             f"got min = {theory_grid['min']}, max = {theory_grid['max']}"
         )
+    # the library's own bounds (Equilibrium refuses the same), where the 1e-8 target is met
+    check_solver_settings(
+        config["solver"]["quadrature_step"], config["solver"]["weight_panel_nodes"], "solver."
+    )
     solver_grid = config["solver"]["restitution_grid"]
     low, high = SOLVER_RESTITUTION_RANGE
     if not low <= solver_grid["min"] < solver_grid["max"] <= high:

@@ -3,6 +3,7 @@
 import copy
 from fractions import Fraction
 
+import numpy as np
 import pytest
 import yaml
 from workflow_support import REPOSITORY
@@ -55,6 +56,37 @@ def test_bad_r_named(value, message):
     assert "restitution[1]" in str(error.value)
 
 
+@pytest.mark.parametrize(
+    ("value", "exact"),
+    [
+        (np.float32(0.5), Fraction(1, 2)),
+        (np.float32(0.1), Fraction(1, 10)),  # its shortest decimal, as 0.1 is read
+        (np.float16(0.3), Fraction(3, 10)),
+        (np.float64(0.3), Fraction(3, 10)),
+        (np.longdouble("0.25"), Fraction(1, 4)),
+    ],
+)
+def test_numpy_floats_are_read_as_written(value, exact):
+    assert parse_restitution(value) == exact
+
+
+@pytest.mark.parametrize(
+    ("value", "message"),
+    [
+        (np.int64(1), "outside the allowed range"),
+        (np.int32(0), "outside the allowed range"),
+        (np.bool_(True), "not a number"),
+        (np.complex128(0.5), "not a number"),
+        (np.float64("nan"), "not a finite number"),
+        (np.float32("inf"), "not a finite number"),
+        (float("-inf"), "not a finite number"),
+    ],
+)
+def test_numpy_scalars_that_are_not_an_r_are_refused_for_what_they_are(value, message):
+    with pytest.raises(ValueError, match=message):
+        parse_restitution(value, "r")
+
+
 def test_repeated_r_refused_also_in_another_spelling():
     with pytest.raises(ValueError, match=r"restitution\[1\].*repeats"):
         restitution_grid([0.5, "1/2"])
@@ -70,6 +102,18 @@ def _default_config():
 def test_default_config_is_consistent():
     grid = check_config(_default_config())
     assert list(grid) == ["0.25", "0.333333", "0.5", "0.75"]
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [("quadrature_step", 0.4), ("quadrature_step", 0.05), ("weight_panel_nodes", 9)],
+)
+def test_solver_settings_are_held_to_the_library_bounds(key, value):
+    """The config check calls the library's own check (equilibrium.check_solver_settings)."""
+    config = _default_config()
+    config["solver"][key] = value
+    with pytest.raises(ValueError, match=rf"^solver\.{key} must be .* got {value}"):
+        check_config(config)
 
 
 def test_per_r_overrides_apply_by_label():

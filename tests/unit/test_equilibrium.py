@@ -105,7 +105,7 @@ def test_flight_times_match_the_exact_ones(pair):
 def test_floor_density_is_the_speed_integral_where_it_is_finite():
     """Above r = 1/2 (beta < 1) P(x) has a finite limit at the floor, (1 + r) int P(0, v) dv;
     P(x) of eq. (P(x)1) at small x tends to it like x^((1 - beta)/3) (``predicted_exponents``)."""
-    eq = bb.Equilibrium(0.6, weight_panel_nodes=6)  # the test config's: a faster w(F)
+    eq = bb.Equilibrium(0.6)
     floor = eq.px(0.0)
     assert np.isfinite(floor) and floor > eq.px(1e-3)
     assert eq.v2_given_x(0.0) == pytest.approx(1.0 / floor, rel=1e-14)

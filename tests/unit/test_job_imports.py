@@ -24,6 +24,7 @@ def loaded(module, heavy):
         "bouncing_ball.comparison",  # the moments and position tables, Fig. 7
         "bouncing_ball.workflow.plotting",  # every figure
         "bouncing_ball.asymptotics",  # r_c for Figs. 1 and 6
+        "bouncing_ball.workflow.config",  # the config check at every start of the workflow
     ],
 )
 def test_job_libraries_load_neither_scipy_nor_numba(module):
