@@ -12,8 +12,8 @@ and settings in a process, and kept for as long as any of them lives (and for th
 met (``QUADRATURE_STEP_RANGE``, ``WEIGHT_PANEL_NODES_RANGE``, ``check_solver_settings``; the
 config's ``solver`` section is checked by the same function).  It is the workflow's solve rule
 (scripts/solve.py writes its tables to ``results/solver/r{r}/``), so every number is the one
-the rule writes for the same settings.  Above ``restitution.DISTRIBUTION_RESTITUTION_RANGE`` (up to
-``SOLVER_RESTITUTION_RANGE``) it gives P(0, v), the time averages, the flight times and the
+the rule writes for the same settings.  Above ``restitution.DISTRIBUTION_RESTITUTION_RANGE``
+(up to ``SOLVER_RESTITUTION_RANGE``) it gives P(0, v), the time averages, the flight times and the
 exponents, and its position-dependent methods raise ValueError naming r and the range.
 
 Its accuracy is measured, not assumed: ``accuracy`` is the solver's own estimate, the largest
@@ -126,7 +126,7 @@ def check_solver_settings(quadrature_step=None, weight_panel_nodes=None, where: 
     >>> check_solver_settings(0.25, 4, where="solver.")
     Traceback (most recent call last):
     ...
-    ValueError: solver.weight_panel_nodes must be a whole number from 10 to 40, got 4: with fewer, ...
+    ValueError: solver.weight_panel_nodes must be a whole number from 10 to 40, got 4: ...
     """
     if quadrature_step is None:
         from . import solver
@@ -514,10 +514,11 @@ class _EquilibriumState:
 
 
 def _solution(exact: Fraction, step: float):
-    """P(0, v) of eq. (inteq) at r = ``exact``, trapezoidal step ``step``.  Where the whole distribution is computed (``DISTRIBUTION_RESTITUTION_RANGE``)
-    its nodes reach where P(0, v) falls to e^-690, as w(F) at small F needs
-    (``distribution.outgoing_speed_solution``); above, up to the solver's own highest node
-    (``solver.solve_outgoing_speed_density``), which holds P(0, v) and the time averages."""
+    """P(0, v) of eq. (inteq) at r = ``exact``, trapezoidal step ``step``.  Where the whole
+    distribution is computed (``DISTRIBUTION_RESTITUTION_RANGE``) its nodes reach where P(0, v)
+    falls to e^-690, as w(F) at small F needs (``distribution.outgoing_speed_solution``);
+    above, up to the solver's own highest node (``solver.solve_outgoing_speed_density``), which
+    holds P(0, v) and the time averages."""
     from . import distribution, solver
 
     if in_range(exact, DISTRIBUTION_RESTITUTION_RANGE):
