@@ -339,14 +339,16 @@ class _EquilibriumState:
         Parameters
         ----------
         v : array_like
-            Return speeds, v >= 0.
+            Return speeds, finite, v >= 0.
         u : array_like
-            Outgoing speeds, u > 0, broadcast against ``v``.
+            Outgoing speeds, finite, u > 0, broadcast against ``v``.
 
         Returns
         -------
         numpy.ndarray or numpy.float64
-            v G_g(v, u), the broadcast shape; it integrates to 1 over v (eq. (normG)).
+            v G_g(v, u), the broadcast shape; it integrates to 1 over v (eq. (normG)).  Finite
+            for every finite v, u (computed in logs, ``kernel.return_speed_density``): 0 only
+            where it underflows (below ~1e-308, e.g. far from v ~ u at large u).
 
         Examples
         --------
@@ -354,12 +356,12 @@ class _EquilibriumState:
         >>> print(ExactEquilibrium("1/2").return_speed_density([0.5, 1.0], 1.0).round(6))
         [0.232269 0.429368]
         """
-        from .kernel import return_speed_kernel
+        from .kernel import return_speed_density
 
         v = _checked(v, "v", low=0.0)
         u = _checked(u, "u", low=0.0, strictly=True)
         v, u = _broadcast(v, u, ("v", "u"))
-        return _out(v * return_speed_kernel(v, u))
+        return _out(return_speed_density(v, u))
 
     def observables(self) -> dict:
         """The scalars: r, beta, m, q, collision_rate, mean_x, delta_x, mean_flight_time,
