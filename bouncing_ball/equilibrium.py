@@ -144,19 +144,41 @@ class _EquilibriumState:
         pass
 
     # --- the public methods
+    @functools.cached_property
+    def smallest_speed(self) -> float:
+        """The smallest v > 0 at which P(0, v) is a double: below it A v^-beta (eq. (asym1))
+        comes within e^10 of the largest double (``p0v`` refuses such v); 0 where it stays
+        below for every v > 0 (small beta, r near 1)."""
+        reference = 1e-30  # where P(0, v) is its power law to rounding
+        prefactor = float(self._outgoing(np.array([reference]))[0]) * reference**self.beta
+        largest = np.log(np.finfo(float).max) - 10.0
+        return float(np.exp((np.log(prefactor) - largest) / self.beta))
+
     def p0v(self, v):
         """P(0, v) on the outgoing side of the floor, eq. (P(0,v)) (exact) or eq. (inteq).
+
+        Below the solver's lowest node (1e-12, 1e-20 where beta >= 2) ``Equilibrium`` gives
+        the power law A v^-beta of eq. (asym1), its prefactor matched there
+        (``solver.OutgoingSpeedSolution.outgoing_speed_density``): relative error of order
+        1e-12 besides the solver's own.
 
         Parameters
         ----------
         v : array_like
-            Outgoing speeds, v >= 0.  (The incoming side is ``pxv(0, -v)``, eq. (bc).)
+            Outgoing speeds: v = 0 or ``smallest_speed`` <= v (about 1e-205 at r = 1/3, 1e-120
+            at r = 0.02; below, P(0, v) exceeds the largest double), finite.  (The incoming
+            side is ``pxv(0, -v)``, eq. (bc).)
 
         Returns
         -------
         numpy.ndarray or numpy.float64
             P(0, v), the shape of ``v``; inf at v = 0, where P(0, v) ~ v^-beta diverges
-            (eq. (asym1)).
+            (eq. (asym1)); 0 where it underflows (v beyond ~700 / q).
+
+        Raises
+        ------
+        ValueError
+            Naming v and the bound, for v < 0, 0 < v < ``smallest_speed``, NaN or inf.
 
         Examples
         --------
@@ -165,6 +187,13 @@ class _EquilibriumState:
         [0.404354 0.122626 0.022556]
         """
         v = _checked(v, "v", low=0.0)
+        tiny = (v > 0.0) & (v < self.smallest_speed)
+        if tiny.any():
+            raise ValueError(
+                f"v = {v[tiny].flat[0]:g} is below smallest_speed = {self.smallest_speed:.3g} at "
+                f"r = {self.label}, where P(0, v) ~ A v^-beta (eq. (asym1)) exceeds the largest "
+                "double; give v = 0 (P = inf) or v >= smallest_speed"
+            )
         result = np.full(v.shape, np.inf)
         positive = v > 0.0
         result[positive] = self._outgoing(v[positive])

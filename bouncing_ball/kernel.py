@@ -79,22 +79,30 @@ _WEIGHTS = 0.5 * _WEIGHTS
 
 
 @njit(cache=True)
-def _kernel_parts(v, u, nodes, weights):
-    """The factors of G_g(v, u) = (3^(1/2) / pi) e^exponent (upper / z0) (total / z0) for
-    v, u > 0: the Gaussian's exponent, z0, the cut upper limit of tau and the tau integral.
+def _geometry(v, u):
+    """For v, u > 0: the Gaussian's exponent -(3/4) (v - u)^2 / ((v + u) / 2 + z0), z0 and the
+    upper limit of tau, min(tau1, TAIL / z0^(1/2)), of the stable form above.
 
-    Every quantity is formed from s = max(v, u) and the scaled v / s, u / s, (v u)^(1/2) / s,
-    so that nothing over- or underflows for any finite v, u > 0 (z0^2 and v u themselves would
-    overflow above ~1e154, and underflow below ~1e-154)."""
+    Every quantity is formed from s = max(v, u) and the scaled (v / s)^(1/2), (u / s)^(1/2),
+    (v - u) / s, so that nothing over- or underflows for any finite v, u > 0 (z0^2 and v u
+    themselves overflow above ~1e154 and underflow below ~1e-154)."""
     scale = max(v, u)
     root = math.sqrt(scale)
     a = math.sqrt(v) / root  # (v / s)^(1/2)
     b = math.sqrt(u) / root
     difference = (v - u) / scale
     z = math.hypot(difference, a * b)  # z0 / s, in [3^(1/2) / 2, 1]
-    z0 = scale * z
     tau1 = math.sqrt(3.0) * a * b / (math.sqrt(a * a + b * b + z) * math.sqrt(z))
     upper = min(tau1, TAIL / (root * math.sqrt(z)))
+    exponent = -0.75 * scale * difference * difference / (0.5 * (a * a + b * b) + z)
+    return exponent, scale * z, upper
+
+
+@njit(cache=True)
+def _kernel_parts(v, u, nodes, weights):
+    """The factors of G_g(v, u) = (3^(1/2) / pi) e^exponent (upper / z0) (total / z0) for
+    v, u > 0 (``_geometry``) and the tau integral ``total``."""
+    exponent, z0, upper = _geometry(v, u)
     total = 0.0
     for k in range(nodes.size):
         tau = upper * nodes[k]
@@ -103,7 +111,6 @@ def _kernel_parts(v, u, nodes, weights):
         total += weights[k] * (
             math.exp(-z0 * t2) * (1.0 + z0 * one_t2) / (one_t2 * one_t2 * math.sqrt(2.0 + t2))
         )
-    exponent = -0.75 * scale * difference * difference / (0.5 * (a * a + b * b) + z)
     return exponent, z0, upper, total
 
 
