@@ -115,6 +115,8 @@ from .solver import (
 )
 
 __all__ = [
+    "SMALLEST_POSITION",
+    "LARGEST_POSITION",
     "THETA_MAX",
     "WEDGE_CLEAN",
     "PANEL_CHEBYSHEV_NODES",
@@ -2348,7 +2350,9 @@ def position_table(weight, positions):
     """
     x = np.asarray(positions, dtype=float)
     px = position_density(x, weight)
-    return pd.DataFrame({"x": x, "px": px, "v2_given_x": position_tail(x, weight) / px})
+    return pd.DataFrame(
+        {"x": x, "px": px, "v2_given_x": mean_speed_squared_given_position(x, weight)}
+    )
 
 
 def distribution_table(weight, solution, positions, speeds):

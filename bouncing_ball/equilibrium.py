@@ -80,6 +80,22 @@ def _checked(value, name: str, *, low: float | None = None, strictly: bool = Fal
     return array
 
 
+def _heights(value, name: str) -> np.ndarray:
+    """``_checked`` heights: x = 0, or ``distribution.SMALLEST_POSITION`` <= x <=
+    ``distribution.LARGEST_POSITION`` (ValueError naming ``name`` and the bound)."""
+    from .distribution import LARGEST_POSITION, SMALLEST_POSITION
+
+    x = _checked(value, name, low=0.0)
+    bad = ((x > 0.0) & (x < SMALLEST_POSITION)) | (x > LARGEST_POSITION)
+    if bad.any():
+        raise ValueError(
+            f"{name} = {x[bad].flat[0]:g} is outside the heights computed: x = 0 or "
+            f"{SMALLEST_POSITION:g} <= x <= {LARGEST_POSITION:g} "
+            "(distribution.SMALLEST_POSITION, LARGEST_POSITION)"
+        )
+    return x
+
+
 def _broadcast(first, second, names):
     """The two arrays broadcast together; ValueError naming both if their shapes do not."""
     try:
@@ -202,16 +218,28 @@ class _EquilibriumState:
     def px(self, x):
         """P(x), the density of the height x, eq. (P(x)1) (eq. (P(x)2) for the exact solutions).
 
+        Each x is its own F integral (``distribution.position_density``), out to the small-x
+        law P(x) ~ x^((1 - beta)/3) (docs/distribution.md) through the power law of w(F) above
+        its largest computed F, whose first neglected term (relative F_max^(-2/3), 5e-6 at
+        F_max = 1e8) bounds the error there.
+
         Parameters
         ----------
         x : array_like
-            Heights, x >= 0.
+            Heights: x = 0 or ``distribution.SMALLEST_POSITION`` (1e-300) <= x <=
+            ``distribution.LARGEST_POSITION`` (1e12).
 
         Returns
         -------
         numpy.ndarray or numpy.float64
-            P(x), the shape of ``x``.  At x = 0 it is int P(0, v) dv over both sides,
-            (1 + r) int_0^inf P(0, v) dv by eq. (bc): inf where beta >= 1 (r <= 1/2).
+            P(x), the shape of ``x``; 0 where it underflows (x beyond ~1e6 at r <= 1/2).  At
+            x = 0 it is int P(0, v) dv over both sides, (1 + r) int_0^inf P(0, v) dv by
+            eq. (bc): inf where beta >= 1 (r <= 1/2).
+
+        Raises
+        ------
+        ValueError
+            Naming x and the bound, for an x outside the domain, NaN or inf.
 
         Examples
         --------
@@ -220,7 +248,7 @@ class _EquilibriumState:
         [0.503776 0.183784 0.018862]
         """
         self._check_distribution("px")
-        x = _checked(x, "x", low=0.0)
+        x = _heights(x, "x")
         result = np.full(x.shape, self._floor_density())
         positive = x > 0.0
         if positive.any():
@@ -231,15 +259,24 @@ class _EquilibriumState:
         """<v^2>_x, the mean squared velocity at height x, eq. (moment2):
         P(x)^-1 int_x^inf P(x') dx'.
 
+        The ratio is taken in logs, so it is finite where P(x) underflows (it grows like
+        (x / (S + 1/12))^(1/2), ``distribution.small_force_decay``).
+
         Parameters
         ----------
         x : array_like
-            Heights, x >= 0.
+            Heights: x = 0 or ``distribution.SMALLEST_POSITION`` (1e-300) <= x <=
+            ``distribution.LARGEST_POSITION`` (1e12).
 
         Returns
         -------
         numpy.ndarray or numpy.float64
             <v^2>_x, the shape of ``x``; 1 / P(0) at x = 0 (0 where P(0) = inf).
+
+        Raises
+        ------
+        ValueError
+            Naming x and the bound, for an x outside the domain, NaN or inf.
 
         Examples
         --------
@@ -248,7 +285,7 @@ class _EquilibriumState:
         [1.853157 3.710784]
         """
         self._check_distribution("v2_given_x")
-        x = _checked(x, "x", low=0.0)
+        x = _heights(x, "x")
         result = np.full(x.shape, 1.0 / self._floor_density())
         positive = x > 0.0
         if positive.any():
@@ -750,7 +787,7 @@ class Equilibrium(_EquilibriumState):
         import pandas as pd
 
         speeds = _checked(speeds, "speeds", low=0.0, strictly=True)
-        return pd.DataFrame({"v": speeds, "p0v": self.solution.outgoing_speed_density(speeds)})
+        return pd.DataFrame({"v": speeds, "p0v": self.p0v(speeds)})
 
     def position_table(self, positions):
         """P(x) and <v^2>_x, eqs. (P(x)1), (moment2), as a table
@@ -777,7 +814,9 @@ class Equilibrium(_EquilibriumState):
         from . import distribution
 
         self._check_distribution("position_table")
-        positions = _checked(positions, "positions", low=0.0, strictly=True)
+        positions = _heights(positions, "positions")
+        if np.any(positions == 0.0):
+            raise ValueError("positions must be > 0 (P(0) is px(0))")
         return distribution.position_table(self.weight_function, positions)
 
     def distribution_table(self, positions, speeds):

@@ -528,7 +528,9 @@ def weight_function(force, restitution):
     z = 1.0 / (12.0 * force)
     if _which(restitution) == Fraction(1, 2):
         return 0.5 * a * force**-0.5 * np.exp(-z)
-    return np.sqrt(2.0 / (27.0 * np.pi)) * a * force**-0.5 * special.kve(1.0 / 6.0, z) * np.exp(-z)
+    # in logs: F^-1/2 overflows where K e^-z underflows (F below ~1e-300)
+    log_c = np.log(np.sqrt(2.0 / (27.0 * np.pi)) * a)
+    return np.exp(log_c - 0.5 * np.log(force) + np.log(special.kve(1.0 / 6.0, z)) - z)
 
 
 def _scalar_weight_function(restitution):

@@ -202,8 +202,10 @@ def return_speed_kernel(v, u):
 
 
 def return_speed_density(v, u):
-    """v G_g(v, u) of eq. (kernel3): the density of the return speed v of a particle that
-    leaves the floor with speed u, for arrays v, u (broadcast).
+    """v G_g(v, u) of eq. (kernel3), the density of the return speed, for arrays v, u.
+
+    The density of the return speed v of a particle that leaves the floor with speed u
+    (v and u broadcast).
 
     Computed as exp of its logarithm (``_log_speed_weighted_kernel``), so it is finite for
     every finite v, u and 0 only where it underflows (below ~1e-308): G_g itself underflows

@@ -95,6 +95,7 @@ __all__ = [
     "LARGEST_STEP",
     "ACCURACY_TARGET",
     "CHECKED_SPEEDS",
+    "SMALLEST_OUTPUT_SPEED",
     "speed_of_coordinate",
     "coordinate_of_speed",
     "default_lowest_speed",
@@ -651,6 +652,10 @@ def time_averages(solution) -> dict:
         "collision_rate": solution.moment(1),
     }
 
+
+#: The smallest speed the workflow writes P(0, v) at (``solver.output_speeds``): there
+#: A v^-beta (eq. (asym1)) stays below 1e250 for every r the solver answers (beta < 5/2).
+SMALLEST_OUTPUT_SPEED = 1e-100
 
 #: The accuracy the solver is held to: relative error of P(0, v) over CHECKED_SPEEDS
 #: (independent of the output grid), and of the energy balance (M_3 above).
