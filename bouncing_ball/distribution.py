@@ -115,6 +115,8 @@ from .solver import (
 )
 
 __all__ = [
+    "SMALLEST_POSITION",
+    "LARGEST_POSITION",
     "THETA_MAX",
     "WEDGE_CLEAN",
     "PANEL_CHEBYSHEV_NODES",
@@ -1558,6 +1560,50 @@ def _total_decay(weight) -> float:
     return small_force_decay(weight.restitution) + 1.0 / 12.0
 
 
+#: The F integrals of P(x) (``_log_laplace``) run between the two F at which the factor
+#: e^(-(S + 1/12)/F - F x) has fallen FORCE_EFOLDS e-folds below its saddle value.
+FORCE_EFOLDS = 100.0
+#: Their Gauss-Legendre panels in ln F are at most this wide, and at most FORCE_PANEL_SIGMAS
+#: times the width of the saddle in ln F, (2 ((S + 1/12) x)^(1/2))^(-1/2) (a power of 2 below
+#: the widest, so that the panel edges lie on a grid fixed by x alone).
+FORCE_PANEL_WIDTH = 0.5
+FORCE_PANEL_SIGMAS = 2.5
+#: The heights at which P(x), its tail and <v^2>_x are computed (x = 0 aside): below, the F
+#: integral reaches past the largest double; above, the saddle in ln F narrows towards the
+#: spacing of doubles.
+SMALLEST_POSITION = 1e-300
+LARGEST_POSITION = 1e12
+
+
+def _force_nodes(weight, power, x):
+    """Gauss-Legendre nodes ln F and ln of their weights for int dF F^(-1/2 - power) w(F)
+    e^(-1/(12F) - F x) at one x >= 0, the factor F^(1/2 - power) w e^(-1/(12F)) dF/dlnF folded
+    into the weights.  The nodes depend on x alone, so a result never depends on the other
+    points of an array.  At x > 0 they span the FORCE_EFOLDS e-folds of e^(-(S + 1/12)/F - F x)
+    about its saddle F_s = ((S + 1/12) / x)^(1/2) (out to F = FORCE_EFOLDS / x at small x, where
+    w is its power law, so P(x) follows its small-x law, docs/distribution.md); at x = 0 (the
+    moments, power >= 1) out to where the power law F^((beta - 1)/3 - power) has fallen by
+    e^-FORCE_EFOLDS beyond F = 1e24."""
+    total = _total_decay(weight)
+    if x > 0.0:
+        root = math.sqrt(total * x)
+        centre = 0.5 * math.log(total / x)
+        reach = math.acosh(1.0 + FORCE_EFOLDS / (2.0 * root))
+        lo, hi = centre - reach, centre + reach
+        sigma = (2.0 * root) ** -0.5
+        halvings = max(0, math.ceil(math.log2(FORCE_PANEL_WIDTH / (FORCE_PANEL_SIGMAS * sigma))))
+    else:
+        decay = power - (small_speed_exponent(weight.restitution) - 1.0) / 3.0
+        lo, hi = math.log(total / FORCE_EFOLDS), math.log(1e24) + FORCE_EFOLDS / decay
+        halvings = 0
+    width = FORCE_PANEL_WIDTH * 2.0**-halvings
+    first, last = math.floor(lo / width), math.ceil(hi / width)
+    y, wy = _panels(first * width, last * width, width)
+    force = np.exp(y)
+    log_weights = np.log(wy) + (0.5 - power) * y + weight.log(force) - 1.0 / (12.0 * force)
+    return force, log_weights
+
+
 def _force_quadrature(weight, largest_x=0.0, width=0.5):
     """Gauss-Legendre nodes in ln F (panels ``width`` wide) from where F^(-1/2) w e^(-1/(12F)) has
     fallen below e^-100 (and below a twentieth of the saddle point ((S + 1/12)/x)^(1/2) of the
@@ -1571,12 +1617,22 @@ def _force_quadrature(weight, largest_x=0.0, width=0.5):
     return force, log_weights
 
 
-def _laplace(weight, power, x):
-    """int dF F^(-1/2 - power) w(F) exp(-1/(12F) - F x), for an array x >= 0."""
+def _log_laplace(weight, power, x):
+    """ln int dF F^(-1/2 - power) w(F) exp(-1/(12F) - F x), for an array x >= 0, each x on its
+    own nodes (``_force_nodes``): finite where the integral itself under- or overflows."""
     x = np.asarray(x, dtype=float)
-    force, log_weights = _force_quadrature(weight, float(np.max(x, initial=0.0)))
-    exponent = log_weights[None, :] - power * np.log(force)[None, :] - np.outer(x.ravel(), force)
-    return np.sum(np.exp(exponent), axis=1).reshape(x.shape)
+    flat = x.ravel()
+    out = np.empty(flat.size)
+    for index, point in enumerate(flat):
+        force, log_weights = _force_nodes(weight, power, float(point))
+        out[index] = _log_sum(log_weights - point * force)[0]
+    return out.reshape(x.shape)
+
+
+def _laplace(weight, power, x):
+    """int dF F^(-1/2 - power) w(F) exp(-1/(12F) - F x), for an array x >= 0 (0 where it
+    underflows)."""
+    return np.exp(_log_laplace(weight, power, x))
 
 
 def position_density(x, weight):
@@ -1672,7 +1728,7 @@ def mean_speed_squared_given_position(x, weight):
     >>> print(exact.mean_speed_squared_given_position([0.1, 1.0, 10.0], "1/2").round(8))
     [1.85315706 3.71078371 9.13728189]
     """
-    return position_tail(x, weight) / position_density(x, weight)
+    return np.exp(_log_laplace(weight, 1.0, x) - _log_laplace(weight, 0.0, x))
 
 
 def position_moment(k: int, weight) -> float:
@@ -2294,7 +2350,9 @@ def position_table(weight, positions):
     """
     x = np.asarray(positions, dtype=float)
     px = position_density(x, weight)
-    return pd.DataFrame({"x": x, "px": px, "v2_given_x": position_tail(x, weight) / px})
+    return pd.DataFrame(
+        {"x": x, "px": px, "v2_given_x": mean_speed_squared_given_position(x, weight)}
+    )
 
 
 def distribution_table(weight, solution, positions, speeds):

@@ -201,6 +201,22 @@ def _checked(value, name: str, *, low: float | None = None, strictly: bool = Fal
     return array
 
 
+def _heights(value, name: str) -> np.ndarray:
+    """``_checked`` heights: x = 0, or ``distribution.SMALLEST_POSITION`` <= x <=
+    ``distribution.LARGEST_POSITION`` (ValueError naming ``name`` and the bound)."""
+    from .distribution import LARGEST_POSITION, SMALLEST_POSITION
+
+    x = _checked(value, name, low=0.0)
+    bad = ((x > 0.0) & (x < SMALLEST_POSITION)) | (x > LARGEST_POSITION)
+    if bad.any():
+        raise ValueError(
+            f"{name} = {x[bad].flat[0]:g} is outside the heights computed: x = 0 or "
+            f"{SMALLEST_POSITION:g} <= x <= {LARGEST_POSITION:g} "
+            "(distribution.SMALLEST_POSITION, LARGEST_POSITION)"
+        )
+    return x
+
+
 def _broadcast(first, second, names):
     """The two arrays broadcast together; ValueError naming both if their shapes do not."""
     try:
@@ -265,19 +281,41 @@ class _EquilibriumState:
         pass
 
     # --- the public methods
+    @functools.cached_property
+    def smallest_speed(self) -> float:
+        """The smallest v > 0 at which P(0, v) is a double: below it A v^-beta (eq. (asym1))
+        comes within e^10 of the largest double (``p0v`` refuses such v); 0 where it stays
+        below for every v > 0 (small beta, r near 1)."""
+        reference = 1e-30  # where P(0, v) is its power law to rounding
+        prefactor = float(self._outgoing(np.array([reference]))[0]) * reference**self.beta
+        largest = np.log(np.finfo(float).max) - 10.0
+        return float(np.exp((np.log(prefactor) - largest) / self.beta))
+
     def p0v(self, v):
         """P(0, v) on the outgoing side of the floor, eq. (P(0,v)) (exact) or eq. (inteq).
+
+        Below the solver's lowest node (1e-12, 1e-20 where beta >= 2) ``Equilibrium`` gives
+        the power law A v^-beta of eq. (asym1), its prefactor matched there
+        (``solver.OutgoingSpeedSolution.outgoing_speed_density``): relative error of order
+        1e-12 besides the solver's own.
 
         Parameters
         ----------
         v : array_like
-            Outgoing speeds, v >= 0.  (The incoming side is ``pxv(0, -v)``, eq. (bc).)
+            Outgoing speeds: v = 0 or ``smallest_speed`` <= v (about 1e-205 at r = 1/3, 1e-120
+            at r = 0.02; below, P(0, v) exceeds the largest double), finite.  (The incoming
+            side is ``pxv(0, -v)``, eq. (bc).)
 
         Returns
         -------
         numpy.ndarray or numpy.float64
             P(0, v), the shape of ``v``; inf at v = 0, where P(0, v) ~ v^-beta diverges
-            (eq. (asym1)).
+            (eq. (asym1)); 0 where it underflows (v beyond ~700 / q).
+
+        Raises
+        ------
+        ValueError
+            Naming v and the bound, for v < 0, 0 < v < ``smallest_speed``, NaN or inf.
 
         Examples
         --------
@@ -286,6 +324,13 @@ class _EquilibriumState:
         [0.404354 0.122626 0.022556]
         """
         v = _checked(v, "v", low=0.0)
+        tiny = (v > 0.0) & (v < self.smallest_speed)
+        if tiny.any():
+            raise ValueError(
+                f"v = {v[tiny].flat[0]:g} is below smallest_speed = {self.smallest_speed:.3g} at "
+                f"r = {self.label}, where P(0, v) ~ A v^-beta (eq. (asym1)) exceeds the largest "
+                "double; give v = 0 (P = inf) or v >= smallest_speed"
+            )
         result = np.full(v.shape, np.inf)
         positive = v > 0.0
         result[positive] = self._outgoing(v[positive])
@@ -294,16 +339,28 @@ class _EquilibriumState:
     def px(self, x):
         """P(x), the density of the height x, eq. (P(x)1) (eq. (P(x)2) for the exact solutions).
 
+        Each x is its own F integral (``distribution.position_density``), out to the small-x
+        law P(x) ~ x^((1 - beta)/3) (docs/distribution.md) through the power law of w(F) above
+        its largest computed F, whose first neglected term (relative F_max^(-2/3), 5e-6 at
+        F_max = 1e8) bounds the error there.
+
         Parameters
         ----------
         x : array_like
-            Heights, x >= 0.
+            Heights: x = 0 or ``distribution.SMALLEST_POSITION`` (1e-300) <= x <=
+            ``distribution.LARGEST_POSITION`` (1e12).
 
         Returns
         -------
         numpy.ndarray or numpy.float64
-            P(x), the shape of ``x``.  At x = 0 it is int P(0, v) dv over both sides,
-            (1 + r) int_0^inf P(0, v) dv by eq. (bc): inf where beta >= 1 (r <= 1/2).
+            P(x), the shape of ``x``; 0 where it underflows (x beyond ~1e6 at r <= 1/2).  At
+            x = 0 it is int P(0, v) dv over both sides, (1 + r) int_0^inf P(0, v) dv by
+            eq. (bc): inf where beta >= 1 (r <= 1/2).
+
+        Raises
+        ------
+        ValueError
+            Naming x and the bound, for an x outside the domain, NaN or inf.
 
         Examples
         --------
@@ -312,7 +369,7 @@ class _EquilibriumState:
         [0.503776 0.183784 0.018862]
         """
         self._check_distribution("px")
-        x = _checked(x, "x", low=0.0)
+        x = _heights(x, "x")
         result = np.full(x.shape, self._floor_density())
         positive = x > 0.0
         if positive.any():
@@ -323,15 +380,24 @@ class _EquilibriumState:
         """<v^2>_x, the mean squared velocity at height x, eq. (moment2):
         P(x)^-1 int_x^inf P(x') dx'.
 
+        The ratio is taken in logs, so it is finite where P(x) underflows (it grows like
+        (x / (S + 1/12))^(1/2), ``distribution.small_force_decay``).
+
         Parameters
         ----------
         x : array_like
-            Heights, x >= 0.
+            Heights: x = 0 or ``distribution.SMALLEST_POSITION`` (1e-300) <= x <=
+            ``distribution.LARGEST_POSITION`` (1e12).
 
         Returns
         -------
         numpy.ndarray or numpy.float64
             <v^2>_x, the shape of ``x``; 1 / P(0) at x = 0 (0 where P(0) = inf).
+
+        Raises
+        ------
+        ValueError
+            Naming x and the bound, for an x outside the domain, NaN or inf.
 
         Examples
         --------
@@ -340,7 +406,7 @@ class _EquilibriumState:
         [1.853157 3.710784]
         """
         self._check_distribution("v2_given_x")
-        x = _checked(x, "x", low=0.0)
+        x = _heights(x, "x")
         result = np.full(x.shape, 1.0 / self._floor_density())
         positive = x > 0.0
         if positive.any():
@@ -460,14 +526,16 @@ class _EquilibriumState:
         Parameters
         ----------
         v : array_like
-            Return speeds, v >= 0.
+            Return speeds, finite, v >= 0.
         u : array_like
-            Outgoing speeds, u > 0, broadcast against ``v``.
+            Outgoing speeds, finite, u > 0, broadcast against ``v``.
 
         Returns
         -------
         numpy.ndarray or numpy.float64
-            v G_g(v, u), the broadcast shape; it integrates to 1 over v (eq. (normG)).
+            v G_g(v, u), the broadcast shape; it integrates to 1 over v (eq. (normG)).  Finite
+            for every finite v, u (computed in logs, ``kernel.return_speed_density``): 0 only
+            where it underflows (below ~1e-308, e.g. far from v ~ u at large u).
 
         Examples
         --------
@@ -475,12 +543,12 @@ class _EquilibriumState:
         >>> print(ExactEquilibrium("1/2").return_speed_density([0.5, 1.0], 1.0).round(6))
         [0.232269 0.429368]
         """
-        from .kernel import return_speed_kernel
+        from .kernel import return_speed_density
 
         v = _checked(v, "v", low=0.0)
         u = _checked(u, "u", low=0.0, strictly=True)
         v, u = _broadcast(v, u, ("v", "u"))
-        return _out(v * return_speed_kernel(v, u))
+        return _out(return_speed_density(v, u))
 
     def observables(self) -> dict:
         """The scalars: r, beta, m, q, collision_rate, mean_x, delta_x, mean_flight_time,
@@ -914,7 +982,7 @@ class Equilibrium(_EquilibriumState):
         import pandas as pd
 
         speeds = _checked(speeds, "speeds", low=0.0, strictly=True)
-        return pd.DataFrame({"v": speeds, "p0v": self.solution.outgoing_speed_density(speeds)})
+        return pd.DataFrame({"v": speeds, "p0v": self.p0v(speeds)})
 
     def position_table(self, positions):
         """P(x) and <v^2>_x, eqs. (P(x)1), (moment2), as a table
@@ -941,7 +1009,9 @@ class Equilibrium(_EquilibriumState):
         from . import distribution
 
         self._check_distribution("position_table")
-        positions = _checked(positions, "positions", low=0.0, strictly=True)
+        positions = _heights(positions, "positions")
+        if np.any(positions == 0.0):
+            raise ValueError("positions must be > 0 (P(0) is px(0))")
         return distribution.position_table(self.weight_function, positions)
 
     def distribution_table(self, positions, speeds):

@@ -309,7 +309,7 @@ def position_density(x, restitution):
     return _position_density_third(x)
 
 
-def _force_integrals_third(lo, power, width=None):
+def _force_integrals_third(lo, power, width=None, scaled=False):
     """The integrals over F of eq. (P(x)2) at r = 1/3, all at once (``_adaptive_gauss_kronrod``):
 
         (1/4 pi) int dF F^-1 K_{1/6}(z) e^{-z} e^{-F lo_i} F^-power (1 - e^{-F width_i}),
@@ -317,19 +317,29 @@ def _force_integrals_third(lo, power, width=None):
     z = 1/(12 F), in ln F, the last factor 1 without ``width``.  P(x) is power 0 at lo = x;
     int_x^inf P(x') dx' power 1; int over a bin [lo, lo + width) of P power 1 and of the tail
     power 2.  e^{-2z} cuts off small F, e^{-F lo} large F; at lo = 0 the integrand decays only
-    as F^(1/6 - power) in ln F, so it runs to F = 1e16 / width."""
+    as F^(1/6 - power) in ln F, so it runs to F = 1e16 / width.  With ``scaled``, the integrals
+    times e^{2 (lo / 6)^(1/2)}, the saddle value of e^{-2z - F lo} (at F = (6 lo)^(-1/2)): finite
+    where the integrals underflow (lo beyond ~1e5)."""
     lo = np.asarray(lo, dtype=float)
     scale = np.ones_like(lo) if width is None else np.asarray(width, dtype=float)
+    shift = 2.0 * np.sqrt(lo / 6.0) if scaled else np.zeros_like(lo)
 
     def integrand(log_f, owner):
         f = np.exp(log_f)
         z = 1.0 / (12.0 * f)
-        value = special.kve(1.0 / 6.0, z) * np.exp(-2.0 * z - f * lo[owner, None]) / f**power
+        exponent = -2.0 * z - f * lo[owner, None] + shift[owner, None]
+        value = special.kve(1.0 / 6.0, z) * np.exp(exponent) / f**power
         return value if width is None else value * -np.expm1(-f * scale[owner, None])
 
     with np.errstate(divide="ignore"):
-        upper = np.maximum(np.where(lo > 0.0, np.log(60.0 / lo), np.log(1.0e16 / scale)), 8.0)
-    values, _ = _adaptive_gauss_kronrod(integrand, np.full(upper.shape, -8.0), upper, 1e-11)
+        # at lo > 0, where e^{-2z - F lo} has fallen by e^-60 from its saddle value at
+        # F = (6 lo)^(-1/2) (to F = 60 / lo at small lo), widened by e either side
+        root = np.sqrt(lo / 6.0)
+        saddle = -0.5 * np.log(6.0 * np.where(lo > 0.0, lo, 1.0))
+        reach = np.arccosh(1.0 + 30.0 / np.where(lo > 0.0, root, 1.0)) + 1.0
+        lower = np.where(lo > 0.0, saddle - reach, -8.0)
+        upper = np.where(lo > 0.0, saddle + reach, np.maximum(np.log(1.0e16 / scale), 8.0))
+    values, _ = _adaptive_gauss_kronrod(integrand, lower, upper, 1e-11)
     return values / (4.0 * np.pi)
 
 
@@ -518,7 +528,9 @@ def weight_function(force, restitution):
     z = 1.0 / (12.0 * force)
     if _which(restitution) == Fraction(1, 2):
         return 0.5 * a * force**-0.5 * np.exp(-z)
-    return np.sqrt(2.0 / (27.0 * np.pi)) * a * force**-0.5 * special.kve(1.0 / 6.0, z) * np.exp(-z)
+    # in logs: F^-1/2 overflows where K e^-z underflows (F below ~1e-300)
+    log_c = np.log(np.sqrt(2.0 / (27.0 * np.pi)) * a)
+    return np.exp(log_c - 0.5 * np.log(force) + np.log(special.kve(1.0 / 6.0, z)) - z)
 
 
 def _scalar_weight_function(restitution):
@@ -733,7 +745,8 @@ def mean_speed_squared_given_position(x, restitution):
     Returns
     -------
     numpy.ndarray
-        <v^2>_x with P(x) of eq. (P(x)2), the shape of ``x``.
+        <v^2>_x with P(x) of eq. (P(x)2), the shape of ``x``: the ratio of the exponentially
+        scaled integrals, so finite where P(x) underflows (x beyond ~1e5).
 
     Raises
     ------
@@ -749,15 +762,10 @@ def mean_speed_squared_given_position(x, restitution):
     x = np.asarray(x, dtype=float)
     if _which(restitution) == Fraction(1, 2):
         u = np.sqrt(2.0 * x / 3.0)
-        return u * special.k1(u) / (special.k0(u) / 3.0)
-
-    return _position_tail_third(x) / position_density(x, restitution)
-
-
-def _position_tail_third(x):
-    """int_x^inf P(x') dx' at r = 1/3 for an array x >= 0 (``_force_integrals_third``)."""
-    x = np.asarray(x, dtype=float)
-    return _force_integrals_third(x.ravel(), 1).reshape(x.shape)
+        return 3.0 * u * special.k1e(u) / special.k0e(u)  # e^u K: finite where K underflows
+    flat = x.ravel()
+    tail = _force_integrals_third(flat, 1, scaled=True)
+    return (tail / _force_integrals_third(flat, 0, scaled=True)).reshape(x.shape)
 
 
 def distribution_table(positions, speeds, restitution):

@@ -59,6 +59,7 @@ __all__ = [
     "TAIL",
     "return_speed_kernel",
     "return_speed_kernel_matrix",
+    "return_speed_density",
     "kernel_small_u_limit",
 ]
 
@@ -78,14 +79,30 @@ _WEIGHTS = 0.5 * _WEIGHTS
 
 
 @njit(cache=True)
-def _kernel(v, u, nodes, weights):
-    if v <= 0.0 or u <= 0.0:
-        return 0.0
-    difference = v - u
-    z0_squared = difference * difference + v * u
-    z0 = math.sqrt(z0_squared)
-    tau1 = math.sqrt(3.0 * v * u / ((v + u + z0) * z0))
-    upper = min(tau1, TAIL / math.sqrt(z0))
+def _geometry(v, u):
+    """For v, u > 0: the Gaussian's exponent -(3/4) (v - u)^2 / ((v + u) / 2 + z0), z0 and the
+    upper limit of tau, min(tau1, TAIL / z0^(1/2)), of the stable form above.
+
+    Every quantity is formed from s = max(v, u) and the scaled (v / s)^(1/2), (u / s)^(1/2),
+    (v - u) / s, so that nothing over- or underflows for any finite v, u > 0 (z0^2 and v u
+    themselves overflow above ~1e154 and underflow below ~1e-154)."""
+    scale = max(v, u)
+    root = math.sqrt(scale)
+    a = math.sqrt(v) / root  # (v / s)^(1/2)
+    b = math.sqrt(u) / root
+    difference = (v - u) / scale
+    z = math.hypot(difference, a * b)  # z0 / s, in [3^(1/2) / 2, 1]
+    tau1 = math.sqrt(3.0) * a * b / (math.sqrt(a * a + b * b + z) * math.sqrt(z))
+    upper = min(tau1, TAIL / (root * math.sqrt(z)))
+    exponent = -0.75 * scale * difference * difference / (0.5 * (a * a + b * b) + z)
+    return exponent, scale * z, upper
+
+
+@njit(cache=True)
+def _kernel_parts(v, u, nodes, weights):
+    """The factors of G_g(v, u) = (3^(1/2) / pi) e^exponent (upper / z0) (total / z0) for
+    v, u > 0 (``_geometry``) and the tau integral ``total``."""
+    exponent, z0, upper = _geometry(v, u)
     total = 0.0
     for k in range(nodes.size):
         tau = upper * nodes[k]
@@ -94,8 +111,43 @@ def _kernel(v, u, nodes, weights):
         total += weights[k] * (
             math.exp(-z0 * t2) * (1.0 + z0 * one_t2) / (one_t2 * one_t2 * math.sqrt(2.0 + t2))
         )
-    gauss = math.exp(-0.75 * difference * difference / (0.5 * (v + u) + z0))
-    return (math.sqrt(3.0) / math.pi) * gauss * upper * total / z0_squared
+    return exponent, z0, upper, total
+
+
+@njit(cache=True)
+def _kernel(v, u, nodes, weights):
+    """G_g(v, u) (0 where v <= 0 or u <= 0; it underflows to 0 where it is below ~1e-308)."""
+    if v <= 0.0 or u <= 0.0:
+        return 0.0
+    exponent, z0, upper, total = _kernel_parts(v, u, nodes, weights)
+    return (math.sqrt(3.0) / math.pi) * math.exp(exponent) * (upper / z0) * (total / z0)
+
+
+@njit(cache=True)
+def _log_speed_weighted_kernel(v, u, nodes, weights):
+    """ln(v G_g(v, u)) (-inf where v <= 0 or u <= 0): finite wherever v G_g is positive, also
+    where G_g itself underflows (v, u above ~1e154)."""
+    if v <= 0.0 or u <= 0.0:
+        return -np.inf
+    exponent, z0, upper, total = _kernel_parts(v, u, nodes, weights)
+    if upper <= 0.0:  # (v u)^(1/2) / s underflows: v / u or u / v beyond 1e-616
+        return -np.inf
+    return (
+        math.log(math.sqrt(3.0) / math.pi)
+        + exponent
+        + math.log(upper)
+        + math.log(total)
+        + math.log(v / z0)
+        - math.log(z0)
+    )
+
+
+@njit(cache=True)
+def _speed_weighted_kernel_pairs(v, u, nodes, weights):
+    out = np.empty(v.size)
+    for i in range(v.size):
+        out[i] = math.exp(_log_speed_weighted_kernel(v[i], u[i], nodes, weights))
+    return out
 
 
 @njit(cache=True, parallel=False)
@@ -144,6 +196,43 @@ def return_speed_kernel(v, u):
     """
     v, u = np.broadcast_arrays(np.asarray(v, dtype=float), np.asarray(u, dtype=float))
     flat = _kernel_pairs(
+        np.ascontiguousarray(v.ravel()), np.ascontiguousarray(u.ravel()), _NODES, _WEIGHTS
+    )
+    return flat.reshape(v.shape)
+
+
+def return_speed_density(v, u):
+    """v G_g(v, u) of eq. (kernel3), the density of the return speed, for arrays v, u.
+
+    The density of the return speed v of a particle that leaves the floor with speed u
+    (v and u broadcast).
+
+    Computed as exp of its logarithm (``_log_speed_weighted_kernel``), so it is finite for
+    every finite v, u and 0 only where it underflows (below ~1e-308): G_g itself underflows
+    where v, u exceed ~1e154 while v G_g ~ 1 / (v + u) does not.
+
+    Parameters
+    ----------
+    v : array_like
+        Return speeds (0 where v <= 0), finite.
+    u : array_like
+        Outgoing speeds (0 where u <= 0), finite; broadcast against ``v``.
+
+    Returns
+    -------
+    numpy.ndarray
+        v G_g(v, u), the broadcast shape; int_0^inf v G_g(v, u) dv = 1, eq. (normG).
+
+    Examples
+    --------
+    Compiles on its first call (so not run as a doctest):
+
+    >>> from bouncing_ball.kernel import return_speed_density
+    >>> print(return_speed_density([1.0, 2.0], 1.0).round(8))  # doctest: +SKIP
+    [0.42936793 0.27287564]
+    """
+    v, u = np.broadcast_arrays(np.asarray(v, dtype=float), np.asarray(u, dtype=float))
+    flat = _speed_weighted_kernel_pairs(
         np.ascontiguousarray(v.ravel()), np.ascontiguousarray(u.ravel()), _NODES, _WEIGHTS
     )
     return flat.reshape(v.shape)

@@ -71,6 +71,7 @@ r = 1/2, eq. (xandDeltax), from the exact P(0, v) on the solver's nodes:
 {'mean_x': 6.0, 'delta_x': 10.39230485, 'collision_rate': 0.33333333}
 """
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -82,7 +83,7 @@ from .jit import njit
 from .kernel import (
     _NODES,
     _WEIGHTS,
-    TAIL,
+    _geometry,
     _kernel,
     kernel_small_u_limit,
     return_speed_kernel_matrix,
@@ -94,6 +95,7 @@ __all__ = [
     "LARGEST_STEP",
     "ACCURACY_TARGET",
     "CHECKED_SPEEDS",
+    "SMALLEST_OUTPUT_SPEED",
     "speed_of_coordinate",
     "coordinate_of_speed",
     "default_lowest_speed",
@@ -331,9 +333,15 @@ class OutgoingSpeedSolution:
         return rows
 
     def outgoing_speed_density(self, v):
-        """P(0, v) anywhere (v >= 0), by the Nystrom formula of eq. (inteq).
+        """P(0, v) anywhere (v >= 0): the Nystrom formula of eq. (inteq) from the lowest node
+        u_0 up, and its power law eq. (asym1) below.
 
-        r^-2 int du u G_g(v / r, u) P(0, u), the integral by the solver's rule.
+        At v >= u_0, r^-2 int du u G_g(v / r, u) P(0, u), the integral by the solver's rule.
+        Below u_0, A v^-beta with A = ``small_speed_prefactor`` (the Nystrom value at u_0
+        times u_0^beta): the rule's lower tail reaches only TAIL_EFOLDS below u_0, and the
+        power law is what the solver builds in there.  Its relative error is that of the
+        next term of P(0, v) at u_0, of relative order u_0 (e^(-v) / (3 v) at r = 1/2:
+        exactly u_0 - v), besides the error of the Nystrom value.
 
         Parameters
         ----------
@@ -343,7 +351,8 @@ class OutgoingSpeedSolution:
         Returns
         -------
         numpy.ndarray
-            P(0, v), the shape of ``v``.
+            P(0, v), the shape of ``v``: inf at v = 0, and where A v^-beta exceeds the largest
+            double (v below ~(A / 1.8e308)^(1/beta), 1e-120 or less); 0 where it underflows.
 
         Raises
         ------
@@ -356,8 +365,28 @@ class OutgoingSpeedSolution:
                 "v: P(0, v) is the density of outgoing speeds, v >= 0; "
                 "the incoming side is r^2 P(0, r |v|), eq. (bc)"
             )
+        flat = np.ascontiguousarray(v.ravel())
+        out = np.empty(flat.size)
+        below = flat < self.speeds[0]
+        out[~below] = self._nystrom(flat[~below])
+        with np.errstate(divide="ignore", over="ignore"):
+            out[below] = np.exp(
+                np.log(self.small_speed_prefactor) - self.small_speed_exponent * np.log(flat[below])
+            )
+        return out.reshape(v.shape)
+
+    @functools.cached_property
+    def small_speed_prefactor(self) -> float:
+        """A of P(0, v) ~ A v^-beta at v -> 0, eq. (asym1): the Nystrom value at the lowest node
+        u_0 times u_0^beta (relative error of order u_0, the next term of P(0, v))."""
+        u0 = self.speeds[0]
+        return float(self._nystrom(np.array([u0]))[0] * u0**self.small_speed_exponent)
+
+    def _nystrom(self, v):
+        """r^-2 int du u G_g(v / r, u) P(0, u) for a 1-d array v >= 0, by the solver's rule and
+        its lower tail."""
         r = self.restitution
-        incoming = np.ascontiguousarray(v.ravel()) / r
+        incoming = v / r
         u = self.speeds
         tail_u, tail_weights, remainder = self._lower_tail(incoming)
         flat = _kernel_sums(
@@ -368,8 +397,7 @@ class OutgoingSpeedSolution:
             _NODES,
             _WEIGHTS,
         )
-        flat = (flat + remainder * self.density[0]) / (r * r)
-        return flat.reshape(v.shape)
+        return (flat + remainder * self.density[0]) / (r * r)
 
     def moment(self, k: float) -> float:
         """M_k = int_0^inf v^k P(0, v) dv on the outgoing side.
@@ -416,16 +444,9 @@ def _kernel_sums(incoming, u, weights, density, nodes, tau_weights):
             if log_weights[j] == -np.inf:
                 bounds[j] = -np.inf
                 continue
-            difference = big_v - u[j]
-            z0_squared = difference * difference + big_v * u[j]
-            z0 = math.sqrt(z0_squared)
-            tau1 = math.sqrt(3.0 * big_v * u[j] / ((big_v + u[j] + z0) * z0))
-            upper = min(tau1, TAIL / math.sqrt(z0))
-            bounds[j] = (
-                log_weights[j]
-                + math.log(upper * (1.0 + z0) / z0_squared)
-                - 0.75 * difference * difference / (0.5 * (big_v + u[j]) + z0)
-            )
+            exponent, z0, upper = _geometry(big_v, u[j])
+            bounds[j] = log_weights[j] + math.log(upper) + math.log1p(z0) - 2.0 * math.log(z0)
+            bounds[j] += exponent
             best = max(best, bounds[j])
         total = 0.0
         for j in range(u.size):
@@ -631,6 +652,10 @@ def time_averages(solution) -> dict:
         "collision_rate": solution.moment(1),
     }
 
+
+#: The smallest speed the workflow writes P(0, v) at (``solver.output_speeds``): there
+#: A v^-beta (eq. (asym1)) stays below 1e250 for every r the solver answers (beta < 5/2).
+SMALLEST_OUTPUT_SPEED = 1e-100
 
 #: The accuracy the solver is held to: relative error of P(0, v) over CHECKED_SPEEDS
 #: (independent of the output grid), and of the energy balance (M_3 above).

@@ -360,3 +360,18 @@ def test_a_study_whose_bins_need_more_memory_than_a_job_may_use_is_refused():
     studies["r075"]["simulation"] = {"velocity_bins": {"lo": -24, "hi": 20, "width": 1.0e-3}}
     with pytest.raises(ValueError, match=r"velocity_bins .*the shards of r075 \(run c3\)"):
         study_runs(studies, _default_config())
+
+
+@pytest.mark.parametrize(
+    "key, value",
+    [
+        ("solver.output_speeds.min", 1.0e-120),
+        ("solver.position_grid.min", 1.0e-310),
+        ("solver.position_grid.max", 1.0e13),
+        ("exact.position_grid.min", 1.0e-310),
+    ],
+)
+def test_a_grid_beyond_what_the_library_computes_is_refused_naming_the_key(key, value):
+    config = _set(_small_config(), key, value)
+    with pytest.raises(ValueError, match=rf"config: {key}: .*(less|greater) than the m"):
+        check_config(config, _schema())

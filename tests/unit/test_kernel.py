@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from bouncing_ball.kernel import kernel_small_u_limit, return_speed_kernel
+from bouncing_ball.kernel import kernel_small_u_limit, return_speed_density, return_speed_kernel
 
 SPEEDS = np.geomspace(1e-12, 1e3, 46)
 
@@ -93,9 +93,33 @@ def test_return_probability_is_one(u):
 
 
 def test_small_u_limit():
+    # the limit's relative correction is O(u max(1, 1 / v)) (its docstring): u / 2 at v = 20
     v = np.array([1e-3, 0.5, 3.0, 20.0])
     u = 1e-9 * v
-    np.testing.assert_allclose(return_speed_kernel(v, u), kernel_small_u_limit(v, u), rtol=1e-8)
+    relative = return_speed_kernel(v, u) / kernel_small_u_limit(v, u) - 1.0
+    assert np.all(np.abs(relative) <= u * np.maximum(1.0, 1.0 / v))
+
+
+@pytest.mark.parametrize(
+    ("v", "u"),
+    [(1e155, 1.0), (1e200, 1.0), (1.0, 1e300), (1e300, 1e300), (1e-200, 1e-200), (100.0, 5e-324)],
+)
+def test_return_speed_density_is_finite_at_extreme_speeds(v, u):
+    """v G_g(v, u) in logs: 0 where it underflows, never NaN; where it is positive, the
+    scale-free limits hold: v G_g(v, v) (v)^(1/2) -> 0.3454941494712 for large v (the Gaussian
+    peak of width ~v^(1/2)), v G_g ~ (3^(1/2) / pi) / (2 v) ... at v = u -> 0 and the small-u
+    limit at u << v."""
+    value = float(return_speed_density(v, u))
+    assert np.isfinite(value) and value >= 0.0
+    if v == u and v > 1.0:
+        assert value * np.sqrt(v) == pytest.approx(0.3454941494712, rel=1e-10)
+    elif v == u:
+        # scale-free: v G_g(v, v) = 1 / v times its value at v = u = 1e-100, to rounding
+        assert value * v == pytest.approx(float(return_speed_density(1e-100, 1e-100)) * 1e-100)
+    elif u < 1e-300:
+        assert value == pytest.approx(v * kernel_small_u_limit(v, u), rel=1e-12)
+    else:
+        assert value == 0.0  # e^(-(3/4) v) underflows
 
 
 def test_tau_rule_is_converged():
