@@ -187,11 +187,12 @@ def _temporary_cache_folder() -> Path | None:
 
 
 def cache_base(preferred: Path) -> Path:
-    """The folder that holds numba's cache folders: ``preferred`` (NUMBA_CACHE_DIR, else the
-    package's ``__pycache__``), else the user's cache folder (``user_cache_folder``), else,
-    with a one-line warning, ``bouncing_ball-<user id>`` in the temporary folder (a
-    container with a read-only install and no home: compiled code then lasts as long as
-    that folder).
+    """The first writable folder for numba's cache folders, warning if it is a temporary one.
+
+    ``preferred`` (NUMBA_CACHE_DIR, else the package's ``__pycache__``), else the user's
+    cache folder (``user_cache_folder``), else, with a one-line warning,
+    ``bouncing_ball-<user id>`` in the temporary folder (a container with a read-only install
+    and no home: compiled code then lasts as long as that folder).
 
     Parameters
     ----------
