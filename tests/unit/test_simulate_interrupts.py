@@ -23,7 +23,7 @@ import bouncing_ball as bb
 from bouncing_ball import monte_carlo
 
 def interrupt_after_two(self, done):
-    if done == 2 and not hasattr(monte_carlo, "sent"):
+    if done == {after} and not hasattr(monte_carlo, "sent"):
         monte_carlo.sent = time.perf_counter()
         os.killpg(0, signal.SIGINT) if {group} else os.kill(os.getpid(), signal.SIGINT)
 
@@ -36,14 +36,17 @@ if __name__ == "__main__":
     except KeyboardInterrupt as error:
         stopped = time.perf_counter() - monte_carlo.sent
         result = error.result
+        if result is None:
+            print(type(error).__name__, f"{{stopped:.3f}}", len(error.finished), error)
+            sys.exit()
         print(type(error).__name__, f"{{stopped:.3f}}", result.shards, result.requested_shards,
               result.partial, "PARTIAL" in repr(result), bool(result.summary.partial.iloc[0]))
 """
 
 
-def _interrupted_run(processes, group, shards, shard_time):
+def _interrupted_run(processes, group, shards, shard_time, after=2):
     script = _INTERRUPTED_CHILD.format(
-        group=group, shards=shards, shard_time=shard_time, processes=processes
+        group=group, shards=shards, shard_time=shard_time, processes=processes, after=after
     )
     run = subprocess.run(
         [sys.executable, "-c", script],
@@ -75,6 +78,12 @@ def test_ctrl_c_in_this_process_stops_after_the_shard_under_way_keeping_it():
     assert name == "SimulationInterrupted"
     assert (int(finished), int(requested)) == (2, 50)  # the interrupt came with shard 2's end
     assert (partial, shown, in_summary) == ("True", "True", "True")
+
+
+def test_ctrl_c_with_one_shard_finished_says_there_is_no_result():
+    words = _interrupted_run(processes=1, group=False, shards=50, shard_time=1.0e5, after=1)
+    assert words[0] == "SimulationInterrupted" and words[2] == "1"
+    assert "1 of 50 shards finished: too few for a result" in " ".join(words)
 
 
 def _children(pid):
