@@ -2,6 +2,7 @@
 keeps the finished shards (a partial SimulationResult) and stops at once with worker
 processes, the workers die with their parent, a shard with no collision is refused."""
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -48,15 +49,20 @@ def _interrupted_run(processes, group, shards, shard_time, after=2):
     script = _INTERRUPTED_CHILD.format(
         group=group, shards=shards, shard_time=shard_time, processes=processes, after=after
     )
-    run = subprocess.run(
+    child = subprocess.Popen(
         [sys.executable, "-c", script],
-        capture_output=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
         text=True,
-        timeout=120,
         start_new_session=True,  # its own process group, for a terminal's Ctrl-C
     )
-    assert run.returncode == 0, run.stderr
-    return run.stdout.split()
+    try:
+        stdout, stderr = child.communicate(timeout=120)
+    finally:  # whatever happened, nothing of the child's group outlives the test
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(child.pid, signal.SIGKILL)
+    assert child.returncode == 0, stderr
+    return stdout.split()
 
 
 @pytest.mark.parametrize("group", [False, True], ids=["notebook", "terminal"])
