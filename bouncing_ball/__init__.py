@@ -24,6 +24,7 @@ __all__ = [
     "ExactEquilibrium",
     "simulate",
     "SimulationResult",
+    "SimulationInterrupted",
     "PACKAGE",
     "source_digest",
     "__version__",
@@ -35,6 +36,7 @@ _LAZY = {
     "ExactEquilibrium": "equilibrium",
     "simulate": "monte_carlo",
     "SimulationResult": "monte_carlo",
+    "SimulationInterrupted": "monte_carlo",
 }
 
 

@@ -19,7 +19,8 @@ Two faults are survived rather than passed on to every job: a checkout that
 cannot be written to (a shared read-only install) caches under the user's
 cache folder instead (``$XDG_CACHE_HOME/bouncing_ball``, else
 ``~/.cache/bouncing_ball``), where numba would otherwise recompile in every
-process; and a damaged cache file (a truncated write, a full disk) is a cache
+process, and where that cannot be written either (a container with no home) under
+the temporary folder, saying so in one line (``cache_base``); and a damaged cache file (a truncated write, a full disk) is a cache
 miss, reported with its folder, removed and recompiled, where numba would raise
 ``UnpicklingError`` in every job.
 """
@@ -49,6 +50,7 @@ __all__ = [
     "prune_caches",
     "user_cache_folder",
     "writable_cache_base",
+    "cache_base",
     "RecoveringFunctionCache",
 ]
 
@@ -111,16 +113,35 @@ def prune_caches(
     return removed
 
 
-def user_cache_folder() -> Path:
+def user_cache_folder() -> Path | None:
     """Where the cache goes when the checkout cannot be written to.
 
     Returns
     -------
-    pathlib.Path
-        ``$XDG_CACHE_HOME/bouncing_ball``, else ``~/.cache/bouncing_ball``.
+    pathlib.Path or None
+        ``$XDG_CACHE_HOME/bouncing_ball``, else ``~/.cache/bouncing_ball``; None with
+        neither a ``XDG_CACHE_HOME`` nor a home folder.
     """
-    root = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    root = os.environ.get("XDG_CACHE_HOME")
+    if not root:
+        try:
+            root = Path.home() / ".cache"
+        except (RuntimeError, KeyError):  # no HOME and no entry in the password database
+            return None
     return Path(root) / "bouncing_ball"
+
+
+def _is_writable(folder: Path | None) -> bool:
+    """Whether a cache folder can be made and written in ``folder``."""
+    if folder is None:
+        return False
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+        return True
+    except OSError:
+        return False
 
 
 def writable_cache_base(preferred: Path, fallback: Path) -> Path:
@@ -144,13 +165,68 @@ def writable_cache_base(preferred: Path, fallback: Path) -> Path:
     >>> writable_cache_base(folder / "cache", folder / "other") == folder / "cache"
     True
     """
+    return preferred if _is_writable(preferred) else fallback
+
+
+def _temporary_cache_folder() -> Path | None:
+    """``bouncing_ball-<user id>`` in the temporary folder, made private to this user; a
+    fresh folder where that name is another user's (who could plant compiled code in it);
+    None with no writable temporary folder."""
     try:
-        preferred.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=preferred):
-            pass
-        return preferred
-    except OSError:
-        return fallback
+        user = os.getuid()
+        folder = Path(tempfile.gettempdir()) / f"bouncing_ball-{user}"
+        folder.mkdir(mode=0o700, exist_ok=True)
+        if folder.is_symlink() or folder.stat().st_uid != user:
+            folder = Path(tempfile.mkdtemp(prefix="bouncing_ball-"))
+        return folder
+    except (OSError, AttributeError):  # no temporary folder; no getuid (Windows)
+        try:
+            return Path(tempfile.mkdtemp(prefix="bouncing_ball-"))
+        except OSError:
+            return None
+
+
+def cache_base(preferred: Path) -> Path:
+    """The first writable folder for numba's cache folders, warning if it is a temporary one.
+
+    ``preferred`` (NUMBA_CACHE_DIR, else the package's ``__pycache__``), else the user's
+    cache folder (``user_cache_folder``), else, with a one-line warning,
+    ``bouncing_ball-<user id>`` in the temporary folder (a container with a read-only install
+    and no home: compiled code then lasts as long as that folder).
+
+    Parameters
+    ----------
+    preferred : pathlib.Path
+        The folder wanted.
+
+    Returns
+    -------
+    pathlib.Path
+        The first of them that can be written to.
+
+    Raises
+    ------
+    RuntimeError
+        Saying to set NUMBA_CACHE_DIR, where none of them can be written to.
+    """
+    fallback = user_cache_folder()
+    for folder in (preferred, fallback):
+        if _is_writable(folder):
+            return folder
+    temporary = _temporary_cache_folder()
+    if not _is_writable(temporary):
+        raise RuntimeError(
+            f"no folder for numba's cache can be written to ({preferred}, {fallback}, the "
+            "temporary folder): set NUMBA_CACHE_DIR to a writable folder"
+        )
+    logging.getLogger(__name__).warning(
+        "bouncing_ball: %s and %s cannot be written to; numba caches compiled code in %s "
+        "(set NUMBA_CACHE_DIR to a writable folder to keep it)",
+        preferred,
+        fallback if fallback is not None else "the user's cache folder (no HOME)",
+        temporary,
+    )
+    return temporary
 
 
 class RecoveringFunctionCache(FunctionCache):
@@ -301,7 +377,7 @@ COMPILED = (
 )
 
 _preferred = Path(numba.config.CACHE_DIR) if numba.config.CACHE_DIR else PACKAGE / "__pycache__"
-_base = writable_cache_base(_preferred, user_cache_folder())
+_base = cache_base(_preferred)
 #: numba's cache folder, named after the source of the modules of ``COMPILED``.
 CACHE = _base / f"numba-{source_digest(COMPILED)}"
 numba.config.CACHE_DIR = str(CACHE)

@@ -6,10 +6,17 @@ It is the workflow's machinery, called directly: shard k of r draws from
 ``simulation.shard_seed_sequence(seed, label of r, k)`` (``batches.simulate_batch``), so a
 shard of ``simulate`` is the workflow's shard k for the same seed and settings, whatever the
 number of processes; the tables are ``histograms``' (the workflow's merge stage).
+
+A Ctrl-C keeps the shards that finished (``SimulationInterrupted``), and the worker processes
+never outlive the process that started them (``_watch_parent``).
 """
 
+import contextlib
 import math
+import os
+import signal
 import sys
+import threading
 import time
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -18,8 +25,9 @@ from functools import cached_property
 import numpy as np
 
 from .restitution import parse_restitution, restitution_label
+from .settings import MAX_SHARDS, ShardSettings, real_number
 
-__all__ = ["simulate", "SimulationResult", "DEFAULT_SETTINGS"]
+__all__ = ["simulate", "SimulationResult", "SimulationInterrupted", "DEFAULT_SETTINGS"]
 
 # the shard settings ``simulate`` uses where it is not told otherwise (the default config's
 # ``simulation`` section holds the workflow's); every bin set is ``ShardSettings``' default
@@ -34,8 +42,6 @@ DEFAULT_SETTINGS = {
 def _shard_settings(shard_time, settings):
     """The ``ShardSettings`` of a call: ``settings`` (a ShardSettings, or a mapping of
     overrides of DEFAULT_SETTINGS) with ``shard_time``."""
-    from .settings import ShardSettings
-
     if isinstance(settings, ShardSettings):
         if shard_time is None:
             return settings
@@ -60,7 +66,9 @@ def _shard_settings(shard_time, settings):
         raise ValueError("settings: give shard_time as simulate's own argument, not in settings")
     if shard_time is None:
         raise TypeError("simulate needs shard_time, the simulated time each shard records")
-    _positive_number(shard_time, "shard_time")
+    shard_time = real_number(shard_time, "shard_time")
+    if not 0.0 < shard_time < math.inf:
+        raise ValueError(f"shard_time must be positive and finite, got {shard_time!r}")
     try:
         return ShardSettings.from_mapping(
             {**DEFAULT_SETTINGS, **overrides, "shard_time": shard_time}
@@ -69,26 +77,201 @@ def _shard_settings(shard_time, settings):
         raise ValueError(f"settings: {error}") from None
 
 
-def _positive_number(value, name):
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise TypeError(f"{name} must be a number, got {value!r}")
-    if not (math.isfinite(value) and value > 0):
-        raise ValueError(f"{name} must be positive and finite, got {value!r}")
-
-
-def _whole_number(value, name, least):
+def _whole_number(value, name, least, most=None):
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise TypeError(f"{name} must be a whole number, got {value!r}")
     if value < least:
         raise ValueError(f"{name} must be >= {least}, got {value}")
+    if most is not None and value > most:
+        raise ValueError(f"{name} must be <= {most}, got {value}")
     return int(value)
 
 
-def _run_shard(restitution, seed, label, shard, settings):
+def _run_shard(restitution, seed, label, settings, shard):
     """One shard on its own stream (a module-level function: picklable for spawned workers)."""
     from .simulation import shard_seed_sequence, simulate_shard  # numba: only where it runs
 
     return shard, simulate_shard(restitution, shard_seed_sequence(seed, label, shard), settings)
+
+
+#: Seconds between a worker's checks that the process that started it is alive.
+PARENT_CHECK_INTERVAL = 0.2
+
+
+def _exit_with_parent_on_linux():
+    """Ask Linux to SIGKILL this process when the thread that started it ends (prctl's
+    PR_SET_PDEATHSIG): it reaches a worker busy in compiled code, which holds the GIL and so
+    keeps its watch thread from running.  Elsewhere a no-op."""
+    if not sys.platform.startswith("linux"):
+        return
+    import ctypes
+
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # 1: PR_SET_PDEATHSIG
+
+
+def _watch_parent(parent):
+    """The initializer of a worker of ``simulate``: ignore Ctrl-C, which the parent handles
+    (a terminal sends it to every process of the job), and exit as soon as the parent
+    ``parent`` (its pid) is gone, whatever killed it: on Linux at once, elsewhere at the
+    worker's next check (``PARENT_CHECK_INTERVAL``) outside compiled code."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _exit_with_parent_on_linux()
+
+    def watch():
+        while os.getppid() == parent:
+            time.sleep(PARENT_CHECK_INTERVAL)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="watch-parent", daemon=True).start()
+    if os.getppid() != parent:  # died before the watch began
+        os._exit(1)
+
+
+def _stop_workers(pool):
+    """Cancel the queued shards of ``pool`` and kill its workers (mid-shard: their work is
+    lost, the finished shards are not)."""
+    # the executor's own list of its workers (no public way to stop them before Python 3.14's
+    # ``kill_workers``); taken before ``shutdown``, which forgets it
+    workers = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for worker in workers:
+        with contextlib.suppress(OSError, ValueError):
+            worker.kill()
+    for worker in workers:
+        with contextlib.suppress(OSError, ValueError):
+            worker.join(timeout=5.0)
+
+
+def _run_in_workers(arguments, shards, processes, finished, on_finished):
+    """Run shards 0 .. ``shards`` - 1 on ``processes`` spawned workers, putting each shard's
+    tallies in ``finished`` as it ends; on any exception (a Ctrl-C) the finished ones are
+    kept, the rest cancelled and the workers killed before it propagates."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    pool = ProcessPoolExecutor(
+        max_workers=processes,
+        mp_context=multiprocessing.get_context("spawn"),
+        initializer=_watch_parent,
+        initargs=(os.getpid(),),
+    )
+    futures = []
+    try:
+        futures.extend(pool.submit(_run_shard, *arguments, index) for index in range(shards))
+        for future in as_completed(futures):
+            index, shard_tallies = future.result()
+            finished[index] = shard_tallies
+            on_finished()
+    except BaseException:
+        for future in futures:  # done while the exception was raised
+            if future.done() and not future.cancelled() and future.exception() is None:
+                index, shard_tallies = future.result()
+                finished[index] = shard_tallies
+        _stop_workers(pool)
+        raise
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+@contextlib.contextmanager
+def _interrupt_between_shards():
+    """Within it, a Ctrl-C in the main thread (SIGINT: a terminal's or a notebook's interrupt)
+    sets the flag it yields (a list, true once interrupted) instead of raising inside a
+    shard; elsewhere (another thread) Ctrl-C is Python's as usual."""
+    flag = []
+    if threading.current_thread() is not threading.main_thread():
+        yield flag
+        return
+    previous = signal.signal(signal.SIGINT, lambda number, frame: flag.append(number))
+    try:
+        yield flag
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _run_here(arguments, shards, finished, on_finished):
+    """Run the shards one after the other in this process; a Ctrl-C stops the run when the
+    shard under way ends (the compiled loop does not see signals), keeping it."""
+    with _interrupt_between_shards() as interrupted:
+        for index in range(shards):
+            finished[index] = _run_shard(*arguments, index)[1]
+            on_finished()
+            if interrupted:
+                raise KeyboardInterrupt
+
+
+def _check_recorded(tallies, settings):
+    """Refuse shards (``{index: ShardTallies}``) that recorded no time (the step budget ran
+    out in equilibration) or no flight: every estimate needs collisions in every shard (the
+    jackknife error is the scatter between the shards), and I = 0 +- 0 would be a claim."""
+    for index, shard_tallies in sorted(tallies.items()):
+        if not shard_tallies.time > 0.0:
+            raise RuntimeError(
+                f"shard {index} recorded no time: its step budget (max_steps = "
+                f"{settings.max_steps}) ran out during equilibration; raise max_steps or "
+                "shorten equilibration_time"
+            )
+    empty = [index for index, shard_tallies in sorted(tallies.items()) if shard_tallies.flights < 1]
+    if empty:
+        raise ValueError(
+            f"shard_time = {settings.shard_time!r} is too short: {len(empty)} of {len(tallies)} "
+            f"shards (the first: shard {empty[0]}) recorded no collision ending a flight, and "
+            "every estimate needs collisions in every shard (the errors are the scatter "
+            "between shards); use a shard_time of many mean flight times <T> = 1/I "
+            "(eq. (collrate))"
+        )
+
+
+class SimulationInterrupted(KeyboardInterrupt):
+    """``simulate`` stopped by a Ctrl-C: a KeyboardInterrupt (a script stops as it would
+    anyway) that holds the shards that finished.
+
+    Attributes
+    ----------
+    result : SimulationResult or None
+        The finished shards' result, marked partial (``result.partial``); None with fewer
+        than 2 finished shards (an error needs two) or shards that recorded nothing.
+    finished : dict
+        {shard index: tallies.ShardTallies} of every shard that finished.
+    requested : int
+        The shards asked for.
+    """
+
+    def __init__(self, message, result, finished, requested):
+        super().__init__(message)
+        self.result, self.finished, self.requested = result, finished, requested
+
+
+def _interrupted(exact, seed, settings, finished, requested):
+    """The ``SimulationInterrupted`` of a run stopped with ``finished`` shards done."""
+    done = sorted(finished)
+    head = f"simulate r={exact} interrupted: {len(done)} of {requested} shards finished"
+    result, why = None, None
+    if len(done) < 2:
+        why = "too few for a result (an error needs 2 shards)"
+    else:
+        try:
+            _check_recorded(finished, settings)
+        except (RuntimeError, ValueError) as error:
+            why = f"no result: {error}"
+        else:
+            result = SimulationResult(
+                restitution=exact,
+                seed=seed,
+                settings=settings,
+                tallies=tuple(finished[index] for index in done),
+                shard_indices=tuple(done),
+                requested_shards=requested,
+            )
+    if result is not None:
+        message = (
+            f"{head} ({', '.join(map(str, done))}); their SimulationResult, marked partial, "
+            "is this exception's `result` (in IPython or Jupyter: `sys.last_value.result`)"
+        )
+    else:
+        message = f"{head}: {why}; their tallies are this exception's `finished`"
+    return SimulationInterrupted(message, result, dict(finished), requested)
 
 
 class _Progress:
@@ -124,10 +307,13 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
         as ``"1/3"``, 0 < r < 1.  Below r_c (eq. (rc)) the collapse needs
         ``settings={"min_step_floor": ...}``.
     shards : int
-        Independent shards, >= 2 (every error bar is the scatter between them).
+        Independent shards, 2 to ``settings.MAX_SHARDS`` (every error bar is the scatter
+        between them).
     shard_time : float
-        Simulated time each shard records, after its equilibration time (may be left out when
-        ``settings`` is a ``ShardSettings``, which holds one).
+        Simulated time each shard records, after its equilibration time, positive and finite
+        (a Python or numpy scalar; may be left out when ``settings`` is a ``ShardSettings``,
+        which holds one).  Every shard must record collisions: a run whose shards are too
+        short for that is refused after it ran (ValueError).
     seed : int, optional
         Root seed of the random streams; shard k draws from
         ``simulation.shard_seed_sequence(seed, label of r, k)``, as in the workflow.  None
@@ -136,11 +322,14 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
         The shard settings (``settings.ShardSettings``), or a dict overriding some of
         ``DEFAULT_SETTINGS`` and ``ShardSettings``' defaults (equilibration_time, criterion_c,
         min_step_divisor, max_steps, speed_bins, position_bins, velocity_bins,
-        flight_time_bins, min_step_floor).
+        flight_time_bins, min_step_floor).  Their ranges are ``ShardSettings``', the
+        workflow's config check's: c of eq. (criterion) at least ``MIN_CRITERION_C``,
+        min_step_floor at most ``MAX_MIN_STEP_FLOOR``.
     processes : int, optional
-        Worker processes (spawned); 1 runs the shards in this process.  The numbers do not
-        depend on it.  A script that uses more than one must call ``simulate`` under
-        ``if __name__ == "__main__":``.
+        Worker processes (spawned), >= 1; 1 runs the shards in this process.  The numbers do
+        not depend on it.  A script that uses more than one must call ``simulate`` under
+        ``if __name__ == "__main__":``.  The workers exit when the process that started them
+        dies, however it dies.
     progress : bool, optional
         Show the shards done on stderr, when stderr is a terminal.
 
@@ -149,21 +338,41 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
     SimulationResult
         The merged tables and the observables with their errors.
 
+    Raises
+    ------
+    SimulationInterrupted
+        On Ctrl-C (a KeyboardInterrupt, in a terminal or a notebook), holding the shards
+        that finished: ``error.result`` is their ``SimulationResult`` marked partial (None
+        with fewer than 2), ``error.finished`` their tallies.  With ``processes`` >= 2 the
+        run stops at once, the shards under way lost.  With ``processes=1`` the shards run in
+        this process in compiled code, which does not see signals: the run stops when the
+        shard under way ends, and keeps it; so a Ctrl-C waits up to one shard's run time.
+    ValueError
+        Naming the argument out of its range; or, after the run, a shard_time too short for
+        a collision in every shard.
+
     Examples
     --------
     >>> from bouncing_ball import simulate
     >>> result = simulate("1/2", shards=4, shard_time=200.0, seed=1,
     ...                   settings={"equilibration_time": 20.0}, progress=False)
-    >>> result.shards, result.total_time
-    (4, 800.0)
+    >>> result.shards, result.total_time, result.partial
+    (4, 800.0, False)
     >>> sorted(result.summary.columns)[:4]
     ['collision_rate', 'collision_rate_controlled', 'collision_rate_controlled_err', 'collision_rate_err']
+
+    A Ctrl-C keeps what finished:
+
+    >>> try:                                                      # doctest: +SKIP
+    ...     result = simulate(0.6, shards=64, shard_time=1e7)
+    ... except KeyboardInterrupt as error:
+    ...     result = error.result  # the finished shards, result.partial is True
     """
     from .asymptotics import CRITICAL_RESTITUTION
 
     exact = parse_restitution(r, "r")
     label = restitution_label(exact)
-    shards = _whole_number(shards, "shards", 2)
+    shards = _whole_number(shards, "shards", 2, MAX_SHARDS)
     processes = _whole_number(processes, "processes", 1)
     run_settings = _shard_settings(shard_time, settings)
     if exact < CRITICAL_RESTITUTION and not run_settings.min_step_floor > 0.0:
@@ -176,41 +385,26 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
         seed = int(np.random.SeedSequence().entropy)
     seed = _whole_number(seed, "seed", 0)
     progress_line = _Progress(label, shards, progress)
-    tallies = {}
+    finished = {}
+    arguments = (float(exact), seed, label, run_settings)
     progress_line.show(0)
     try:
         if processes == 1:
-            for index in range(shards):
-                tallies[index] = _run_shard(float(exact), seed, label, index, run_settings)[1]
-                progress_line.show(len(tallies))
+            _run_here(arguments, shards, finished, lambda: progress_line.show(len(finished)))
         else:
-            import multiprocessing
-            from concurrent.futures import ProcessPoolExecutor, as_completed
-
-            context = multiprocessing.get_context("spawn")
-            with ProcessPoolExecutor(max_workers=processes, mp_context=context) as pool:
-                futures = [
-                    pool.submit(_run_shard, float(exact), seed, label, index, run_settings)
-                    for index in range(shards)
-                ]
-                for future in as_completed(futures):
-                    index, shard_tallies = future.result()
-                    tallies[index] = shard_tallies
-                    progress_line.show(len(tallies))
+            _run_in_workers(
+                arguments, shards, processes, finished, lambda: progress_line.show(len(finished))
+            )
+    except KeyboardInterrupt:
+        raise _interrupted(exact, seed, run_settings, finished, shards) from None
     finally:
         progress_line.close()
-    for index, shard_tallies in tallies.items():
-        if not shard_tallies.time > 0.0:
-            raise RuntimeError(
-                f"shard {index} recorded no time: its step budget (max_steps = "
-                f"{run_settings.max_steps}) ran out during equilibration; raise max_steps or "
-                "shorten equilibration_time"
-            )
+    _check_recorded(finished, run_settings)
     return SimulationResult(
         restitution=exact,
         seed=seed,
         settings=run_settings,
-        tallies=tuple(tallies[index] for index in range(shards)),
+        tallies=tuple(finished[index] for index in range(shards)),
     )
 
 
@@ -228,6 +422,12 @@ class SimulationResult:
     settings : settings.ShardSettings
     tallies : tuple of tallies.ShardTallies
         Each shard's tallies, in the order of the shards (the raw data).
+    shard_indices : tuple of int
+        The index of each shard of ``tallies`` (its random stream); 0 .. shards - 1 unless
+        the run was interrupted.
+    requested_shards : int
+        The shards asked for; ``partial`` (shown in the repr and the summary) when fewer
+        finished: a run stopped by Ctrl-C (``SimulationInterrupted``).
     merged : tallies.ShardTallies
         Their sum.
     collision_rate, mean_x, delta_x, mean_flight_time, flight_time_second_moment : float
@@ -264,6 +464,23 @@ class SimulationResult:
     seed: int
     settings: object
     tallies: tuple = field(repr=False)
+    shard_indices: tuple = field(default=None, repr=False)
+    requested_shards: int = None
+
+    def __post_init__(self):
+        if self.shard_indices is None:
+            object.__setattr__(self, "shard_indices", tuple(range(len(self.tallies))))
+        if self.requested_shards is None:
+            object.__setattr__(self, "requested_shards", len(self.tallies))
+        if len(self.shard_indices) != len(self.tallies):
+            raise ValueError(
+                f"shard_indices: {len(self.shard_indices)} indices for {len(self.tallies)} shards"
+            )
+
+    @property
+    def partial(self) -> bool:
+        """True when fewer shards finished than were asked for (an interrupted run)."""
+        return self.shards < self.requested_shards
 
     @property
     def r(self) -> float:
@@ -291,7 +508,8 @@ class SimulationResult:
     def summary(self):
         from .histograms import position_moments_summary
 
-        return position_moments_summary(list(self.tallies), self.r)
+        summary = position_moments_summary(list(self.tallies), self.r)
+        return summary.assign(requested_shards=self.requested_shards, partial=self.partial)
 
     def _scalar(self, name) -> float:
         return float(self.summary[name].iloc[0])
@@ -370,7 +588,7 @@ class SimulationResult:
         ``results/simulation/r{r}/shards{first}-{last}.parquet``)."""
         from .workflow.batches import batch_to_frame
 
-        return batch_to_frame(dict(enumerate(self.tallies)))
+        return batch_to_frame(dict(zip(self.shard_indices, self.tallies)))
 
     def __repr__(self):
         row = self.summary.iloc[0]
@@ -379,7 +597,13 @@ class SimulationResult:
             return f"{symbol} = {row[name]:.6g} +- {row[name + '_err']:.2g}"
 
         return (
-            f"SimulationResult(r={self.restitution}, shards={self.shards}, seed={self.seed}, "
+            f"SimulationResult(r={self.restitution}, "
+            + (
+                f"PARTIAL: shards={self.shards} of {self.requested_shards} (interrupted), "
+                if self.partial
+                else f"shards={self.shards}, "
+            )
+            + f"seed={self.seed}, "
             f"total time {row.total_time:.6g}, {int(row.collisions)} collisions, "
             f"{int(row.steps)} steps): "
             + ", ".join(

@@ -8,6 +8,8 @@ The number of shards is not a shard setting: adding shards leaves the
 existing ones alone.
 """
 
+import math
+import numbers
 from dataclasses import asdict, dataclass, fields, replace
 
 from .bins import LinearBins, LogBins, linear_bins, log_bins
@@ -15,6 +17,10 @@ from .bins import LinearBins, LogBins, linear_bins, log_bins
 __all__ = [
     "ShardSettings",
     "MAX_STEPS_LIMIT",
+    "MIN_CRITERION_C",
+    "MAX_MIN_STEP_FLOOR",
+    "MAX_SHARDS",
+    "real_number",
     "DEFAULT_SPEED_BINS",
     "DEFAULT_POSITION_BINS",
     "DEFAULT_VELOCITY_BINS",
@@ -25,6 +31,20 @@ __all__ = [
 #: The largest step budget: far beyond any shard (10^15 steps are years of CPU), far inside
 #: the compiled loop's 64-bit step counter (9.2e18); the config schema repeats it.
 MAX_STEPS_LIMIT = 10**15
+
+#: The smallest c of eq. (criterion): below about 2 a step overshoots excursions below the
+#: floor that it cannot see, and the results are biased (docs/validation.md, the criterion-bias
+#: study; the default 3 keeps a margin above it).  The config schema repeats it.
+MIN_CRITERION_C = 2.0
+
+#: The largest min_step_floor: it regularises the collapse below r_c at speeds of order
+#: (2 floor)^(1/2) (docs/methods.md, below r_c); a larger floor moves the speeds the
+#: simulation resolves into the range it reports.  The config schema repeats it.
+MAX_MIN_STEP_FLOOR = 1.0e-6
+
+#: The most shards of one r (``simulate``'s ``shards``, the config's ``simulation.shards``):
+#: the merge holds every shard's tallies.  The config schema repeats it.
+MAX_SHARDS = 10**6
 
 # the bins of the tallies, when a config or a caller does not name them (the default config
 # names them; config/README.md says why these)
@@ -53,7 +73,8 @@ class ShardSettings:
     equilibration_time : float
         Simulated time run and discarded first, >= 0.
     criterion_c : float
-        The constant c of the step criterion, eq. (criterion), > 0.
+        The constant c of the step criterion, eq. (criterion), at least ``MIN_CRITERION_C``
+        (below it the results are biased).
     min_step_divisor : float
         After each collision the step is sqrt(2 Delta) = v_out / min_step_divisor, > 0.
     max_steps : int
@@ -63,15 +84,20 @@ class ShardSettings:
     position_bins : LogBins or dict
         Bins of heights, P(x) and <v^2>_x.
     min_step_floor : float
-        Lower bound on the step Delta, >= 0 (0: the paper's rule alone).
+        Lower bound on the step Delta, 0 (the paper's rule alone) to ``MAX_MIN_STEP_FLOOR``.
     velocity_bins : LinearBins or dict
         Bins of v of the 2-D P(x, v), its x-bins being ``position_bins`` (a dict:
         ``{lo, hi, width}``).
     flight_time_bins : LogBins or dict
         Bins of the times between collisions.
 
+    Every number may be a Python or a numpy scalar; the times, c, the divisor and the floor
+    must be finite.
+
     Raises
     ------
+    TypeError
+        Naming a setting that is not a real number (a string, a bool).
     ValueError
         Naming every setting out of its range, or a max_steps that is not a whole number.
 
@@ -104,10 +130,16 @@ class ShardSettings:
     flight_time_bins: LogBins = DEFAULT_FLIGHT_TIME_BINS  # times between collisions
 
     def __post_init__(self):
-        for name in ("shard_time", "equilibration_time", "criterion_c", "min_step_divisor"):
-            object.__setattr__(self, name, float(getattr(self, name)))
-        object.__setattr__(self, "min_step_floor", float(self.min_step_floor))
-        if isinstance(self.max_steps, float) and not self.max_steps.is_integer():
+        for name in (
+            "shard_time",
+            "equilibration_time",
+            "criterion_c",
+            "min_step_divisor",
+            "min_step_floor",
+        ):
+            object.__setattr__(self, name, real_number(getattr(self, name), name))
+        max_steps = real_number(self.max_steps, "max_steps")
+        if not max_steps.is_integer():
             raise ValueError(f"max_steps must be a whole number, got {self.max_steps}")
         object.__setattr__(self, "max_steps", int(self.max_steps))
         for name in ("speed_bins", "position_bins", "flight_time_bins"):
@@ -119,16 +151,26 @@ class ShardSettings:
         problems = [
             f"{name} = {getattr(self, name)} must be {rule}"
             for name, rule, holds in (
-                ("shard_time", "positive", self.shard_time > 0.0),
-                ("equilibration_time", "0 or more", self.equilibration_time >= 0.0),
-                ("criterion_c", "positive", self.criterion_c > 0.0),
-                ("min_step_divisor", "positive", self.min_step_divisor > 0.0),
+                ("shard_time", "positive", 0.0 < self.shard_time < math.inf),
+                ("equilibration_time", "0 or more", 0.0 <= self.equilibration_time < math.inf),
+                (
+                    "criterion_c",
+                    f"at least {MIN_CRITERION_C:g} (below it a step overshoots excursions "
+                    "below the floor it cannot see, and the results are biased)",
+                    MIN_CRITERION_C <= self.criterion_c < math.inf,
+                ),
+                ("min_step_divisor", "positive", 0.0 < self.min_step_divisor < math.inf),
                 (
                     "max_steps",
                     f"between 1 and {MAX_STEPS_LIMIT:.0e}",
                     1 <= self.max_steps <= MAX_STEPS_LIMIT,
                 ),
-                ("min_step_floor", "0 or more", self.min_step_floor >= 0.0),
+                (
+                    "min_step_floor",
+                    f"between 0 and {MAX_MIN_STEP_FLOOR:g} (a larger floor biases the speeds "
+                    "the simulation reports)",
+                    0.0 <= self.min_step_floor <= MAX_MIN_STEP_FLOOR,
+                ),
             )
             if not holds
         ]
@@ -185,3 +227,39 @@ class ShardSettings:
         ShardSettings
         """
         return replace(self, **changes)
+
+
+def real_number(value, name: str) -> float:
+    """``value`` as a float, if it is a real number: a Python or numpy integer or float.
+
+    Parameters
+    ----------
+    value : object
+        The value given.
+    name : str
+        The argument's name, for the message.
+
+    Returns
+    -------
+    float
+        ``float(value)`` (which may be NaN or infinite: the caller states the range).
+
+    Raises
+    ------
+    TypeError
+        Naming ``name``, for anything else (a bool, a string, None, an array).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bouncing_ball.settings import real_number
+    >>> real_number(np.int64(50), "shard_time"), real_number(np.float32(0.5), "shard_time")
+    (50.0, 0.5)
+    >>> real_number("50", "shard_time")
+    Traceback (most recent call last):
+    ...
+    TypeError: shard_time must be a number, got '50'
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name} must be a number, got {value!r}")
+    return float(value)

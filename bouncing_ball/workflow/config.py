@@ -215,8 +215,26 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
                 f"as a target it would be asked for by its label {label}, which is another r "
                 f"({label}); add r = {key} to restitution, or key the override by {label}"
             )
+    check_shard_settings(config)
     check_memory(config)
     return grid
+
+
+def check_shard_settings(config: dict) -> None:
+    """The shard settings of every r (the ``simulation`` section, and it with each override of
+    ``simulation.per_restitution``) checked by ``settings.ShardSettings``, the library's own
+    check: the pipeline and ``simulate`` refuse the same settings.  ValueError naming the
+    section otherwise."""
+    cases = {"simulation": simulation_settings(config, "")}  # no r has the label ""
+    for key in per_restitution(config):
+        cases[f"simulation.per_restitution.{key}"] = simulation_settings(
+            config, restitution_label(parse_restitution(key))
+        )
+    for where, settings in cases.items():
+        try:
+            ShardSettings.from_mapping(settings)
+        except (TypeError, ValueError) as error:
+            raise ValueError(f"{where}: {error}") from None
 
 
 def check_figure_positions(config: dict) -> None:
