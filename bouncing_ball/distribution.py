@@ -118,6 +118,7 @@ __all__ = [
     "SMALLEST_POSITION",
     "LARGEST_POSITION",
     "LARGEST_VELOCITY",
+    "SMALLEST_WEIGHT_FORCE",
     "THETA_MAX",
     "WEDGE_CLEAN",
     "PANEL_CHEBYSHEV_NODES",
@@ -1580,6 +1581,10 @@ LARGEST_POSITION = 1e12
 #: in v of variance <v^2>_x < 4e4 wherever P(x) is a double (x below ~1e7), e^-1000 down at
 #: |v| = 1e4.
 LARGEST_VELOCITY = 1e4
+#: The smallest F of the config's ``solver.forces``: above ``Equilibrium.smallest_force`` (below
+#: which w(F) ~ F^gamma e^(-S/F), S < 0, exceeds the largest double) at every r of
+#: DISTRIBUTION_RESTITUTION_RANGE (1.03e-4 at r = 0.9, the largest).
+SMALLEST_WEIGHT_FORCE = 2e-4
 
 
 def _force_nodes(weight, power, x):

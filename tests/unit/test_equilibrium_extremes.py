@@ -109,6 +109,12 @@ def test_the_schema_bounds_are_the_librarys():
     bounds = defs["$defs"]["position_grid"]["allOf"][1]["properties"]
     assert bounds["min"]["minimum"] == SMALLEST_POSITION
     assert bounds["max"]["maximum"] == LARGEST_POSITION
+    assert defs["$defs"]["positions"]["items"]["anyOf"][1]["maximum"] == LARGEST_POSITION
+    velocities = defs["$defs"]["velocity_grid"]["allOf"][1]["properties"]
+    assert velocities["max"]["maximum"] == -velocities["min"]["minimum"]
+    assert velocities["max"]["maximum"] == distribution.LARGEST_VELOCITY
+    forces = defs["$defs"]["force_grid"]["allOf"][1]["properties"]
+    assert forces["min"]["minimum"] == distribution.SMALLEST_WEIGHT_FORCE
     speeds = defs["properties"]["solver"]["properties"]["output_speeds"]["allOf"][1]
     assert speeds["properties"]["min"]["minimum"] == solver.SMALLEST_OUTPUT_SPEED
     # every r the solver answers writes a finite P(0, v) there (beta < 5/2)
@@ -140,6 +146,8 @@ def test_weight_refuses_forces_where_it_exceeds_the_largest_double():
     with pytest.raises(ValueError, match=r"F = 1e-300 is below smallest_force"):
         eq.weight([1.0, 1e-300])
     assert Equilibrium(0.6).smallest_force == 0.0
+    # the config's solver.forces bound lies above it at every r of the range (the largest, 0.9)
+    assert eq.smallest_force < distribution.SMALLEST_WEIGHT_FORCE
 
 
 @pytest.mark.parametrize("x", [1e4, 1e5])
