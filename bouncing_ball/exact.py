@@ -539,7 +539,8 @@ def weight_function(force, restitution):
     small = z < 1e-100
     log_bessel = np.where(
         small,
-        np.log(0.5 * special.gamma(1.0 / 6.0)) + (np.log(2.0) - np.log(np.where(small, z, 1.0))) / 6.0,
+        np.log(0.5 * special.gamma(1.0 / 6.0))
+        + (np.log(2.0) - np.log(np.where(small, z, 1.0))) / 6.0,
         np.log(special.kve(1.0 / 6.0, np.clip(z, 1e-100, 1e8))),
     )
     log_c = np.log(np.sqrt(2.0 / (27.0 * np.pi)) * a)
