@@ -117,6 +117,8 @@ from .solver import (
 __all__ = [
     "SMALLEST_POSITION",
     "LARGEST_POSITION",
+    "LARGEST_VELOCITY",
+    "SMALLEST_WEIGHT_FORCE",
     "THETA_MAX",
     "WEDGE_CLEAN",
     "PANEL_CHEBYSHEV_NODES",
@@ -1573,6 +1575,16 @@ FORCE_PANEL_SIGMAS = 2.5
 #: spacing of doubles.
 SMALLEST_POSITION = 1e-300
 LARGEST_POSITION = 1e12
+#: Beyond this |v|, P(x, v) is 0 to every double (``Equilibrium.pxv``): on the floor P(0, v) ~
+#: e^(-q v) and P(0, -v) = r^2 P(0, r v) fall below e^-1400 at every r of
+#: DISTRIBUTION_RESTITUTION_RANGE (r q = 0.148 at r = 0.9), and above it P(x, v) is a Gaussian
+#: in v of variance <v^2>_x < 4e4 wherever P(x) is a double (x below ~1e7), e^-1000 down at
+#: |v| = 1e4.
+LARGEST_VELOCITY = 1e4
+#: The smallest F of the config's ``solver.forces``: above ``Equilibrium.smallest_force`` (below
+#: which w(F) ~ F^gamma e^(-S/F), S < 0, exceeds the largest double) at every r of
+#: DISTRIBUTION_RESTITUTION_RANGE (1.03e-4 at r = 0.9, the largest).
+SMALLEST_WEIGHT_FORCE = 2e-4
 
 
 def _force_nodes(weight, power, x):
@@ -1601,19 +1613,6 @@ def _force_nodes(weight, power, x):
     y, wy = _panels(first * width, last * width, width)
     force = np.exp(y)
     log_weights = np.log(wy) + (0.5 - power) * y + weight.log(force) - 1.0 / (12.0 * force)
-    return force, log_weights
-
-
-def _force_quadrature(weight, largest_x=0.0, width=0.5):
-    """Gauss-Legendre nodes in ln F (panels ``width`` wide) from where F^(-1/2) w e^(-1/(12F)) has
-    fallen below e^-100 (and below a twentieth of the saddle point ((S + 1/12)/x)^(1/2) of the
-    largest x) up to F = 1e24, with ln of F^(1/2) w(F) e^(-1/(12F)) dF/dlnF folded in:
-    int dF F^(-1/2) w(F) e^(-1/(12F)) f(F) ~ sum_k exp(log_weights_k) f(F_k)."""
-    total = _total_decay(weight)
-    lo = np.log(min(total / 100.0, np.sqrt(total / max(largest_x, 1e-300)) / 20.0))
-    y, wy = _panels(lo, np.log(1e24), width)
-    force = np.exp(y)
-    log_weights = np.log(wy) + 0.5 * y + weight.log(force) - 1.0 / (12.0 * force)
     return force, log_weights
 
 
@@ -1795,16 +1794,36 @@ def position_averages(weight) -> dict:
     }
 
 
-def _bin_laplace(weight, power, lo, hi):
-    """int dF F^(-1/2 - power) w e^(-1/(12F)) (e^(-F lo) - e^(-F hi)) (no cancellation in narrow bins)."""
-    lo = np.asarray(lo, dtype=float)
-    hi = np.asarray(hi, dtype=float)
-    force, log_weights = _force_quadrature(weight, float(np.max(lo, initial=0.0)))
-    lo_b, hi_b = np.broadcast_arrays(lo, hi)
-    f = force[None, :]
-    difference = -np.expm1(-f * (hi_b.ravel() - lo_b.ravel())[:, None])
-    exponent = log_weights[None, :] - power * np.log(f) - f * lo_b.ravel()[:, None]
-    return np.sum(np.exp(exponent) * difference, axis=1).reshape(lo_b.shape)
+def _log_bin_laplace(weight, power, lo, hi):
+    """ln int dF F^(-1/2 - power) w e^(-1/(12F)) (e^(-F lo) - e^(-F hi)), each bin on the nodes
+    of its own lower edge (``_force_nodes``: a bin's result never depends on the other bins; no
+    cancellation in narrow bins; finite where the integral underflows)."""
+    lo, hi = np.broadcast_arrays(np.asarray(lo, dtype=float), np.asarray(hi, dtype=float))
+    out = np.empty(lo.shape)
+    for index in np.ndindex(lo.shape):
+        edge, width = float(lo[index]), float(hi[index] - lo[index])
+        force, log_weights = _force_nodes(weight, power, edge)
+        with np.errstate(divide="ignore"):  # F width below the smallest double
+            difference = np.log(-np.expm1(-force * width))
+        out[index] = _log_sum(log_weights - force * edge + difference)[0]
+    return out
+
+
+def _check_bins(lo, hi):
+    """The bins' edges broadcast, each bin within the heights computed: lo = 0 or
+    SMALLEST_POSITION <= lo < hi <= LARGEST_POSITION (ValueError naming lo or hi and the
+    bound)."""
+    lo, hi = np.broadcast_arrays(np.asarray(lo, dtype=float), np.asarray(hi, dtype=float))
+    for name, edge, bad in (
+        ("lo", lo, ~(lo >= 0.0) | ((lo > 0.0) & (lo < SMALLEST_POSITION))),
+        ("hi", hi, ~(hi > lo) | ~(hi <= LARGEST_POSITION)),
+    ):
+        if bad.any():
+            raise ValueError(
+                f"{name} = {edge[bad].flat[0]:g}: bins need lo = 0 or SMALLEST_POSITION = "
+                f"{SMALLEST_POSITION:g} <= lo < hi <= LARGEST_POSITION = {LARGEST_POSITION:g}"
+            )
+    return lo, hi
 
 
 def position_bin_average(lo, hi, weight):
@@ -1837,8 +1856,8 @@ def position_bin_average(lo, hi, weight):
     >>> print(exact.position_bin_average([0.0, 1.0], [1.0, 2.0], "1/2").round(8))
     [0.31801854 0.1429493 ]
     """
-    lo, hi = np.broadcast_arrays(np.asarray(lo, dtype=float), np.asarray(hi, dtype=float))
-    return _bin_laplace(weight, 1.0, lo, hi) / (hi - lo)
+    lo, hi = _check_bins(lo, hi)
+    return np.exp(_log_bin_laplace(weight, 1.0, lo, hi)) / (hi - lo)
 
 
 def speed_squared_given_position_bin_average(lo, hi, weight):
@@ -1872,7 +1891,8 @@ def speed_squared_given_position_bin_average(lo, hi, weight):
     >>> print(exact.speed_squared_given_position_bin_average([0, 1], [1, 2], "1/2").round(8))
     [2.53258574 4.23045873]
     """
-    return _bin_laplace(weight, 2.0, lo, hi) / _bin_laplace(weight, 1.0, lo, hi)
+    lo, hi = _check_bins(lo, hi)
+    return np.exp(_log_bin_laplace(weight, 2.0, lo, hi) - _log_bin_laplace(weight, 1.0, lo, hi))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1894,6 +1914,19 @@ def _distribution_integrand(log_force, x, v, weight, width=0.0):
         return special.airy(argument)[0] * math.exp(log_rest)
     airy = special.airye(argument)[0] if argument < 1e6 else float(scaled_airy_ai(argument))
     return airy * math.exp(log_rest - (2.0 / 3.0) * argument**1.5)
+
+
+def _force_range(weight, x):
+    """ln F from where w(F) e^{-v/2} psi_F(-v) of eq. (fpsol) has fallen below e^-150 of its
+    largest at small F (e^{-(S + 1/12)/F}) to where e^{-F x} < e^-60, at one x > 0; widened to
+    where e^{-(S + 1/12)/F - F x} has fallen by e^-60 from its saddle value at
+    F_s = ((S + 1/12) / x)^(1/2), which lies beyond both ends at large x (beyond ~1e3)."""
+    total = _total_decay(weight)
+    root = math.sqrt(total * x)
+    centre = 0.5 * math.log(total / x)
+    reach = math.acosh(1.0 + 30.0 / root) + 1.0
+    lower = min(math.log(total / 150.0), centre - reach)
+    return lower, max(math.log(60.0 / x), centre + reach, lower + 1.0)
 
 
 def distribution_by_force_integral(x, v, weight):
@@ -1941,12 +1974,15 @@ def distribution_by_force_integral(x, v, weight):
     check_force_integral_point(xi, vi)
     # w(F) e^{-v/2} psi_F(-v) vanishes like e^{-(S + 1/12)/F} at small F (or faster);
     # e^{-F x} cuts large F (at x = 0, v < 0 the Airy factor ~ exp(-(2/3) F^(1/2) |v|^(3/2)))
-    lower = np.log(_total_decay(weight) / 150.0)
-    upper = np.log(60.0 / xi) if xi > 0.0 else np.log((90.0 / abs(vi) ** 1.5) ** 2 + 1.0)
+    if xi > 0.0:
+        lower, upper = _force_range(weight, xi)
+    else:
+        lower = np.log(_total_decay(weight) / 150.0)
+        upper = max(np.log((90.0 / abs(vi) ** 1.5) ** 2 + 1.0), lower + 1.0)
     value, error, *_ = integrate.quad(
         _distribution_integrand,
         lower,
-        max(upper, lower + 1.0),
+        upper,
         args=(xi, vi, weight),
         limit=2000,
         epsabs=0.0,
@@ -2068,8 +2104,7 @@ def distribution_by_force_rule(x, speeds, weight):
     for v in speeds:
         check_force_integral_point(x, float(v))
     decay = _total_decay(weight)
-    lower = np.log(decay / 150.0)
-    y_grid = np.linspace(lower, max(np.log(60.0 / x), lower + 1.0), FORCE_RULE_GRID)
+    y_grid = np.linspace(*_force_range(weight, x), FORCE_RULE_GRID)
     log_rest_grid = weight.log(np.exp(y_grid)) + (5.0 / 6.0) * y_grid - np.exp(y_grid) * x
     values, check = (
         _force_rule_sum(x, speeds, log_rest_grid, y_grid, decay, phase, nodes, weight)
@@ -2142,11 +2177,10 @@ def distribution_cell_average(x_lo, x_hi, v_lo, v_hi, weight, speed_nodes=CELL_S
             "oscillates too fast to evaluate (check_force_integral_point)"
         )
     nodes, node_weights = np.polynomial.legendre.leggauss(speed_nodes)
-    lower = np.log(_total_decay(weight) / 150.0)
     result = np.empty(x_lo.shape)
     for index in np.ndindex(x_lo.shape):
         lo, width = float(x_lo[index]), float(x_hi[index] - x_lo[index])
-        upper = max(np.log(60.0 / lo), lower + 1.0)
+        lower, upper = _force_range(weight, lo)
         panels = int(np.ceil((v_hi[index] - v_lo[index]) / lo ** (1.0 / 3.0)))
         edges = np.linspace(v_lo[index], v_hi[index], panels + 1)
         total = 0.0

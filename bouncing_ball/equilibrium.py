@@ -417,17 +417,34 @@ class _EquilibriumState:
         """P(x, v), the joint density of height and velocity, eq. (fpsol); at x = 0 the
         outgoing side is P(0, v) and the incoming side eq. (bc), P(0, -v) = r^2 P(0, r v).
 
+        At x > 0 each value is good to ``distribution.DISTRIBUTION_NOISE`` (1e-10) of the
+        largest P(x, v) at that x (the F integral's Airy factor cancels); at x = 0 it is
+        ``p0v``'s.
+
         Parameters
         ----------
         x : array_like
-            Heights, x >= 0.
+            Heights: x = 0 or ``distribution.SMALLEST_POSITION`` (1e-300) <= x <=
+            ``distribution.LARGEST_POSITION`` (1e12).
         v : array_like
-            Velocities (either sign), broadcast against ``x``.
+            Velocities (either sign), finite, broadcast against ``x``.  At x > 0 and v > 0 the
+            F integral's Airy factor oscillates, and P(x, v) is computed only where its phase
+            stays below ``airy.LARGEST_AIRY_PHASE`` (x >= 60 (v^(3/2) / 6e4)^2: x >= 1e-4 up to
+            v = 18).  Beyond ``distribution.LARGEST_VELOCITY`` (1e4) in |v|, P(x, v) is 0 to
+            every double and 0 is returned.
 
         Returns
         -------
         numpy.ndarray or numpy.float64
-            P(x, v), the broadcast shape; inf at x = v = 0, where P(0, v) diverges.
+            P(x, v), the broadcast shape; inf at x = v = 0, where P(0, v) diverges; 0 where it
+            underflows.
+
+        Raises
+        ------
+        ValueError
+            Naming x or v and the bound: x outside its domain, NaN or inf in either, or an
+            (x, v > 0) at which the Airy phase is too large
+            (``airy.check_force_integral_point``).
 
         Examples
         --------
@@ -435,27 +452,65 @@ class _EquilibriumState:
         >>> print(ExactEquilibrium("1/2").pxv(0.1, [-1.0, 0.0, 1.0]).round(6))
         [0.074292 0.198028 0.146809]
         """
+        from .distribution import LARGEST_VELOCITY
+
         self._check_distribution("pxv")
-        x = _checked(x, "x", low=0.0)
+        x = _heights(x, "x")
         v = _checked(v, "v")
         x, v = _broadcast(x, v, ("x", "v"))
-        result = np.array(self._joint(x, v), dtype=float)
+        result = np.zeros(x.shape)
+        computed = np.abs(v) <= LARGEST_VELOCITY
+        if computed.any():
+            result[computed] = self._joint(x[computed], v[computed])
         result[(x == 0.0) & (v == 0.0)] = np.inf
         return _out(result)
+
+    @functools.cached_property
+    def smallest_force(self) -> float:
+        """The smallest F > 0 at which w(F) is a double: 0 where w(F) ~ F^gamma e^(-S/F)
+        vanishes as F -> 0 (S >= 0, r up to 0.73: ``distribution.small_force_decay``); where
+        S < 0 it grows without bound, and below this F it comes within e^10 of the largest
+        double (``weight`` refuses such F)."""
+        from scipy import optimize
+
+        from .distribution import small_force_decay
+
+        if small_force_decay(self.r) >= 0.0:
+            return 0.0
+        largest = np.log(np.finfo(float).max) - 10.0
+        log_weight = self.weight_function.log
+        return float(
+            np.exp(
+                optimize.brentq(
+                    lambda y: float(log_weight(np.exp(y))) - largest, np.log(1e-300), 0.0
+                )
+            )
+        )
 
     def weight(self, F):
         """The weight function w(F) of eq. (weightfunc) (eq. (weightfunc2) for the exact
         solutions): P(x, v) is a superposition of the modes of eq. (fpsol) with weight w(F).
 
+        ``Equilibrium`` interpolates ln w between F_min and F_max
+        (``distribution.WeightFunction``, relative error ``weight_function.interpolation_error``),
+        continues it by its small-F form below and by its power law F^((2 beta - 5)/6) above,
+        whose first neglected term is relative (F / F_max)^(-2/3) at most (F_max = 1e8).
+
         Parameters
         ----------
         F : array_like
-            F > 0.
+            F >= ``smallest_force`` and F > 0, finite (subnormal F included).
 
         Returns
         -------
         numpy.ndarray or numpy.float64
-            w(F), the shape of ``F``.
+            w(F), the shape of ``F``; 0 where it underflows (F below ~1e-4 where S > 0).
+
+        Raises
+        ------
+        ValueError
+            Naming F and the bound: F <= 0, F < ``smallest_force`` (where w exceeds the largest
+            double: r above 0.73), NaN or inf.
 
         Examples
         --------
@@ -465,7 +520,15 @@ class _EquilibriumState:
         """
         self._check_distribution("weight")
         force = _checked(F, "F", low=0.0, strictly=True)
-        return _out(np.asarray(self._weight(force), dtype=float))
+        small = force < self.smallest_force
+        if small.any():
+            raise ValueError(
+                f"F = {force[small].flat[0]:g} is below smallest_force = {self.smallest_force:.3g}"
+                f" at r = {self.label}, where w(F) ~ F^gamma e^(-S/F) with S < 0 exceeds the "
+                "largest double (distribution.small_force_decay)"
+            )
+        with np.errstate(over="ignore", divide="ignore"):  # e^(-S/F) underflows at tiny F
+            return _out(np.asarray(self._weight(force), dtype=float))
 
     def flight_rate_density(self, T):
         """nu(T), flights of duration in dT per unit time, eq. (rate) of ``flight_time``:

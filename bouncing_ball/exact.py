@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 from scipy import integrate, special
 
-from .airy import airy_ai, check_force_integral_point
+from .airy import check_force_integral_point, oscillating_airy_ai, scaled_airy_ai
 from .restitution import EXACT_RESTITUTIONS, parse_restitution
 
 __all__ = [
@@ -328,7 +328,7 @@ def _force_integrals_third(lo, power, width=None, scaled=False):
         f = np.exp(log_f)
         z = 1.0 / (12.0 * f)
         exponent = -2.0 * z - f * lo[owner, None] + shift[owner, None]
-        value = special.kve(1.0 / 6.0, z) * np.exp(exponent) / f**power
+        value = special.kve(1.0 / 6.0, z) * np.exp(exponent) * f**-power
         return value if width is None else value * -np.expm1(-f * scale[owner, None])
 
     with np.errstate(divide="ignore"):
@@ -423,19 +423,22 @@ def speed_squared_given_position_bin_average(lo, hi, restitution):
     >>> print(round(float(speed_squared_given_position_bin_average(0.0, 1.5, "1/2")), 10))
     2.8271885085
     """
-    lo = np.asarray(lo, dtype=float)
-    hi = np.asarray(hi, dtype=float)
+    lo, hi = np.broadcast_arrays(np.asarray(lo, dtype=float), np.asarray(hi, dtype=float))
     if _which(restitution) == Fraction(1, 2):
-
-        def primitive(x):
-            u = np.sqrt(2.0 * x / 3.0)
-            safe = np.where(u > 0, u, 1.0)
-            return np.where(u > 0, -3.0 * safe**2 * special.kn(2, safe), -6.0)
-
-        numerator = primitive(hi) - primitive(lo)
-    else:
-        numerator = _bin_integrals_third(lo, hi, 2)
-    return numerator / (position_bin_average(lo, hi, restitution) * (hi - lo))
+        # int_x^inf P = u K1(u), int u K1(u) dx = -3 u^2 K2(u), u = sqrt(2x/3); both bin
+        # integrals times e^(u_lo) (the scaled Bessel functions): finite where they underflow
+        u_lo, u_hi = np.sqrt(2.0 * lo / 3.0), np.sqrt(2.0 * hi / 3.0)
+        safe = np.where(u_lo > 0.0, u_lo, 1.0)
+        decay = np.exp(u_lo - u_hi)
+        tail_lo = np.where(u_lo > 0.0, 3.0 * safe**2 * special.kve(2, safe), 6.0)
+        mass_lo = np.where(u_lo > 0.0, safe * special.k1e(safe), 1.0)
+        numerator = tail_lo - 3.0 * u_hi**2 * special.kve(2, u_hi) * decay
+        denominator = mass_lo - u_hi * special.k1e(u_hi) * decay
+        return numerator / denominator
+    width = (hi - lo).ravel()
+    numerator = _force_integrals_third(lo.ravel(), 2, width, scaled=True)
+    denominator = _force_integrals_third(lo.ravel(), 1, width, scaled=True)
+    return (numerator / denominator).reshape(lo.shape)
 
 
 def _bin_integrals_third(lo, hi, power):
@@ -525,12 +528,23 @@ def weight_function(force, restitution):
     """
     force = np.asarray(force, dtype=float)
     a = normalization_constant(restitution)
-    z = 1.0 / (12.0 * force)
+    with np.errstate(over="ignore"):  # z = inf at subnormal F, where w underflows to 0
+        z = (1.0 / 12.0) / force
     if _which(restitution) == Fraction(1, 2):
         return 0.5 * a * force**-0.5 * np.exp(-z)
-    # in logs: F^-1/2 overflows where K e^-z underflows (F below ~1e-300)
+    # in logs: F^-1/2 overflows where K e^-z underflows (F below ~1e-300); beyond z = 1e8 (where
+    # scipy's kve stops) w < e^-z underflows to 0 whatever K_nu(z) e^z (~ (pi / 2z)^(1/2));
+    # below z = 1e-100 (where kve overflows at subnormal z) K_nu(z) = Gamma(nu)/2
+    # (2/z)^nu (1 + O(z^(2 nu))), relative 1e-33 there
+    small = z < 1e-100
+    log_bessel = np.where(
+        small,
+        np.log(0.5 * special.gamma(1.0 / 6.0))
+        + (np.log(2.0) - np.log(np.where(small, z, 1.0))) / 6.0,
+        np.log(special.kve(1.0 / 6.0, np.clip(z, 1e-100, 1e8))),
+    )
     log_c = np.log(np.sqrt(2.0 / (27.0 * np.pi)) * a)
-    return np.exp(log_c - 0.5 * np.log(force) + np.log(special.kve(1.0 / 6.0, z)) - z)
+    return np.exp(log_c - 0.5 * np.log(force) + log_bessel - z)
 
 
 def _scalar_weight_function(restitution):
@@ -629,7 +643,8 @@ def _force_integrals(x, v, restitution):
     their absolute error estimates."""
 
     def integrand(log_force, owner):
-        # e^{-v/2} w(F) e^{-F x} psi_{1/4,F}(-v) F, eqs. (fpsol), (psi); dF = F d(ln F)
+        # e^{-v/2} w(F) e^{-F x} psi_{1/4,F}(-v) F, eqs. (fpsol), (psi); dF = F d(ln F); the
+        # decay of Ai (z > 0) joins e^{-v/2 - F x} in one exponential: finite at any v
         f = np.exp(log_force)
         xi, vi = x[owner, None], v[owner, None]
         argument = -np.cbrt(f) * vi + 0.25 * f ** (-2.0 / 3.0)
@@ -637,12 +652,26 @@ def _force_integrals(x, v, restitution):
         key = log_force[:, 0] + 1j * log_force[:, -1]
         _, first, shared = np.unique(key, return_index=True, return_inverse=True)
         weight = weight_function(f[first], restitution)[shared.ravel()]
-        return np.exp(-0.5 * vi - f * xi) * weight * f ** (5.0 / 6.0) * airy_ai(argument)
+        decaying = argument > 0.0
+        airy = np.empty(argument.shape)
+        airy[decaying] = scaled_airy_ai(argument[decaying])
+        airy[~decaying] = oscillating_airy_ai(-argument[~decaying])
+        decay = (2.0 / 3.0) * np.where(decaying, argument, 0.0) ** 1.5
+        return np.exp(-0.5 * vi - f * xi - decay) * weight * f ** (5.0 / 6.0) * airy
 
     if x.size == 0:
         return np.empty(0), np.empty(0)
-    # as distribution_by_force_integral: w(F) ~ e^{-1/(6F)} below e^-6, e^{-F x} < e^-60 above
-    return _adaptive_gauss_kronrod(integrand, np.full(x.shape, -6.0), np.log(60.0 / x), 1e-10)
+    # as distribution_by_force_integral: w(F) ~ e^{-1/(6F)} below e^-6, e^{-F x} < e^-60 above;
+    # widened to where e^{-1/(6F) - F E} has fallen by e^-60 from its saddle value at
+    # F = (6 E)^(-1/2), E = x + v^2/2 on the incoming side (v < 0: e^{-v/2} Ai = e^{-1/(12F) -
+    # F v^2/2 ...}), where the saddle lies outside (x beyond ~1e3, or v below ~-30)
+    energy = x + 0.5 * np.minimum(v, 0.0) ** 2
+    root = np.sqrt(energy / 6.0)
+    saddle = -0.5 * np.log(6.0 * energy)
+    reach = np.arccosh(1.0 + 30.0 / root) + 1.0
+    lower = np.minimum(-6.0, saddle - reach)
+    upper = np.maximum(np.log(60.0 / x), saddle + reach)
+    return _adaptive_gauss_kronrod(integrand, lower, upper, 1e-10)
 
 
 def distribution_with_error(x, v, restitution):

@@ -284,7 +284,10 @@ def check_figure_positions(config: dict) -> None:
 
 # the peak memory of a solve job per point of its output grids, in bytes (tracemalloc at
 # r = 0.05, 1/2 and 0.75, with a margin): the flight-time density integrates McKean's law
-# over every node of the solution at each T
+# over every node of the solution at each T; P(x) and <v^2>_x take each x on its own F nodes
+# (distribution._force_nodes, the most at x = SMALLEST_POSITION), held for one x at a time, so
+# the position grid's cost per point is its rows alone, far below the bound here (the slope of
+# the peak between 100 and 1000 points from 1e-300 to 1e12, the nodes a fixed cost besides)
 SOLVER_BYTES_PER_POINT = {
     "solver.flight_times": 1.2e6,
     "solver.position_grid": 2.5e4,

@@ -370,9 +370,20 @@ def test_a_study_whose_bins_need_more_memory_than_a_job_may_use_is_refused():
         ("solver.position_grid.min", 1.0e-310),
         ("solver.position_grid.max", 1.0e13),
         ("exact.position_grid.min", 1.0e-310),
+        ("solver.speeds.min", -2.0e4),
+        ("solver.speeds.max", 2.0e4),
+        ("exact.speeds.max", 2.0e4),
+        ("solver.forces.min", 1.0e-5),
     ],
 )
 def test_a_grid_beyond_what_the_library_computes_is_refused_naming_the_key(key, value):
     config = _set(_small_config(), key, value)
     with pytest.raises(ValueError, match=rf"config: {key}: .*(less|greater) than the m"):
+        check_config(config, _schema())
+
+
+@pytest.mark.parametrize("section", ["solver", "exact"])
+def test_a_position_beyond_the_largest_height_is_refused_naming_the_key(section):
+    config = _set(_small_config(), f"{section}.positions", [0, 1.0e13])
+    with pytest.raises(ValueError, match=rf"config: {section}.positions"):
         check_config(config, _schema())
