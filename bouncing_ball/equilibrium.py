@@ -591,14 +591,17 @@ class _EquilibriumState:
         v : array_like
             Return speeds, finite, v >= 0.
         u : array_like
-            Outgoing speeds, finite, u > 0, broadcast against ``v``.
+            Outgoing speeds, finite, u >= ``kernel.SMALLEST_OUTGOING_SPEED`` (1e-300: the
+            density peaks near v = u at about 0.24 / u, which must stay a double), broadcast
+            against ``v``.
 
         Returns
         -------
         numpy.ndarray or numpy.float64
             v G_g(v, u), the broadcast shape; it integrates to 1 over v (eq. (normG)).  Finite
-            for every finite v, u (computed in logs, ``kernel.return_speed_density``): 0 only
-            where it underflows (below ~1e-308, e.g. far from v ~ u at large u).
+            for every finite v and every u in range (computed in logs,
+            ``kernel.return_speed_density``): 0 only where it underflows (below ~1e-308, e.g.
+            far from v ~ u at large u).
 
         Examples
         --------
@@ -606,10 +609,10 @@ class _EquilibriumState:
         >>> print(ExactEquilibrium("1/2").return_speed_density([0.5, 1.0], 1.0).round(6))
         [0.232269 0.429368]
         """
-        from .kernel import return_speed_density
+        from .kernel import SMALLEST_OUTGOING_SPEED, return_speed_density
 
         v = _checked(v, "v", low=0.0)
-        u = _checked(u, "u", low=0.0, strictly=True)
+        u = _checked(u, "u", low=SMALLEST_OUTGOING_SPEED)
         v, u = _broadcast(v, u, ("v", "u"))
         return _out(return_speed_density(v, u))
 

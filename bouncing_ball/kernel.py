@@ -57,6 +57,7 @@ __all__ = [
     "TAU_NODES",
     "TIME_MOMENT_TAU_NODES",
     "TAIL",
+    "SMALLEST_OUTGOING_SPEED",
     "return_speed_kernel",
     "return_speed_kernel_matrix",
     "return_speed_density",
@@ -72,6 +73,9 @@ TAU_NODES = 20
 TIME_MOMENT_TAU_NODES = 24
 #: exp(-TAIL^2) ~ 1e-18: the cut of the tau integral for large z0.
 TAIL = 6.4
+#: The smallest outgoing speed u of the return-speed density v G_g(v, u): the density peaks
+#: near v = u at about 0.24 / u, which stays a double (with room for its logs) down to here.
+SMALLEST_OUTGOING_SPEED = 1e-300
 
 _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(TAU_NODES)
 _NODES = 0.5 * (_NODES + 1.0)  # on [0, 1]

@@ -368,7 +368,12 @@ class OutgoingSpeedSolution:
         flat = np.ascontiguousarray(v.ravel())
         out = np.empty(flat.size)
         below = flat < self.speeds[0]
-        out[~below] = self._nystrom(flat[~below])
+        # beyond twice the underflow scale P(0, v) < e^-1400 (eq. (asym4)): 0 in doubles, and
+        # v / r would overflow in the Nystrom formula near the largest double
+        beyond = flat > 2.0 * UNDERFLOW_EFOLDS / large_speed_decay_rate(self.restitution)
+        inside = ~below & ~beyond
+        out[beyond] = 0.0
+        out[inside] = self._nystrom(flat[inside])
         with np.errstate(divide="ignore", over="ignore"):
             out[below] = np.exp(
                 np.log(self.small_speed_prefactor) - self.small_speed_exponent * np.log(flat[below])
