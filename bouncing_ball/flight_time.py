@@ -878,7 +878,9 @@ def _direct_flight_rate_density(solution, times, step):
         row_of_pair = np.repeat(rows, sizes[rows])
         column = start[row_of_pair] + np.arange(offsets[-1]) - np.repeat(offsets[:-1], sizes[rows])
         f = flight_time_density(times[row_of_pair], u[column])
-        result[rows] = np.add.reduceat(f * rate[column], offsets[:-1]) + tail[rows] * f[offsets[:-1]]
+        result[rows] = (
+            np.add.reduceat(f * rate[column], offsets[:-1]) + tail[rows] * f[offsets[:-1]]
+        )
     return result
 
 
@@ -923,7 +925,7 @@ def flight_rate_in_regimes(times, direct, short_amplitude, beta, restitution):
         )
     result = np.zeros(times.shape)
     short = times < SHORT_FLIGHT_TIME
-    result[short] = short_amplitude * times[short] ** (-0.5 * beta)
+    result[short] = _short_law(short_amplitude, beta, times[short])
     middle = ~short & (times <= underflow_flight_time(restitution))
     if middle.any():
         result[middle] = direct(times[middle])
@@ -1177,7 +1179,14 @@ def short_flight_rate_density(solution, times):
     """
     beta = solution.small_speed_exponent
     amplitude = small_speed_amplitude(solution) * short_time_constant(beta)
-    return amplitude * np.asarray(times, dtype=float) ** (-0.5 * beta)
+    return _short_law(amplitude, beta, np.asarray(times, dtype=float))
+
+
+def _short_law(amplitude, beta, times):
+    """amplitude T^(-beta/2) of eq. (short), as (amplitude^(1/2) T^(-beta/4))^2: finite
+    wherever the product is (T^(-beta/2) alone overflows first where amplitude < 1), to a few
+    ulp."""
+    return (np.sqrt(amplitude) * times ** (-0.25 * beta)) ** 2
 
 
 def large_speed_amplitude(solution):
