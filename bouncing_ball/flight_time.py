@@ -885,10 +885,11 @@ def _direct_flight_rate_density(solution, times, step):
 
 
 def flight_rate_in_regimes(times, direct, short_amplitude, beta, restitution):
-    """nu(T) from its three regimes: eq. (short) below ``SHORT_FLIGHT_TIME``, ``direct`` up to
-    ``underflow_flight_time``, 0 beyond it (and wherever nu is below the smallest normal
-    double).  The one home of the domain of nu(T), for ``flight_rate_density`` and
-    ``equilibrium.ExactEquilibrium``.
+    """nu(T) of eq. (rate) from its three regimes, each T on its own.
+
+    Eq. (short) below ``SHORT_FLIGHT_TIME``, ``direct`` up to ``underflow_flight_time``, 0
+    beyond it (and wherever nu is below the smallest normal double).  The one home of the
+    domain of nu(T), for ``flight_rate_density`` and ``equilibrium.ExactEquilibrium``.
 
     Parameters
     ----------
