@@ -336,7 +336,7 @@ class _EquilibriumState:
         T : array_like
             Flight times, T = 0 or T >= the T below which nu(T) exceeds the largest double
             (``flight_time.shortest_flight_time``: 0, i.e. every T > 0, unless beta > 1.9,
-            i.e. r < 0.2; 1.3e-257 at r = 0.02).
+            i.e. r < 0.2; 2.4e-258 at r = 0.02).
 
         Returns
         -------

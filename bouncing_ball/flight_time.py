@@ -962,7 +962,7 @@ def flight_rate_density(solution, times, step=RATE_STEP):
         The solver's P(0, u), eq. (inteq).
     times : array_like
         Flight times, T >= ``shortest_flight_time`` (> 0; below it nu(T) exceeds the largest
-        double: only where beta > 1.9, at T below ~1e-290).
+        double: 0 unless beta > 1.9, i.e. r < 0.2; 2.4e-258 at r = 0.02).
     step : float
         The rule's step in s.
 
