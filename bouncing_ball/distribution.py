@@ -2634,23 +2634,28 @@ EXPONENT_TOLERANCES = {
 DISTRIBUTION_NOISE = 1e-10
 
 
-def _nan_defects(name, table, allowed=None) -> list:
-    """'name: n NaN in column c' for every column with NaN outside the rows ``allowed`` marks."""
+def _non_finite_defects(name, table, allowed=None) -> list:
+    """'name: n of m c are NaN' for every column with NaN outside the rows ``allowed`` marks,
+    and 'name: n of m c are infinite' for every column holding +-inf (no table of rule solve
+    has one: P(0, 0) and P(x = 0, v = 0) are NaN, and every flight time is > 0)."""
     defects = []
     for column in table.columns:
         values = pd.to_numeric(table[column], errors="coerce").to_numpy(dtype=float)
         missing = np.isnan(values) & ~(False if allowed is None else allowed(table, column))
         if missing.any():
             defects.append(f"{name}: {int(missing.sum())} of {values.size} {column} are NaN")
+        infinite = np.isinf(values)
+        if infinite.any():
+            defects.append(f"{name}: {int(infinite.sum())} of {values.size} {column} are infinite")
     return defects
 
 
 def solve_table_defects(summary, tables, target=1e-8) -> list:
     """What fails among the checks every table of rule solve passes before it is written.
 
-    The checks: no NaN where a value is defined (P(0, 0) is not, nor rho(T) where I is infinite,
-    below r_c, nor the return-speed law given a u-bin above the highest node, where P(0, u)
-    underflows); no P(x, v) below -DISTRIBUTION_NOISE (or the weight_interpolation_error, where
+    The checks: no infinity, and no NaN where a value is defined (P(0, 0) is not, nor rho(T)
+    where I is infinite, below r_c, nor the return-speed law given a u-bin above the highest
+    node, where P(0, u) underflows); no P(x, v) below -DISTRIBUTION_NOISE (or the weight_interpolation_error, where
     larger) of its largest value at that x; int P dx = 1, and <x>, Delta x from P(x) equal the
     Ito values from P(0, v), within the tolerance; every measured exponent within
     ``EXPONENT_TOLERANCES`` of its prediction.
@@ -2664,9 +2669,8 @@ def solve_table_defects(summary, tables, target=1e-8) -> list:
     tables : dict of str to pandas.DataFrame
         p0v, flight_time, return_speed, position, distribution, weight.
     target : float
-        The accuracy asked for (``solver.ACCURACY_TARGET``); the moments are held to the largest
-        of it, the summary's accuracy_estimate (of P(0, v)) and its weight_interpolation_error
-        (of w(F), and so of P(x): ``WeightFunction.interpolation_error``).
+        The accuracy asked for (``solver.ACCURACY_TARGET``): int P dx - 1 and the moments from
+        P(x) against the Ito ones are held to it.
 
     Returns
     -------
@@ -2704,7 +2708,7 @@ def solve_table_defects(summary, tables, target=1e-8) -> list:
         "return_speed": lambda table, column: table.u_lo >= summary["highest_speed"],
     }
     for name, table in tables.items():
-        defects += _nan_defects(name, table, allowed.get(name))
+        defects += _non_finite_defects(name, table, allowed.get(name))
     if "distribution" in tables:
         joint = tables["distribution"]
         largest = joint.pxv.abs().groupby(joint.x).transform("max").to_numpy(dtype=float)
@@ -2717,11 +2721,7 @@ def solve_table_defects(summary, tables, target=1e-8) -> list:
                 f"distribution: {int(negative.sum())} of {pxv.size} pxv are negative beyond "
                 f"{noise:.1g} of the largest at their x (down to {np.nanmin(pxv):.3g})"
             )
-    tolerance = max(
-        target,
-        summary.get("accuracy_estimate", 0.0),
-        summary.get("weight_interpolation_error", 0.0),
-    )
+    tolerance = target
     for what, value in (
         ("int P dx", summary["position_normalization"]),
         ("<x> from P(x) / <x> from P(0, v)", summary["mean_x_from_position"] / summary["mean_x"]),

@@ -274,7 +274,10 @@ class _EquilibriumState:
     def _weight(self, force):  # w(F), F > 0
         raise NotImplementedError
 
-    def _flight_rate(self, times):  # nu(T), T > 0
+    def _flight_rate(self, times):  # nu(T), T > 0 (flight_time.flight_rate_in_regimes)
+        raise NotImplementedError
+
+    def _short_flight_amplitude(self) -> float:  # A C_beta of nu ~ A C_beta T^(-beta/2)
         raise NotImplementedError
 
     def _check_distribution(self, what: str) -> None:  # ValueError where P(x) is not computed
@@ -530,19 +533,54 @@ class _EquilibriumState:
         with np.errstate(over="ignore", divide="ignore"):  # e^(-S/F) underflows at tiny F
             return _out(np.asarray(self._weight(force), dtype=float))
 
+    def _flight_times(self, T, name: str, per_collision: bool = False) -> np.ndarray:
+        """``T`` checked: >= 0, and each T > 0 at least the T below which nu(T) (rho(T) =
+        nu / I with ``per_collision``) exceeds the largest double (``shortest_flight_time``);
+        ValueError naming ``name``, r and the bound otherwise."""
+        from . import flight_time
+
+        times = _checked(T, name, low=0.0)
+        amplitude = self._short_flight_amplitude()
+        if per_collision and np.isfinite(self.collision_rate):
+            amplitude /= self.collision_rate
+        shortest = flight_time.shortest_flight_time(amplitude, self.beta)
+        bad = (times > 0.0) & (times < shortest)
+        if bad.any():
+            raise ValueError(
+                f"{name} must be 0 or >= {shortest:.3g} at r = {self.label}: below, "
+                f"{'rho' if per_collision else 'nu'}(T) ~ T^(-beta/2) (eq. (short)) exceeds "
+                f"the largest double; got {times[bad].flat[0]:g}"
+            )
+        return times
+
     def flight_rate_density(self, T):
         """nu(T), flights of duration in dT per unit time, eq. (rate) of ``flight_time``:
         int du u P(0, u) f(T | u); finite for T > 0 at every r (also below r_c).
 
+        Each T on its own (``flight_time.flight_rate_in_regimes``): below
+        ``flight_time.SHORT_FLIGHT_TIME`` (1e-30) its short-flight law A C_beta T^(-beta/2),
+        eq. (short) (relative correction O(T^(1/2)) < 1e-14); beyond
+        ``flight_time.underflow_flight_time(r)`` (7556 for r <= 0.618, longer above), and
+        wherever nu is below the smallest normal double, exactly 0; between, the quadrature
+        of eq. (rate).
+
         Parameters
         ----------
         T : array_like
-            Flight times, T >= 0.
+            Flight times, T = 0 or T >= the T below which nu(T) exceeds the largest double
+            (``flight_time.shortest_flight_time``: 0, i.e. every T > 0, unless beta > 1.9,
+            i.e. r < 0.2; 2.4e-258 at r = 0.02).
 
         Returns
         -------
         numpy.ndarray or numpy.float64
-            nu(T), the shape of ``T``; inf at T = 0, where nu ~ T^(-beta/2) (eq. (short)).
+            nu(T), the shape of ``T``, finite; inf at T = 0, where nu ~ T^(-beta/2)
+            (eq. (short)).
+
+        Raises
+        ------
+        ValueError
+            If a T is negative, NaN, infinite, or below the bound.
 
         Examples
         --------
@@ -550,7 +588,7 @@ class _EquilibriumState:
         >>> print(ExactEquilibrium("1/2").flight_rate_density([1.0, 4.0]).round(6))
         [0.065611 0.020642]
         """
-        times = _checked(T, "T", low=0.0)
+        times = self._flight_times(T, "T")
         result = np.full(times.shape, np.inf)
         positive = times > 0.0
         if positive.any():
@@ -559,17 +597,25 @@ class _EquilibriumState:
 
     def flight_time_density(self, T):
         """rho(T) = nu(T) / I, the density of the time between two collisions (per collision);
-        0 for T > 0 below r_c, where I is infinite.
+        0 for T > 0 below r_c, where I is infinite.  nu(T) as ``flight_rate_density`` gives it
+        (eq. (short) below 1e-30, 0 beyond the underflow).
 
         Parameters
         ----------
         T : array_like
-            Flight times, T >= 0.
+            Flight times, T = 0 or T >= the T below which rho(T) exceeds the largest double
+            (``flight_time.shortest_flight_time`` of A C_beta / I: 0, i.e. every T > 0, for
+            every r above r_c but within 1e-3 of it).
 
         Returns
         -------
         numpy.ndarray or numpy.float64
-            rho(T), the shape of ``T``; inf at T = 0 (eq. (short)).
+            rho(T), the shape of ``T``, finite; inf at T = 0 (eq. (short)).
+
+        Raises
+        ------
+        ValueError
+            If a T is negative, NaN, infinite, or below the bound.
 
         Examples
         --------
@@ -577,9 +623,13 @@ class _EquilibriumState:
         >>> print(ExactEquilibrium("1/2").flight_time_density([1.0, 4.0]).round(6))
         [0.196832 0.061925]
         """
-        nu = np.asarray(self.flight_rate_density(T), dtype=float)
+        times = self._flight_times(T, "T", per_collision=True)
         if not np.isfinite(self.collision_rate):
-            return _out(np.where(np.isinf(nu), np.inf, 0.0))
+            return _out(np.where(times == 0.0, np.inf, 0.0))
+        nu = np.full(times.shape, np.inf)
+        positive = times > 0.0
+        if positive.any():
+            nu[positive] = self._flight_rate(times[positive])
         return _out(nu / self.collision_rate)
 
     def return_speed_density(self, v, u):
@@ -935,6 +985,12 @@ class Equilibrium(_EquilibriumState):
 
         return flight_time.flight_rate_density(self.solution, times)
 
+    def _short_flight_amplitude(self) -> float:
+        from . import flight_time
+
+        amplitude = flight_time.small_speed_amplitude(self.solution)
+        return amplitude * flight_time.short_time_constant(self.beta)
+
     # --- the workflow's tables (results/solver/r{r}/)
     @functools.cached_property
     def _summary(self) -> dict:
@@ -983,8 +1039,8 @@ class Equilibrium(_EquilibriumState):
         target ``solver.ACCURACY_TARGET`` (1e-8): ``accuracy`` (P(0, v) against a finer solve)
         and ``position_accuracy`` (int P dx = 1, and <x>, Delta x from P(x) of eq. (P(x)1)
         against the Ito identities) within it; then ``distribution.check_solve_tables``: no
-        NaN where a value is defined, the moments from P(x) equal the Ito ones, the measured
-        exponents within their tolerance of the predicted ones.
+        NaN where a value is defined and no infinity anywhere, the moments from P(x) equal the
+        Ito ones, the measured exponents within their tolerance of the predicted ones.
 
         Parameters
         ----------
@@ -996,13 +1052,21 @@ class Equilibrium(_EquilibriumState):
         ------
         ValueError
             Naming r and every check that fails: first ``accuracy`` and ``position_accuracy``
-            beyond the target (with the settings), then the tables'.
+            beyond the target (with the settings), then the tables' (naming the table and
+            column).
 
         Examples
         --------
+        >>> import numpy as np
         >>> from bouncing_ball import Equilibrium
         >>> eq = Equilibrium("1/2")
         >>> eq.check({"position": eq.position_table([0.1, 1.0])})
+        >>> table = eq.flight_time_table([1.0, 2.0])
+        >>> table.loc[1, "rate_density"] = np.inf
+        >>> eq.check({"flight_time": table})
+        Traceback (most recent call last):
+        ...
+        ValueError: r = 0.5: the solver's tables fail their checks: flight_time: 1 of 2 rate_density are infinite ...
         """
         from . import distribution, solver
 
@@ -1148,13 +1212,20 @@ class Equilibrium(_EquilibriumState):
         Parameters
         ----------
         times : array_like
-            Flight times, T > 0.
+            Flight times, T > 0 and at least the bounds of ``flight_rate_density`` and
+            ``flight_time_density`` (every value of the table is finite).  The pipeline writes
+            ``flight_time.FLIGHT_TIME_TABLE_RANGE`` (config ``solver.flight_times``).
 
         Returns
         -------
         pandas.DataFrame
             Columns t, density, rate_density, time_weighted_density, short_time_form,
             long_time_form.
+
+        Raises
+        ------
+        ValueError
+            If a T is not positive, or below a bound.
 
         Examples
         --------
@@ -1165,6 +1236,8 @@ class Equilibrium(_EquilibriumState):
         from . import flight_time
 
         times = _checked(times, "times", low=0.0, strictly=True)
+        for per_collision in (False, True):  # nu(T) and rho(T) finite
+            self._flight_times(times, "times", per_collision=per_collision)
         return flight_time.flight_time_table(self.solution, times)
 
     def return_speed_table(self, speed_bins):
@@ -1316,10 +1389,25 @@ class ExactEquilibrium(_EquilibriumState):
 
         return exact.weight_function(force, self.restitution)
 
+    def _short_flight_amplitude(self) -> float:
+        from . import exact, flight_time
+
+        amplitude = exact.normalization_constant(self.restitution)  # P(0, v) ~ A v^-beta
+        return amplitude * flight_time.short_time_constant(self.beta)
+
     def _flight_rate(self, times):
+        """nu(T) in the regimes of ``flight_time.flight_rate_in_regimes``, with the exact A of
+        eq. (constants) in eq. (short) and ``_direct_flight_rate`` between."""
+        from . import flight_time
+
+        return flight_time.flight_rate_in_regimes(
+            times, self._direct_flight_rate, self._short_flight_amplitude(), self.beta, self.r
+        )
+
+    def _direct_flight_rate(self, times):
         """nu(T) = int du u P(0, u) f(T | u), eq. (rate): adaptive quadrature in ln u from
         1e-7 T^(1/2) (below, the integrand is u^(5/2 - beta) and is summed in closed form) to
-        where P(0, u) and f(T | u) have both fallen by e^-60."""
+        where P(0, u) and f(T | u) have both fallen by e^-60, for each T on its own."""
         from scipy import integrate
 
         from . import exact, flight_time

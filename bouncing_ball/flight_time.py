@@ -161,6 +161,11 @@ __all__ = [
     "flight_time_density",
     "free_flight_time_density",
     "flight_rate_density",
+    "flight_rate_in_regimes",
+    "SHORT_FLIGHT_TIME",
+    "FLIGHT_TIME_TABLE_RANGE",
+    "shortest_flight_time",
+    "underflow_flight_time",
     "collision_rate",
     "flight_time_density_equilibrium",
     "flight_rate_moment",
@@ -205,6 +210,21 @@ EXPONENT_CUT = 45.0  # time window: the Gaussian factor of f(t | u) above e^-45
 MOMENT_POWERS = range(4)  # k of (timemoments)
 SECH_SERIES_FROM = 80.0  # x above which S0 and S0' are summed from their asymptotic series
 SECH_SERIES_TERMS = 35  # terms of that series: truncation about 1e-14 relative at x = 80
+#: Below this flight time nu(T) is its short-flight law A C_beta T^(-beta/2), eq. (short),
+#: whose relative correction (c1 T^(1/2), |c1| ~ 0.1 at r = 1/2 and 1/3) is below 1e-15
+#: there; above it nu(T) is the quadrature of eq. (rate), which needs P(0, u) down to
+#: 1e-4 T^(1/2) (1e-19 here).
+SHORT_FLIGHT_TIME = 1e-30
+#: The flight times of the pipeline's table (config solver.flight_times, min and max): from
+#: SHORT_FLIGHT_TIME (below, the table's rate_density is its short_time_form) to 1e4 (beyond,
+#: nu(T) is 0 for r <= 0.618, where it decays like e^(-3T/16), and the quadrature of each T
+#: costs T^(1/2) nodes).
+FLIGHT_TIME_TABLE_RANGE = (SHORT_FLIGHT_TIME, 1.0e4)
+#: nu(T) is 0 beyond UNDERFLOW_MARGIN ln(1/tiny) / kappa (``underflow_flight_time``): twice the
+#: flight time where e^(-kappa T) reaches the smallest normal double, which leaves the
+#: prefactors of eqs. (long1), (long2) (at most ~e^20 over the solver's range of r) e^-700.
+UNDERFLOW_MARGIN = 2.0
+RATE_CHUNK_PAIRS = 2**15  # (T, u) pairs of nu(T) evaluated at once: ~13 MB a temporary
 
 
 # --- the joint law ------------------------------------------------------------------------------
@@ -810,17 +830,16 @@ def _lower_tail_factor(solution, exponent):
     return solution.step * solution.speeds[0] ** 2 / np.expm1(decay * solution.step)
 
 
-def _outgoing_rule(solution, lowest, highest, step):
-    """Nodes u_k = u(s_lo + k step), s = ln u + u^(1/2), from ``lowest`` to beyond ``highest``,
-    and the collision rate w_k u_k P(0, u_k) each carries: P from the solver's Nystrom formula up
-    to its highest node u_max, continued above by its large-speed form (eq. (asym3))
-    P(0, u_max) (u / u_max)^-m e^(-q (u - u_max))."""
+def _outgoing_lattice(solution, first, last, step):
+    """Nodes u_k = u(k step), s = ln u + u^(1/2), for k = first..last, and the collision rate
+    w_k u_k P(0, u_k) each carries: P from the solver's Nystrom formula up to its highest node
+    u_max, continued above by its large-speed form (eq. (asym3))
+    P(0, u_max) (u / u_max)^-m e^(-q (u - u_max)).  The lattice is fixed (k step, whatever
+    the times asked for), so that each T is integrated on nodes of its own."""
     r, u_max = solution.restitution, solution.speeds[-1]
-    s_lo = coordinate_of_speed(lowest)
-    count = int(np.ceil((coordinate_of_speed(max(highest, u_max)) - s_lo) / step)) + 1
-    u = speed_of_coordinate(s_lo + step * np.arange(count))
+    u = speed_of_coordinate(step * np.arange(first, last + 1))
     inside = u <= u_max
-    density = np.empty(count)
+    density = np.empty(u.size)
     density[inside] = solution.outgoing_speed_density(u[inside])
     q, m = large_speed_decay_rate(r), large_speed_exponent(r)
     beyond = u[~inside] / u_max
@@ -828,44 +847,143 @@ def _outgoing_rule(solution, lowest, highest, step):
     return u, step * u / (1.0 + 0.5 * np.sqrt(u)) * u * density
 
 
+def _rate_windows(solution, times, step):
+    """The lattice indices [first, last] of ``_outgoing_lattice`` that each T integrates over:
+    from u_lo = min(u_0, 1e-4 T^(1/2)) (u_0 the solver's lowest node) to T/2 + 10 T^(1/2),
+    beyond which f(T | u) < e^-75 of its peak."""
+    lowest = np.minimum(solution.speeds[0], 1e-4 * np.sqrt(times))
+    highest = 0.5 * times + 10.0 * np.sqrt(times)
+    first = np.floor(coordinate_of_speed(lowest) / step).astype(np.int64)
+    last = np.ceil(coordinate_of_speed(highest) / step).astype(np.int64)
+    return first, last
+
+
+def _direct_flight_rate_density(solution, times, step):
+    """nu(T) of eq. (rate) by the trapezoidal rule of ``flight_rate_density``, each T on its own
+    window of the lattice (``_rate_windows``), in chunks of at most ``RATE_CHUNK_PAIRS``
+    (T, u) pairs (a T whose window is longer is a chunk of its own)."""
+    times = np.asarray(times, dtype=float)
+    first, last = _rate_windows(solution, times, step)
+    u, rate = _outgoing_lattice(solution, int(first.min()), int(last.max()), step)
+    start = first - first.min()  # each window's first node in u
+    sizes = last - first + 1
+    # the rule below u_lo: sum_k>=1 of rate_0 (u_-k / u_lo)^(5/2 - beta) (1 + u_lo^(1/2) / 2)
+    decay = 2.5 - solution.small_speed_exponent
+    tail = rate[start] * (1.0 + 0.5 * np.sqrt(u[start])) / np.expm1(decay * step)
+    result = np.empty(times.size)
+    chunk_ends = np.cumsum(sizes) // RATE_CHUNK_PAIRS
+    for chunk in np.unique(chunk_ends):
+        rows = np.flatnonzero(chunk_ends == chunk)
+        offsets = np.concatenate(([0], np.cumsum(sizes[rows])))
+        row_of_pair = np.repeat(rows, sizes[rows])
+        column = start[row_of_pair] + np.arange(offsets[-1]) - np.repeat(offsets[:-1], sizes[rows])
+        f = flight_time_density(times[row_of_pair], u[column])
+        result[rows] = (
+            np.add.reduceat(f * rate[column], offsets[:-1]) + tail[rows] * f[offsets[:-1]]
+        )
+    return result
+
+
+def flight_rate_in_regimes(times, direct, short_amplitude, beta, restitution):
+    """nu(T) of eq. (rate) from its three regimes, each T on its own.
+
+    Eq. (short) below ``SHORT_FLIGHT_TIME``, ``direct`` up to ``underflow_flight_time``, 0
+    beyond it (and wherever nu is below the smallest normal double).  The one home of the
+    domain of nu(T), for ``flight_rate_density`` and ``equilibrium.ExactEquilibrium``.
+
+    Parameters
+    ----------
+    times : array_like
+        Flight times, ``shortest_flight_time(short_amplitude, beta) <= T``.
+    direct : callable
+        nu of a 1-d array of T in [SHORT_FLIGHT_TIME, underflow_flight_time], by quadrature
+        of eq. (rate).
+    short_amplitude : float
+        A C_beta of eq. (short).
+    beta : float
+        The small-speed exponent of eq. (asym2).
+    restitution : float
+        r (for ``underflow_flight_time``).
+
+    Returns
+    -------
+    numpy.ndarray
+        nu(T), shaped like ``times``; finite.
+
+    Raises
+    ------
+    ValueError
+        If a T is not positive or lies below ``shortest_flight_time``, where nu(T) exceeds the
+        largest double.
+    """
+    times = np.asarray(times, dtype=float)
+    shortest = shortest_flight_time(short_amplitude, beta)
+    bad = ~(times >= max(shortest, np.finfo(float).smallest_subnormal))
+    if bad.any():
+        raise ValueError(
+            f"times: nu(T) is finite for T >= {shortest:.3g} (T > 0; below, A C_beta "
+            f"T^(-beta/2) of eq. (short) exceeds the largest double), got {times[bad].flat[0]!r}"
+        )
+    result = np.zeros(times.shape)
+    short = times < SHORT_FLIGHT_TIME
+    result[short] = _short_law(short_amplitude, beta, times[short])
+    middle = ~short & (times <= underflow_flight_time(restitution))
+    if middle.any():
+        result[middle] = direct(times[middle])
+    return np.where(result >= np.finfo(float).tiny, result, 0.0)
+
+
 def flight_rate_density(solution, times, step=RATE_STEP):
     """nu(T) of eq. (rate): flights of duration in dT per unit time, for any r.
 
-    nu(T) = int_0^inf du u P(0, u) f(T | u), finite for T > 0 (also below r_c).  The u-integral is a trapezoidal rule in s = ln u + u^(1/2) of step ``step``, finer than the
-    solver's (f(T | u) falls like exp(-3 u^2 / 4T) for u >> T^(1/2), which the solver's step
-    0.25 resolves only to ~1e-8), with P(0, u) from the solver's Nystrom formula, from
-    u_lo = min(u_0, 1e-4 T_min^(1/2)) up.  Below u_lo the rule is summed in closed form with
-    f(T | u) = f(T | u_lo) (u / u_lo)^(1/2) (relative error O(u_lo / T^(1/2))) and P(0, u) its
-    power law.  Above the solver's highest node u_max, P(0, u) is continued by its large-speed
-    form up to u = T/2 + 10 T^(1/2) (long flights come from fast balls where q(r) < 3/4, i.e.
-    r > 0.618); where that matters (T >~ u_max / (1/2 - 2q/3)) nu(T) is only as good as that
-    form.
+    nu(T) = int_0^inf du u P(0, u) f(T | u), finite for T > 0 (also below r_c), in three
+    regimes (``flight_rate_in_regimes``), each T on its own (a value never depends on the
+    others asked for with it):
+
+    - ``SHORT_FLIGHT_TIME`` <= T <= ``underflow_flight_time(r)``: the u-integral is a
+      trapezoidal rule in s = ln u + u^(1/2) of step ``step`` on the fixed lattice s = k step,
+      finer than the solver's (f(T | u) falls like exp(-3 u^2 / 4T) for u >> T^(1/2), which the
+      solver's step 0.25 resolves only to ~1e-8), with P(0, u) from the solver's Nystrom
+      formula, from u_lo = min(u_0, 1e-4 T^(1/2)) to T/2 + 10 T^(1/2).  Below u_lo the rule is
+      summed in closed form with f(T | u) = f(T | u_lo) (u / u_lo)^(1/2) (relative error
+      O(u_lo / T^(1/2))) and P(0, u) its power law.  Above the solver's highest node u_max,
+      P(0, u) is continued by its large-speed form (long flights come from fast balls where
+      q(r) < 3/4, i.e. r > 0.618); where that matters (T >~ u_max / (1/2 - 2q/3)) nu(T) is
+      only as good as that form (and below e^-690 of its peak).  Accurate to ~1e-9 relative
+      with the solver's P(0, u).
+    - T < ``SHORT_FLIGHT_TIME``: eq. (short), A C_beta T^(-beta/2), its relative correction
+      O(T^(1/2)) below 1e-14 (A read off the solver's lowest node, ``small_speed_amplitude``).
+    - T > ``underflow_flight_time(r)``: 0 (nu decays like e^(-kappa T), eqs. (long1),
+      (long2), and is below the smallest normal double there); so is any nu below that double.
 
     Parameters
     ----------
     solution : solver.OutgoingSpeedSolution
         The solver's P(0, u), eq. (inteq).
     times : array_like
-        Flight times T > 0.
+        Flight times, T >= ``shortest_flight_time`` (> 0; below it nu(T) exceeds the largest
+        double: 0 unless beta > 1.9, i.e. r < 0.2; 2.4e-258 at r = 0.02).
     step : float
         The rule's step in s.
 
     Returns
     -------
     numpy.ndarray
-        nu(T), shaped like ``times``.
+        nu(T), shaped like ``times``; finite.
+
+    Raises
+    ------
+    ValueError
+        If a T is not positive or lies below ``shortest_flight_time``.
     """
-    times = np.asarray(times, dtype=float)
-    positive = times[times > 0.0]
-    shortest = float(np.min(positive, initial=1.0))
-    longest = float(np.max(positive, initial=0.0))
-    lowest = min(solution.speeds[0], 1e-4 * np.sqrt(shortest))
-    u, rate = _outgoing_rule(solution, lowest, 0.5 * longest + 10.0 * np.sqrt(longest), step)
-    f = flight_time_density(times.ravel()[:, None], u[None, :])
-    # the rule below u_lo: sum_k>=1 of rate_0 (u_-k / u_lo)^(5/2 - beta) (1 + u_lo^(1/2) / 2)
-    decay = 2.5 - solution.small_speed_exponent
-    tail = rate[0] * (1.0 + 0.5 * np.sqrt(u[0])) / np.expm1(decay * step)
-    return (f @ rate + tail * f[:, 0]).reshape(times.shape)
+    beta = solution.small_speed_exponent
+    return flight_rate_in_regimes(
+        times,
+        lambda t: _direct_flight_rate_density(solution, t, step),
+        small_speed_amplitude(solution) * short_time_constant(beta),
+        beta,
+        solution.restitution,
+    )
 
 
 def collision_rate(solution):
@@ -1062,7 +1180,14 @@ def short_flight_rate_density(solution, times):
     """
     beta = solution.small_speed_exponent
     amplitude = small_speed_amplitude(solution) * short_time_constant(beta)
-    return amplitude * np.asarray(times, dtype=float) ** (-0.5 * beta)
+    return _short_law(amplitude, beta, np.asarray(times, dtype=float))
+
+
+def _short_law(amplitude, beta, times):
+    """amplitude T^(-beta/2) of eq. (short), as (amplitude^(1/2) T^(-beta/4))^2: finite
+    wherever the product is (T^(-beta/2) alone overflows first where amplitude < 1), to a few
+    ulp."""
+    return (np.sqrt(amplitude) * times ** (-0.25 * beta)) ** 2
 
 
 def large_speed_amplitude(solution):
@@ -1140,6 +1265,59 @@ def long_time_decay_rate(restitution):
     """
     q = large_speed_decay_rate(restitution)
     return 3.0 / 16.0 if q > 0.75 else 0.5 * q - q * q / 3.0
+
+
+def underflow_flight_time(restitution):
+    """The flight time beyond which nu(T) is below the smallest normal double, and is 0.
+
+    ``UNDERFLOW_MARGIN`` ln(1/tiny) / kappa, with kappa of ``long_time_decay_rate``: nu(T)
+    ~ K T^a e^(-kappa T), eqs. (long1), (long2).
+
+    Parameters
+    ----------
+    restitution : float
+        r, in (0, 1).
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> from bouncing_ball.flight_time import underflow_flight_time
+    >>> print(round(underflow_flight_time(0.5)))
+    7556
+    """
+    return UNDERFLOW_MARGIN * -np.log(np.finfo(float).tiny) / long_time_decay_rate(restitution)
+
+
+def shortest_flight_time(amplitude, beta):
+    """The flight time below which amplitude T^(-beta/2) exceeds the largest double.
+
+    nu(T) ~ A C_beta T^(-beta/2) at short T (eq. (short)): below this T it is not a float.
+
+    Parameters
+    ----------
+    amplitude : float
+        A C_beta (or A C_beta / I for rho(T)), > 0.
+    beta : float
+        The small-speed exponent of eq. (asym2), >= 0.
+
+    Returns
+    -------
+    float
+        0 where even the smallest double gives a finite value.
+
+    Examples
+    --------
+    >>> from bouncing_ball.flight_time import shortest_flight_time
+    >>> print(shortest_flight_time(1.0, 1.0), f"{shortest_flight_time(1.0, 2.4):.3g}")
+    0.0 1.32e-257
+    """
+    if beta <= 0.0:
+        return 0.0
+    exponent = 2.0 / beta * (np.log(amplitude) - np.log(np.finfo(float).max))
+    return float(np.exp(exponent)) if exponent > np.log(np.finfo(float).smallest_subnormal) else 0.0
 
 
 def flight_time_summary(solution):

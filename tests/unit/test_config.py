@@ -1,6 +1,7 @@
 """Parsing r and checking the config (the parts a JSON schema cannot do)."""
 
 import copy
+import re
 from fractions import Fraction
 
 import numpy as np
@@ -8,6 +9,7 @@ import pytest
 import yaml
 from workflow_support import REPOSITORY
 
+from bouncing_ball.flight_time import FLIGHT_TIME_TABLE_RANGE
 from bouncing_ball.restitution import parse_restitution, restitution_grid, restitution_label
 from bouncing_ball.settings import MAX_STEPS_LIMIT
 from bouncing_ball.workflow.config import (
@@ -387,3 +389,26 @@ def test_a_position_beyond_the_largest_height_is_refused_naming_the_key(section)
     config = _set(_small_config(), f"{section}.positions", [0, 1.0e13])
     with pytest.raises(ValueError, match=rf"config: {section}.positions"):
         check_config(config, _schema())
+
+
+@pytest.mark.parametrize(
+    "key, value, relation",
+    [("solver.flight_times.min", 1.0e-250, "less"), ("solver.flight_times.max", 1.0e14, "greater")],
+)
+def test_flight_times_beyond_the_library_table_range_are_refused(key, value, relation):
+    """Below 1e-30 the flight-time table is its short-flight law; beyond 1e4 it is 0 for
+    r <= 0.618 and each T costs T^(1/2) nodes: refused before any job, naming the key."""
+    config = _set(_small_config(), key, value)
+    with pytest.raises(
+        ValueError, match=rf"{re.escape(key)}: {re.escape(repr(value))} is {relation} than"
+    ):
+        check_config(config, _schema())
+
+
+def test_the_schema_and_the_readme_bound_flight_times_by_the_library_range():
+    bounds = _schema()["properties"]["solver"]["properties"]["flight_times"]["properties"]
+    assert (bounds["min"]["minimum"], bounds["max"]["maximum"]) == FLIGHT_TIME_TABLE_RANGE
+    low, high = FLIGHT_TIME_TABLE_RANGE
+    readme = (REPOSITORY / "config" / "README.md").read_text()
+    stated = f"{low:.1e} <= min < max <= {high:.1e}".replace("e+0", "e+")  # 1.0e+4
+    assert stated in readme
