@@ -365,12 +365,12 @@ def _fma_compiled(a, b, c):
 
 
 def flag_is_set(flag):
-    """Whether ``flag[0]`` is nonzero, ``flag`` a one-element int64 array that another thread
-    may set while compiled code runs (a request to stop, ``simulation.ShardStop``).
+    """Whether ``flag[0]`` is nonzero, read afresh however often compiled code asks.
 
-    Compiled code reads it afresh at every call, by an atomic (monotonic) load: a plain read
-    of memory no one in the loop writes could be read once, before the loop, by the
-    optimiser.
+    ``flag`` is a one-element int64 array that another thread may set while compiled code
+    runs (a request to stop, ``simulation.ShardStop``).  Compiled code reads it at every call
+    by an atomic (monotonic) load: a plain read of memory that nothing in a loop writes may
+    be made once, before the loop, by the optimiser.
 
     Parameters
     ----------

@@ -582,8 +582,10 @@ STOP_CHECK_STEPS = 1 << 16
 
 
 class ShardStop:
-    """A request to stop a running shard (``simulate_shard``'s ``stop``), which ``set`` makes
-    from any thread; the shard then raises ``ShardStopped`` within ``STOP_CHECK_STEPS`` steps.
+    """A request to stop a running shard: ``simulate_shard``'s ``stop``.
+
+    ``set`` makes it, from any thread; the shard then raises ``ShardStopped`` within
+    ``STOP_CHECK_STEPS`` steps.
 
     Examples
     --------
@@ -607,8 +609,10 @@ class ShardStop:
 
 
 class ShardStopped(Exception):
-    """A shard stopped by its ``ShardStop`` before it finished: it has no tallies (the part it
-    ran is no shard of the run's, whose every tally covers the whole recorded time)."""
+    """A shard stopped by its ``ShardStop`` before it finished: it has no tallies.
+
+    The part it ran is no shard of the run's, whose every tally covers the whole recorded
+    time."""
 
 
 # a step this short only happens in a collapse (v ~ 1e-37); much shorter ones overflow the bridge's
