@@ -214,13 +214,14 @@ def _run_here(arguments, shards, finished, on_finished):
             name=f"simulate shard {index}",
             daemon=True,
         )
-        runner.start()
         try:
+            runner.start()
             while runner.is_alive():
                 runner.join(WAIT_INTERVAL)
         finally:
             stop.set()  # changes nothing if it finished
-            runner.join()
+            if runner.ident is not None:  # started
+                runner.join()
             if "tallies" in outcome:  # finished, if just before an interrupt: a whole shard
                 finished[index] = outcome["tallies"]
         if "error" in outcome:
