@@ -45,6 +45,7 @@ from . import PACKAGE, source_digest
 __all__ = [
     "njit",
     "fma",
+    "flag_is_set",
     "COMPILED",
     "CACHE",
     "prune_caches",
@@ -360,6 +361,55 @@ def _llvm_fma(typingctx, a, b, c):
 def _fma_compiled(a, b, c):
     if all(isinstance(value, types.Float) and value.bitwidth == 64 for value in (a, b, c)):
         return lambda a, b, c: _llvm_fma(a, b, c)
+    return None
+
+
+def flag_is_set(flag):
+    """Whether ``flag[0]`` is nonzero, read afresh however often compiled code asks.
+
+    ``flag`` is a one-element int64 array that another thread may set while compiled code
+    runs (a request to stop, ``simulation.ShardStop``).  Compiled code reads it at every call
+    by an atomic (monotonic) load: a plain read of memory that nothing in a loop writes may
+    be made once, before the loop, by the optimiser.
+
+    Parameters
+    ----------
+    flag : numpy.ndarray
+        One-element int64 array.
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bouncing_ball.jit import flag_is_set
+    >>> flag = np.zeros(1, dtype=np.int64)
+    >>> flag_is_set(flag), flag_is_set(flag + 1)
+    (False, True)
+    """
+    return bool(flag[0])
+
+
+@intrinsic
+def _atomic_first_element(typingctx, flag):
+    """The first element of an int64 array, by an atomic load of monotonic ordering."""
+    if not (isinstance(flag, types.Array) and flag.dtype == types.int64):
+        return None
+    signature = types.int64(flag)
+
+    def codegen(context, builder, sig, args):
+        array = context.make_array(sig.args[0])(context, builder, args[0])
+        return builder.load_atomic(array.data, ordering="monotonic", align=8)
+
+    return signature, codegen
+
+
+@overload(flag_is_set)
+def _flag_is_set_compiled(flag):
+    if isinstance(flag, types.Array) and flag.dtype == types.int64:
+        return lambda flag: _atomic_first_element(flag) != 0
     return None
 
 

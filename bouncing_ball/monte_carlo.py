@@ -7,8 +7,10 @@ It is the workflow's machinery, called directly: shard k of r draws from
 shard of ``simulate`` is the workflow's shard k for the same seed and settings, whatever the
 number of processes; the tables are ``histograms``' (the workflow's merge stage).
 
-A Ctrl-C keeps the shards that finished (``SimulationInterrupted``), and the worker processes
-never outlive the process that started them (``_watch_parent``).
+A Ctrl-C stops the run at once and keeps the shards that finished (``SimulationInterrupted``):
+in this process a shard runs in a thread of its own, which the Ctrl-C stops (``_run_here``), and
+the worker processes are killed; they never outlive the process that started them
+(``_watch_parent``).
 """
 
 import contextlib
@@ -87,11 +89,14 @@ def _whole_number(value, name, least, most=None):
     return int(value)
 
 
-def _run_shard(restitution, seed, label, settings, shard):
-    """One shard on its own stream (a module-level function: picklable for spawned workers)."""
+def _run_shard(restitution, seed, label, settings, shard, stop=None):
+    """One shard on its own stream (a module-level function: picklable for spawned workers);
+    ``stop``: ``simulation.simulate_shard``'s."""
     from .simulation import shard_seed_sequence, simulate_shard  # numba: only where it runs
 
-    return shard, simulate_shard(restitution, shard_seed_sequence(seed, label, shard), settings)
+    return shard, simulate_shard(
+        restitution, shard_seed_sequence(seed, label, shard), settings, stop=stop
+    )
 
 
 #: Seconds between a worker's checks that the process that started it is alive.
@@ -174,31 +179,54 @@ def _run_in_workers(arguments, shards, processes, finished, on_finished):
         pool.shutdown(wait=True, cancel_futures=True)
 
 
-@contextlib.contextmanager
-def _interrupt_between_shards():
-    """Within it, a Ctrl-C in the main thread (SIGINT: a terminal's or a notebook's interrupt)
-    sets the flag it yields (a list, true once interrupted) instead of raising inside a
-    shard; elsewhere (another thread) Ctrl-C is Python's as usual."""
-    flag = []
-    if threading.current_thread() is not threading.main_thread():
-        yield flag
-        return
-    previous = signal.signal(signal.SIGINT, lambda number, frame: flag.append(number))
+#: Seconds between the waiting thread's wake-ups while a shard runs in its own thread: where
+#: a wait cannot be interrupted by a signal, the longest a Ctrl-C waits to be seen.
+WAIT_INTERVAL = 0.1
+
+
+def _shard_in_thread(arguments, index, outcome, stop):
+    """The body of a shard's thread: ``outcome["tallies"]``, or ``outcome["error"]`` (not when
+    ``stop`` stopped it: it has nothing to give)."""
+    from .simulation import ShardStopped
+
     try:
-        yield flag
-    finally:
-        signal.signal(signal.SIGINT, previous)
+        outcome["tallies"] = _run_shard(*arguments, index, stop=stop)[1]
+    except ShardStopped:
+        pass
+    except BaseException as error:  # raised again by the waiting thread
+        outcome["error"] = error
 
 
 def _run_here(arguments, shards, finished, on_finished):
-    """Run the shards one after the other in this process; a Ctrl-C stops the run when the
-    shard under way ends (the compiled loop does not see signals), keeping it."""
-    with _interrupt_between_shards() as interrupted:
-        for index in range(shards):
-            finished[index] = _run_shard(*arguments, index)[1]
-            on_finished()
-            if interrupted:
-                raise KeyboardInterrupt
+    """Run the shards one after the other in this process, each in a thread of its own (the
+    compiled loop releases the GIL) while this thread waits for it in short waits, where a
+    Ctrl-C (Python raises KeyboardInterrupt in the main thread, in a terminal and in a
+    notebook) lands at once.  On it, or any exception, the shard under way is stopped
+    (``simulation.ShardStop``) and waited for, its part of a shard discarded, and the
+    finished shards are kept, before it propagates."""
+    from .simulation import ShardStop
+
+    for index in range(shards):
+        outcome, stop = {}, ShardStop()
+        runner = threading.Thread(
+            target=_shard_in_thread,
+            args=(arguments, index, outcome, stop),
+            name=f"simulate shard {index}",
+            daemon=True,
+        )
+        try:
+            runner.start()
+            while runner.is_alive():
+                runner.join(WAIT_INTERVAL)
+        finally:
+            stop.set()  # changes nothing if it finished
+            if runner.ident is not None:  # started
+                runner.join()
+            if "tallies" in outcome:  # finished, if just before an interrupt: a whole shard
+                finished[index] = outcome["tallies"]
+        if "error" in outcome:
+            raise outcome["error"]
+        on_finished()
 
 
 def _check_recorded(tallies, settings):
@@ -343,10 +371,10 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
     SimulationInterrupted
         On Ctrl-C (a KeyboardInterrupt, in a terminal or a notebook), holding the shards
         that finished: ``error.result`` is their ``SimulationResult`` marked partial (None
-        with fewer than 2), ``error.finished`` their tallies.  With ``processes`` >= 2 the
-        run stops at once, the shards under way lost.  With ``processes=1`` the shards run in
-        this process in compiled code, which does not see signals: the run stops when the
-        shard under way ends, and keeps it; so a Ctrl-C waits up to one shard's run time.
+        with fewer than 2), ``error.finished`` their tallies.  The run stops at once,
+        whatever ``processes``: the shards under way are stopped and their work discarded
+        (a shard's numbers do not depend on an interrupt).  A shard still being compiled
+        (the first call in a fresh numba cache) stops when its compile ends.
     ValueError
         Naming the argument out of its range; or, after the run, a shard_time too short for
         a collision in every shard.

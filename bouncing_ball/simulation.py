@@ -93,6 +93,11 @@ depends on the state):
 A shard's work is bounded: it stops after ``max_steps`` steps (equilibration
 included) even if the simulated time has not been reached, and says so.
 
+A shard can be stopped from another thread (``ShardStop``; ``simulate``'s Ctrl-C): the loop
+releases the GIL and looks at its stop flag every ``STOP_CHECK_STEPS`` steps, where it
+checks the step budget, so the step itself is unchanged.  A stopped shard has no tallies
+(``ShardStopped``); a shard that is not stopped is the same, number for number.
+
 Below r_c = exp(-pi / sqrt 3) (inelastic collapse).  The collision rate I
 of eq. (collrate) is infinite there: each collision shrinks the outgoing
 speed by a random factor whose mean logarithm is negative, the speeds go
@@ -139,7 +144,7 @@ from .free_flight import (
     speed_squared_coefficients,
     whole_step_integrals,
 )
-from .jit import fma, njit
+from .jit import flag_is_set, fma, njit
 from .pcg64 import next_double, standard_normal, stream_words
 from .settings import RETURN_LAW_SPEED_BINS, ShardSettings
 from .tallies import EARLY_FRACTION, SCALAR_INDEX, ShardTallies, tally_seed_sequence
@@ -155,6 +160,9 @@ __all__ = [
     "floor_stratum_end",
     "shard_seed_sequence",
     "simulate_shard",
+    "ShardStop",
+    "ShardStopped",
+    "STOP_CHECK_STEPS",
 ]
 
 # indices into the scalar tally array of the compiled loop (its layout: tallies.SCALARS)
@@ -568,12 +576,51 @@ def _tally_second_bridge_point(
     return tally_high, tally_low
 
 
+#: Steps between the shard loop's looks at its stop flag (``ShardStop``), at the check of its
+#: step budget: a small fraction of a second of any shard.
+STOP_CHECK_STEPS = 1 << 16
+
+
+class ShardStop:
+    """A request to stop a running shard: ``simulate_shard``'s ``stop``.
+
+    ``set`` makes it, from any thread; the shard then raises ``ShardStopped`` within
+    ``STOP_CHECK_STEPS`` steps.
+
+    Examples
+    --------
+    >>> from bouncing_ball.simulation import ShardStop
+    >>> stop = ShardStop()
+    >>> stop.is_set()
+    False
+    >>> stop.set()
+    >>> stop.is_set()
+    True
+    """
+
+    def __init__(self):
+        self.flag = np.zeros(1, dtype=np.int64)  # what the compiled loop reads (``flag_is_set``)
+
+    def set(self):
+        self.flag[0] = 1
+
+    def is_set(self) -> bool:
+        return flag_is_set(self.flag)
+
+
+class ShardStopped(Exception):
+    """A shard stopped by its ``ShardStop`` before it finished: it has no tallies.
+
+    The part it ran is no shard of the run's, whose every tally covers the whole recorded
+    time."""
+
+
 # a step this short only happens in a collapse (v ~ 1e-37); much shorter ones overflow the bridge's
 # cubic coefficients (~ x / dt^2) before the speed underflows to zero
 COLLAPSED_STEP = 1.0e-80
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _run(
     stream,
     tally_stream,
@@ -598,7 +645,9 @@ def _run(
     return_law_speed_counts,
     scalars,
     parts,
+    stop,
 ):
+    # stop: the stop flag (ShardStop.flag); returns True when it stopped the shard
     # v_edges: speeds (log); x_edges: heights (log); u_edges: velocities of P(x, v) (linear);
     # f_edges: flight times (log); w_edges: outgoing speeds, fine (log, RETURN_LAW_SPEED_BINS);
     # stream, tally_stream: the PCG64 states (pcg64.stream_words)
@@ -676,6 +725,8 @@ def _run(
     early_collisions = 0
     early_int_x = 0.0
     early_int_x2 = 0.0
+    stopped = False
+    next_check = 0  # the next step at which the budget and the stop flag are looked at
 
     while True:
         if t >= t_stop:
@@ -693,9 +744,14 @@ def _run(
             early_int_x = int_x
             early_int_x2 = int_x2
             t_early = math.inf
-        if steps >= max_steps:
-            exhausted = 1
-            break
+        if steps >= next_check:  # one comparison a step for the budget and the stop flag
+            if steps >= max_steps:
+                exhausted = 1
+                break
+            if flag_is_set(stop):
+                stopped = True
+                break
+            next_check = min(max_steps, steps + STOP_CHECK_STEPS)
         dt = fma(root, root, delta)  # eq. (criterion) plus delta
         if not dt > COLLAPSED_STEP:  # below r_c without a floor on delta: the speed is going to 0
             exhausted = 1
@@ -928,6 +984,7 @@ def _run(
     scalars[_POSITION_NOISE_SUM] = position_noise_sum
     scalars[_POSITION_NOISE_V_SUM] = position_noise_v_sum
     scalars[_POSITION_NOISE_X_SUM] = position_noise_x_sum
+    return stopped
 
 
 def simulate_shard(
@@ -935,6 +992,7 @@ def simulate_shard(
     seed_sequence: np.random.SeedSequence,
     settings: ShardSettings,
     parts: int = EVERY_TALLY,
+    stop: ShardStop = None,
 ) -> ShardTallies:
     """Run one shard of r = ``restitution`` and return its tallies (pure: no I/O).
 
@@ -961,6 +1019,9 @@ def simulate_shard(
         breakdown leaves ``MEAN_PATH_INTEGRALS``, ``POSITION``, ``JOINT``, ``FLIGHTS`` or
         ``CONTROL_VARIATES`` out); the collisions, their outgoing speeds, the time and the
         steps are always recorded.
+    stop : ShardStop, optional
+        Set from another thread to stop the shard (the loop runs without the GIL): it raises
+        ``ShardStopped`` within ``STOP_CHECK_STEPS`` steps.  Not set, it changes nothing.
 
     Returns
     -------
@@ -971,6 +1032,8 @@ def simulate_shard(
     ------
     ValueError
         If r is not in (0, 1).
+    ShardStopped
+        If ``stop`` was set before the shard finished.
 
     Examples
     --------
@@ -995,7 +1058,7 @@ def simulate_shard(
     rng = np.random.Generator(np.random.PCG64(seed_sequence))
     rng_tally = np.random.Generator(np.random.PCG64(tally_seed_sequence(seed_sequence)))
     arrays = ShardTallies.loop_arrays(settings)
-    _run(
+    stopped = _run(
         stream_words(rng),
         stream_words(rng_tally),
         float(restitution),
@@ -1019,5 +1082,8 @@ def simulate_shard(
         arrays["return_law_speed_counts"],
         arrays["scalars"],
         parts,
+        (ShardStop() if stop is None else stop).flag,
     )
+    if stopped:
+        raise ShardStopped(f"the shard of r = {restitution} was stopped before it finished")
     return ShardTallies.from_loop(settings, arrays)

@@ -1,6 +1,7 @@
 """simulate under a Ctrl-C and a killed parent, and the shard times it refuses: an interrupt
-keeps the finished shards (a partial SimulationResult) and stops at once with worker
-processes, the workers die with their parent, a shard with no collision is refused."""
+keeps the finished shards (a partial SimulationResult) and stops at once, with worker
+processes and in this process (the shard under way stopped), the workers die with their
+parent, a shard with no collision is refused."""
 
 import contextlib
 import os
@@ -16,19 +17,24 @@ import pytest
 import bouncing_ball as bb
 from bouncing_ball.monte_carlo import SimulationResult
 
-# a child that interrupts itself (SIGINT, as a terminal or a notebook kernel gets it) once two
-# shards have finished, and reports what simulate raised and how long it took to stop
+# a child that interrupts itself (SIGINT, as a terminal or a notebook kernel gets it) `delay`
+# seconds after `after` shards have finished, and reports what simulate raised and how long it
+# took to stop
 _INTERRUPTED_CHILD = """
-import os, signal, sys, time
+import os, signal, sys, threading, time
 import bouncing_ball as bb
 from bouncing_ball import monte_carlo
 
-def interrupt_after_two(self, done):
-    if done == {after} and not hasattr(monte_carlo, "sent"):
-        monte_carlo.sent = time.perf_counter()
-        os.killpg(0, signal.SIGINT) if {group} else os.kill(os.getpid(), signal.SIGINT)
+def interrupt():
+    monte_carlo.sent = time.perf_counter()
+    os.killpg(0, signal.SIGINT) if {group} else os.kill(os.getpid(), signal.SIGINT)
 
-monte_carlo._Progress.show = interrupt_after_two
+def interrupt_after(self, done):
+    if done == {after} and not hasattr(monte_carlo, "scheduled"):
+        monte_carlo.scheduled = True
+        threading.Timer({delay}, interrupt).start() if {delay} else interrupt()
+
+monte_carlo._Progress.show = interrupt_after
 if __name__ == "__main__":
     try:
         bb.simulate(0.6, shards={shards}, shard_time={shard_time}, seed=1, processes={processes},
@@ -45,9 +51,14 @@ if __name__ == "__main__":
 """
 
 
-def _interrupted_run(processes, group, shards, shard_time, after=2):
+def _interrupted_run(processes, group, shards, shard_time, after=2, delay=0.0):
     script = _INTERRUPTED_CHILD.format(
-        group=group, shards=shards, shard_time=shard_time, processes=processes, after=after
+        group=group,
+        shards=shards,
+        shard_time=shard_time,
+        processes=processes,
+        after=after,
+        delay=delay,
     )
     child = subprocess.Popen(
         [sys.executable, "-c", script],
@@ -78,7 +89,7 @@ def test_ctrl_c_stops_the_workers_at_once_and_keeps_the_finished_shards(group):
     assert (partial, shown, in_summary) == ("True", "True", "True")
 
 
-def test_ctrl_c_in_this_process_stops_after_the_shard_under_way_keeping_it():
+def test_ctrl_c_in_this_process_between_shards_keeps_the_finished_ones():
     words = _interrupted_run(processes=1, group=False, shards=50, shard_time=1.0e5)
     name, _, finished, requested, partial, shown, in_summary = words
     assert name == "SimulationInterrupted"
@@ -86,10 +97,19 @@ def test_ctrl_c_in_this_process_stops_after_the_shard_under_way_keeping_it():
     assert (partial, shown, in_summary) == ("True", "True", "True")
 
 
-def test_ctrl_c_with_one_shard_finished_says_there_is_no_result():
-    words = _interrupted_run(processes=1, group=False, shards=50, shard_time=1.0e5, after=1)
-    assert words[0] == "SimulationInterrupted" and words[2] == "1"
-    assert "1 of 50 shards finished: too few for a result" in " ".join(words)
+@pytest.mark.parametrize("group", [False, True], ids=["notebook", "terminal"])
+def test_ctrl_c_in_this_process_stops_the_shard_under_way_at_once(group):
+    """processes=1, shards of about a second's CPU each: a Ctrl-C a quarter of the way into
+    shard 1 stops it at once, its work discarded, and keeps shard 0 (too few for a result).
+    Waiting for shard 1 to end would take most of a second and keep it too."""
+    words = _interrupted_run(
+        processes=1, group=group, shards=4, shard_time=1.2e6, after=1, delay=0.25
+    )
+    name, stopped, finished = words[:3]
+    assert name == "SimulationInterrupted"
+    assert int(finished) == 1
+    assert float(stopped) < 0.5  # the loop looks at its stop flag every STOP_CHECK_STEPS steps
+    assert "1 of 4 shards finished: too few for a result" in " ".join(words)
 
 
 def _children(pid):
