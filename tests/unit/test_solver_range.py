@@ -276,3 +276,15 @@ def test_the_return_speed_law_may_be_undefined_only_above_the_highest_node():
     assert distribution.solve_table_defects(summary, tables) == [
         "return_speed: 1 of 2 probability are NaN"
     ]
+
+
+def test_an_infinite_value_is_refused_and_an_overflow_bin_edge_is_not():
+    summary, tables = _passing_tables()
+    tables["return_speed"] = pd.DataFrame(
+        {"u_lo": [1.0], "u_hi": [2.0], "v_lo": [50.0], "v_hi": [np.inf], "probability": [0.01]}
+    )
+    assert distribution.solve_table_defects(summary, tables) == []
+    tables["return_speed"].loc[0, "probability"] = np.inf
+    assert distribution.solve_table_defects(summary, tables) == [
+        "return_speed: 1 of 1 probability are infinite"
+    ]
