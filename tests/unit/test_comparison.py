@@ -12,6 +12,7 @@ from bouncing_ball import exact
 from bouncing_ball.bins import LogBins
 from bouncing_ball.comparison import (
     PAPER_VALUES,
+    SIGN_FLIP_SEED,
     VALIDATION_CHECKS,
     fit_checks,
     moment_rows,
@@ -459,13 +460,85 @@ def test_sign_flip_p_value_is_small_for_a_bias():
     assert p_biased < 1e-3
 
 
-def test_sign_flip_test_is_reproducible_and_counts_the_observed_statistic():
+@pytest.mark.parametrize("zero_shards", [0, 1])
+def test_sign_flip_test_counts_every_pattern_that_ties_with_the_observed_statistic(zero_shards):
+    """A shift of 100 standard deviations in every bin of 8 shards: a flipped pattern ties
+    with the observed statistic exactly when it gives every shifted shard the same sign (all
+    + or all -: z^2 does not see the overall sign; a shard of zero deviations, whatever its
+    sign), and every other pattern is far below.  p = (1 + the ties drawn) / (1 + flips),
+    on any BLAS."""
     rng = np.random.default_rng(23)
-    deviations = _correlated_deviations(rng, 8, 12)
+    deviations = _correlated_deviations(rng, 8, 12) + 100.0
+    deviations[8 - zero_shards :] = 0.0
     assert sign_flip_test(deviations) == sign_flip_test(deviations)
-    # every flipped statistic is below an observed one of a large shift: p = 1 / (1 + flips)
-    _, p_chi2, p_worst = sign_flip_test(deviations + 100.0, flips=500)
-    assert p_chi2 == p_worst == pytest.approx(1.0 / 501.0)
+    # the patterns sign_flip_test draws: one block of 500 from its seed
+    signs = np.random.default_rng(SIGN_FLIP_SEED).choice([-1.0, 1.0], size=(500, 8))
+    shifted = signs[:, : 8 - zero_shards]
+    ties = int(np.sum(np.all(shifted == shifted[:, :1], axis=1)))
+    assert ties >= 2  # the draws hold such patterns: the count below is tested
+    _, p_chi2, p_worst = sign_flip_test(deviations, flips=500)
+    assert p_chi2 == p_worst == (1 + ties) / 501
+
+
+def test_sign_flip_test_is_the_same_however_the_blas_blocks_the_sums(monkeypatch):
+    """The flips in blocks of 1000, 7 and 1 (a matrix product or a vector product, other
+    BLAS kernels and roundings): the same statistic and p-values to the last bit."""
+    from bouncing_ball import comparison
+
+    rng = np.random.default_rng(27)
+    deviations = _correlated_deviations(rng, 8, 12) + 100.0
+    results = set()
+    for block in (1000, 7, 1):
+        monkeypatch.setattr(comparison, "_FLIPS_PER_BLOCK", block)
+        results.add(sign_flip_test(deviations, flips=300))
+    assert len(results) == 1
+
+
+def test_sign_flip_sums_over_shards_are_exact():
+    """The deviations as ``_integer_deviations`` rounds them: integers whose sum under any
+    signs (here every one of the 2^10 patterns) is the exact integer sum, in any order."""
+    from itertools import product
+
+    from bouncing_ball.comparison import _integer_deviations
+
+    rng = np.random.default_rng(28)
+    deviations = rng.standard_normal((10, 5)) * np.array([1e-300, 1e-8, 1.0, 1e8, 1e300])
+    integers = _integer_deviations(deviations)
+    # each bin scaled by a power of 2 to a largest |integer| of 52 - ceil(log2(10)) bits and
+    # rounded: the integers' ratios are the deviations' to 2^-47
+    top = np.max(np.abs(integers), axis=0)
+    assert np.all(integers == np.rint(integers)) and np.all((top >= 2.0**47) & (top <= 2.0**48))
+    np.testing.assert_array_less(
+        np.abs(integers / top - deviations / np.max(np.abs(deviations), axis=0)), 2.0**-47
+    )
+    signs = np.array(list(product([-1, 1], repeat=10)))
+    exact = [
+        [sum(int(s) * int(q) for s, q in zip(row, column)) for column in integers.T]
+        for row in signs
+    ]
+    assert np.array_equal(signs.astype(float) @ integers, np.array(exact, dtype=float))
+    assert np.array_equal(
+        signs[:, ::-1].astype(float) @ integers[::-1], np.array(exact, dtype=float)
+    )
+
+
+@pytest.mark.parametrize(
+    "deviations, flips, message",
+    [
+        (np.ones((1, 3)), 10, "shards >= 2"),
+        (np.ones(4), 10, "shards >= 2"),
+        (np.array([[1.0, np.nan], [0.0, 1.0]]), 10, "finite"),
+        (np.array([[1.0, 2.0], [0.0, 2.0], [3.0, 2.0]]), 10, r"bin\(s\) \[1\]"),
+        (np.array([[1.0, 0.0], [0.0, 0.0]]), 10, r"bin\(s\) \[1\]"),
+        (np.array([[1.0], [-1.0]]), 0, "flips"),
+        (np.array([[1.0], [-1.0]]), 2.5, "flips"),
+    ],
+)
+def test_sign_flip_test_refuses_what_it_cannot_test(deviations, flips, message):
+    """No shards to flip, non-finite deviations, a bin without scatter between the shards
+    (z is 0/0 or infinite), no flips."""
+    with pytest.raises(ValueError, match=message):
+        sign_flip_test(deviations, flips=flips)
 
 
 def test_ratio_deviations_add_up_to_the_merged_estimate_minus_the_reference():
