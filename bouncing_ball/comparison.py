@@ -591,6 +591,18 @@ def shard_ratios(shards) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         }
 
 
+def _largest(values, where):
+    """The position of the largest of ``values`` (NaN: the first NaN), of equal ones the one at
+    the smallest ``where``: the same bin whatever the order of the bins (``numpy.argmax``
+    takes the first, e.g. of two empty bins' infinite relative errors, or of z = +-2)."""
+    values, where = np.asarray(values, dtype=float), np.asarray(where, dtype=float)
+    top = np.max(values)
+    if np.isnan(top):
+        return int(np.argmax(values))
+    tied = np.flatnonzero(values == top)
+    return int(tied[np.argmin(where[tied])])
+
+
 def _z_rows(quantity, reference, where, z, shards, symbol, deviations=None):
     """The chi^2/n and worst-bin rows of one set of residuals ``z`` at bin centres ``where``;
     the chi^2/n row's p_sign_flip from ``sign_flip_test`` of ``deviations`` (shards x the
@@ -599,8 +611,8 @@ def _z_rows(quantity, reference, where, z, shards, symbol, deviations=None):
     if n == 0:
         worst, at, chi2 = np.nan, np.nan, np.nan
     else:
-        k = int(np.argmax(np.abs(z)))
-        worst, at, chi2 = float(z[k]), float(where[k]), float(np.mean(np.square(z)))
+        k = _largest(np.abs(z), where)
+        worst, at, chi2 = float(z[k]), float(where[k]), float(order_free_mean(np.square(z)))
     if deviations is None or n == 0:
         p_value = np.nan
         note = f"{shards} shards; no sign-flip p without the shards' tallies"
@@ -732,7 +744,7 @@ def _outgoing_speed_rows(quantity, simulated, restitution, shards, solver_curve,
             np.inf,
         )
     if len(relative):
-        k = int(np.argmax(relative))
+        k = _largest(relative, quality.v.to_numpy())
         largest, at = float(relative[k]), float(quality.v.iloc[k])
     else:
         largest, at = np.nan, np.nan

@@ -356,6 +356,20 @@ def test_validation_relative_error_names_the_worst_bin_and_counts_empty_bins_as_
     )
 
 
+def test_validation_names_the_same_bin_of_equal_worst_values_in_any_order_of_the_bins():
+    """Two empty bins in 0.01 <= v <= 5 (infinite relative errors, an exact tie): the row
+    names the one of the smaller v, with the bins in order and reversed."""
+    rng = np.random.default_rng(16)
+    p0v, _ = _simulated_bins(Fraction(1, 2), 0.01, rng)
+    inside = p0v.index[(p0v.v >= 0.01) & (p0v.v <= 5.0)]
+    p0v.loc[[inside[8], inside[4]], ["p0v", "p0v_err"]] = [0.0, np.nan]
+    for table in (p0v, p0v.iloc[::-1].reset_index(drop=True)):
+        row = _by_check(outgoing_speed_checks(table, Fraction(1, 2), shards=8)).loc[
+            "p0v_largest_relative_error"
+        ]
+        assert row.value == np.inf and row.bin_centre == p0v.loc[inside[4], "v"]
+
+
 def test_validation_at_an_r_without_exact_solution_uses_the_solver_and_skips_p_x():
     """At r = 0.6 the reference of P(0, v) is the solver's curve (here a curve 1% high, which
     the residuals must show); there is no P(x) row."""
@@ -646,3 +660,73 @@ def test_validation_refuses_tallies_of_another_number_of_shards():
         outgoing_speed_checks(
             outgoing_speed_histogram(shards), Fraction(1, 2), 5, per_shard=shard_ratios(shards)
         )
+
+
+def _validation_inputs(permutation_seed=None):
+    """The arguments of ``validation_rows`` for 16 synthetic shards at r = 1/2, the bins of
+    the merged tables and of the shards' tallies shuffled alike by ``permutation_seed``
+    (None: in order)."""
+    restitution = Fraction(1, 2)
+    shards = _synthetic_shards(restitution, 16, np.random.default_rng(29))
+    p0v, position = outgoing_speed_histogram(shards), position_histogram(shards)
+    per_shard = shard_ratios(shards)
+    if permutation_seed is not None:
+        order = np.random.default_rng(permutation_seed)
+        speeds, heights = order.permutation(len(p0v)), order.permutation(len(position))
+        p0v = p0v.iloc[speeds].reset_index(drop=True)
+        position = position.iloc[heights].reset_index(drop=True)
+        columns = {"p0v": speeds, "px": heights, "v2_given_x": heights}
+        per_shard = {
+            key: tuple(part[:, columns[key]] for part in parts) for key, parts in per_shard.items()
+        }
+    return ("0.5", restitution, p0v, position, _fits_table(), len(shards), None, per_shard)
+
+
+def _numbers(rows):
+    """The validation rows' value, bin_centre and p_sign_flip, to the last bit (float.hex)."""
+    return {
+        row["check"]: [float(row[key]).hex() for key in ("value", "bin_centre", "p_sign_flip")]
+        for row in rows
+    }
+
+
+def test_validation_numbers_do_not_depend_on_the_order_of_the_bins_nor_the_blas_threads(
+    tmp_path,
+):
+    """The table's chi^2/n, worst z and its bin, p_sign_flip, ... to the last bit: with the
+    bins in order, shuffled twice, and computed in a process with another number of BLAS
+    threads (2 where this one has 1, else 1)."""
+    import os
+    import pickle
+    import subprocess
+    import sys
+
+    arguments = tmp_path / "arguments.pickle"
+    arguments.write_bytes(pickle.dumps(_validation_inputs()))
+    threads = "2" if os.environ.get("OPENBLAS_NUM_THREADS") == "1" else "1"
+    other = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import pickle, sys\n"
+            "from bouncing_ball.comparison import validation_rows\n"
+            f"arguments = pickle.loads(open({str(arguments)!r}, 'rb').read())\n"
+            "sys.stdout.buffer.write(pickle.dumps(validation_rows(*arguments)))\n",
+        ],
+        env=dict(
+            os.environ,
+            OPENBLAS_NUM_THREADS=threads,
+            OMP_NUM_THREADS=threads,
+            MKL_NUM_THREADS=threads,
+        ),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    in_order = _numbers(validation_rows(*_validation_inputs()))
+    flipped = [p for _, _, p in in_order.values() if p != float("nan").hex()]
+    assert len(flipped) == 3  # P(0, v), P(x), <v^2>_x
+    for seed in (30, 31):
+        assert _numbers(validation_rows(*_validation_inputs(seed))) == in_order, seed
+    out, err = other.communicate(timeout=120)
+    assert other.returncode == 0, err.decode()
+    assert _numbers(pickle.loads(out)) == in_order
