@@ -5,6 +5,7 @@ results/tables/moments.{csv,md} and results/tables/validation.{csv,md} are
 drawn from them.
 """
 
+import numbers
 from fractions import Fraction
 
 import numpy as np
@@ -23,6 +24,7 @@ __all__ = [
     "outgoing_speed_residuals",
     "exact_outgoing_speed_residuals",
     "sign_flip_test",
+    "order_free_mean",
     "ratio_deviations",
     "shard_ratios",
     "outgoing_speed_checks",
@@ -347,6 +349,83 @@ POSITION_RANGE = (1.0e-3, 50.0)
 SIGN_FLIPS = 10_000
 SIGN_FLIP_SEED = 20061121
 _FLIPS_PER_BLOCK = 1000  # flips evaluated at once (memory: block x bins)
+# the unit roundoff of a float64: a rounded +, -, x or / is exact times (1 + e), |e| <= u
+_UNIT_ROUNDOFF = float(np.finfo(float).eps) / 2.0
+# the bits of a float64's significand: every integer of magnitude <= 2^52 is exact
+_SIGNIFICAND_BITS = 53
+
+
+def order_free_mean(values):
+    """The mean along the last axis, the same bits for any order of the values.
+
+    The values are sorted and then added one by one in ascending order (``numpy.cumsum``
+    is sequential), so neither their order nor the machine changes the rounding (numpy's
+    pairwise sum depends on the order).  The sum is off by at most (m - 1) u sum |x|
+    (u = 2^-53, m values).
+
+    Parameters
+    ----------
+    values : array_like, shape (..., m), m >= 1
+        The values; not NaN, and not infinities of both signs.
+
+    Returns
+    -------
+    numpy.ndarray or float
+        The means, shape (...).
+
+    Raises
+    ------
+    ValueError
+        Where there is no value along the last axis.
+
+    Examples
+    --------
+    >>> from bouncing_ball.comparison import order_free_mean
+    >>> print(order_free_mean([0.1, 0.2, 0.3]) == order_free_mean([0.3, 0.1, 0.2]))
+    True
+    """
+    values = np.asarray(values, dtype=float)
+    if values.ndim == 0 or values.shape[-1] == 0:
+        raise ValueError(
+            f"values: need at least one value along the last axis, got shape {values.shape}"
+        )
+    return np.cumsum(np.sort(values, axis=-1), axis=-1)[..., -1] / values.shape[-1]
+
+
+def _integer_deviations(deviations):
+    """Each bin's deviations as integers whose every signed sum over shards is exact.
+
+    Bin b is scaled by a power of 2 (exactly) so that its largest |deviation| lies in
+    [2^(51 - c), 2^(52 - c)), c = ceil(log2(shards)), and rounded to the nearest integer
+    (half to even: -d gives -q).  A sum of the shards' integers times +-1 is then an integer
+    of magnitude <= shards x 2^(52 - c) <= 2^52, exact in float64 whatever the order of the
+    additions (a BLAS kernel's blocking, fused multiply-adds and threads).  z^2 of a bin does
+    not change when the bin is scaled; the rounding moves each deviation by at most
+    2^(c - 53) of the bin's largest, the size of the rounding of the float sum it replaces.
+    """
+    headroom = (deviations.shape[0] - 1).bit_length()  # ceil(log2(shards))
+    _, exponents = np.frexp(np.max(np.abs(deviations), axis=0))
+    return np.rint(np.ldexp(deviations, _SIGNIFICAND_BITS - 1 - headroom - exponents))
+
+
+def _z_squared(signs, integers, squares):
+    """z^2 of every bin under each sign pattern (rows of ``signs``), ``sign_flip_test``.
+
+    With T = sum_k s_k q_k (exact: ``_integer_deviations``) and S = sum_k q_k^2,
+    z^2 = (n - 1) n m^2 / (S - n m^2) at m = T / n is (n - 1) T^2 / (n S - T^2): a function
+    of T^2, so patterns whose T agree up to sign give the same bits.  Where n S - T^2
+    rounds to <= 0 (every s_k q_k equal, the exact z^2 infinite, or within rounding of it),
+    z^2 is inf.
+    """
+    n = integers.shape[0]
+    total_squared = np.square(signs @ integers)
+    with np.errstate(divide="ignore"):
+        return (n - 1) * total_squared / np.maximum(n * squares - total_squared, 0.0)
+
+
+def _statistics(z_squared):
+    """chi^2 per bin (``order_free_mean``) and the largest z^2 of each row of z^2."""
+    return order_free_mean(z_squared), z_squared.max(axis=-1)
 
 
 def sign_flip_test(deviations, flips=SIGN_FLIPS, seed=SIGN_FLIP_SEED):
@@ -357,14 +436,16 @@ def sign_flip_test(deviations, flips=SIGN_FLIPS, seed=SIGN_FLIP_SEED):
 
     Parameters
     ----------
-    deviations : array (shards, bins)
+    deviations : array_like, shape (shards, bins)
         Each shard's deviation from the prediction: its estimate minus the prediction (shards
-        of equal time) or its share of the merged estimate's deviation (``ratio_deviations``).
+        of equal time) or its share of the merged estimate's deviation
+        (``ratio_deviations``); finite, shards >= 2, bins >= 1, and in every bin the shards'
+        deviations must differ by more than the rounding of their sum (else z has no
+        scatter to be measured against).
     flips : int
-        How many random sign patterns are drawn.
+        How many random sign patterns are drawn, >= 1.
     seed : int
-        Seed of ``numpy.random.default_rng`` for the signs: the same deviations give the same
-        p-values on every machine.
+        Seed of ``numpy.random.default_rng`` for the signs.
 
     Returns
     -------
@@ -375,9 +456,27 @@ def sign_flip_test(deviations, flips=SIGN_FLIPS, seed=SIGN_FLIP_SEED):
         vector is symmetric about 0, so flipping the signs of whole shards leaves the joint
         distribution unchanged: the flipped statistics are the null distribution, and it
         carries the correlations between bins (shared shards, the normalisation, cascades of
-        collisions filling neighbouring bins).  p = (1 + number of flipped statistics >= the
-        observed) / (1 + flips).  Flipping every sign leaves z^2 alone, so with n shards there
-        are 2^(n - 1) distinct statistics and p is never much below 2^(1 - n).
+        collisions filling neighbouring bins).
+
+        p = (1 + the number of flipped statistics >= the observed one) / (1 + flips): a
+        flipped statistic equal to the observed one counts.  Every sum over shards is exact
+        (each bin's deviations are first rounded to integers of at most 52 - ceil(log2
+        shards) bits, a change of the size of a float sum's rounding), so statistics whose
+        z^2 agree bin by bin in exact arithmetic have the same bits and tie: flipping every
+        sign leaves z^2 alone, so the all-flipped pattern ties with the observed statistic
+        and counts, and so do patterns that differ only on shards with equal or zero
+        deviations.  With n shards there are 2^(n - 1) distinct statistics and p is never much
+        below 2^(1 - n).
+
+        The same deviations give the same bits on every machine, for any BLAS kernel and
+        thread count (the sums are exact), and for any order of the bins (the mean over bins
+        is ``order_free_mean``); the signs come from the seeded PCG64.
+
+    Raises
+    ------
+    ValueError
+        Where ``deviations`` is not a finite (shards >= 2, bins >= 1) array, a bin's
+        deviations agree to within rounding, or ``flips`` is not an integer >= 1.
 
     Examples
     --------
@@ -391,24 +490,40 @@ def sign_flip_test(deviations, flips=SIGN_FLIPS, seed=SIGN_FLIP_SEED):
     0.0 1.0 1.0
     """
     deviations = np.asarray(deviations, dtype=float)
+    if deviations.ndim != 2 or deviations.shape[0] < 2 or deviations.shape[1] < 1:
+        raise ValueError(
+            f"deviations: need a (shards, bins) array with shards >= 2 and bins >= 1, "
+            f"got shape {deviations.shape}"
+        )
+    if not np.all(np.isfinite(deviations)):
+        raise ValueError("deviations: need finite values")
+    if isinstance(flips, bool) or not isinstance(flips, numbers.Integral) or flips < 1:
+        raise ValueError(f"flips: need an integer >= 1, got {flips!r}")
+    flips = int(flips)
     n = deviations.shape[0]
-    squares = (deviations**2).sum(axis=0)
-
-    def statistics(signs):
-        mean = signs @ deviations / n
-        with np.errstate(divide="ignore", invalid="ignore"):
-            z_squared = (n - 1) * n * mean**2 / (squares - n * mean**2)
-        return z_squared.mean(axis=-1), z_squared.max(axis=-1)
-
-    chi2, worst = statistics(np.ones(n))
+    integers = _integer_deviations(deviations)
+    squares = np.zeros(integers.shape[1])
+    for shard in integers:  # a fixed order: the same bits on every machine
+        squares += shard * shard
+    total_squared = np.square(integers.sum(axis=0))  # exact
+    # n S - T^2 is exact up to (n + 2) u n S: below that z^2 is not resolved
+    unresolved = np.flatnonzero(
+        n * squares - total_squared <= (n + 2) * _UNIT_ROUNDOFF * n * squares
+    )
+    if len(unresolved):
+        raise ValueError(
+            f"deviations: in bin(s) {unresolved.tolist()} the shards' deviations agree to "
+            "within rounding: no scatter between the shards to measure z against"
+        )
+    chi2, worst = _statistics(_z_squared(np.ones((1, n)), integers, squares))
     rng = np.random.default_rng(seed)
     chi2_above = worst_above = 0
     for block in range(0, flips, _FLIPS_PER_BLOCK):
         signs = rng.choice([-1.0, 1.0], size=(min(_FLIPS_PER_BLOCK, flips - block), n))
-        chi2_null, worst_null = statistics(signs)
+        chi2_null, worst_null = _statistics(_z_squared(signs, integers, squares))
         chi2_above += int(np.sum(chi2_null >= chi2))
         worst_above += int(np.sum(worst_null >= worst))
-    return float(chi2), (1 + chi2_above) / (1 + flips), (1 + worst_above) / (1 + flips)
+    return float(chi2[0]), (1 + chi2_above) / (1 + flips), (1 + worst_above) / (1 + flips)
 
 
 def ratio_deviations(numerators, denominators, reference):
@@ -476,6 +591,18 @@ def shard_ratios(shards) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         }
 
 
+def _largest(values, where):
+    """The position of the largest of ``values`` (NaN: the first NaN), of equal ones the one at
+    the smallest ``where``: the same bin whatever the order of the bins (``numpy.argmax``
+    takes the first, e.g. of two empty bins' infinite relative errors, or of z = +-2)."""
+    values, where = np.asarray(values, dtype=float), np.asarray(where, dtype=float)
+    top = np.max(values)
+    if np.isnan(top):
+        return int(np.argmax(values))
+    tied = np.flatnonzero(values == top)
+    return int(tied[np.argmin(where[tied])])
+
+
 def _z_rows(quantity, reference, where, z, shards, symbol, deviations=None):
     """The chi^2/n and worst-bin rows of one set of residuals ``z`` at bin centres ``where``;
     the chi^2/n row's p_sign_flip from ``sign_flip_test`` of ``deviations`` (shards x the
@@ -484,8 +611,8 @@ def _z_rows(quantity, reference, where, z, shards, symbol, deviations=None):
     if n == 0:
         worst, at, chi2 = np.nan, np.nan, np.nan
     else:
-        k = int(np.argmax(np.abs(z)))
-        worst, at, chi2 = float(z[k]), float(where[k]), float(np.mean(np.square(z)))
+        k = _largest(np.abs(z), where)
+        worst, at, chi2 = float(z[k]), float(where[k]), float(order_free_mean(np.square(z)))
     if deviations is None or n == 0:
         p_value = np.nan
         note = f"{shards} shards; no sign-flip p without the shards' tallies"
@@ -617,7 +744,7 @@ def _outgoing_speed_rows(quantity, simulated, restitution, shards, solver_curve,
             np.inf,
         )
     if len(relative):
-        k = int(np.argmax(relative))
+        k = _largest(relative, quality.v.to_numpy())
         largest, at = float(relative[k]), float(quality.v.iloc[k])
     else:
         largest, at = np.nan, np.nan

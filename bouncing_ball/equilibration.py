@@ -24,6 +24,7 @@ import numpy as np
 import pandas as pd
 from scipy import special  # not scipy.stats, the slowest of scipy to import, in every merge
 
+from .histograms import deviations_from_mean
 from .tallies import EARLY_FRACTION, ShardTallies
 
 __all__ = [
@@ -151,7 +152,8 @@ def early_check(
         }
         if n >= 2:
             difference = early - rest
-            error = difference.std(ddof=1) / np.sqrt(n)
+            # 0 exactly where every shard's difference is the same
+            error = np.sqrt(np.sum(deviations_from_mean(difference) ** 2) / (n - 1) / n)
             z = difference.mean() / error if error > 0.0 else 0.0
             p = float(2.0 * special.stdtr(n - 1, -abs(z)))  # Student's t: 2 P(T > |z|)
             row.update(

@@ -66,6 +66,7 @@ from .tallies import (
 __all__ = [
     "CONTROLLED_MOMENTS",
     "jackknife",
+    "deviations_from_mean",
     "shard_controls",
     "moment_controls",
     "outgoing_speed_density",
@@ -125,8 +126,41 @@ def jackknife(estimator, *per_shard):
         leave_one_out = np.stack(
             [estimator(*[t - a[k] for t, a in zip(totals, per_shard)]) for k in range(n)]
         )
-    spread = leave_one_out - leave_one_out.mean(axis=0)
+    spread = deviations_from_mean(leave_one_out)
     return value, np.sqrt((n - 1) / n * (spread**2).sum(axis=0))
+
+
+def deviations_from_mean(values):
+    """The values less their mean over the first axis, exact zeros where every value is equal.
+
+    The mean is taken of the values less the first one (the same deviations in exact
+    arithmetic): equal values give exact zeros, and so an error of exactly 0, while the
+    plain mean of n equal values can be off in its last bit and leave a scatter of ~1e-17
+    that a test such as ``error > 0`` takes for an error.
+
+    Parameters
+    ----------
+    values : array_like, shape (n, ...), n >= 1
+        The values, e.g. the delete-one estimates of the shards.
+
+    Returns
+    -------
+    numpy.ndarray
+        Of the shape of ``values``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bouncing_ball.histograms import deviations_from_mean
+    >>> values = np.full(3, 0.8132702392002724)
+    >>> print(np.std(values) > 0, np.abs(deviations_from_mean(values)).max())
+    True 0.0
+    """
+    values = np.asarray(values, dtype=float)
+    if values.ndim == 0 or len(values) == 0:
+        raise ValueError(f"values: need at least one value, got shape {values.shape}")
+    shifted = values - values[0]
+    return shifted - shifted.mean(axis=0)
 
 
 def shard_controls(shards, names):

@@ -12,6 +12,7 @@ from bouncing_ball import exact
 from bouncing_ball.bins import LogBins
 from bouncing_ball.comparison import (
     PAPER_VALUES,
+    SIGN_FLIP_SEED,
     VALIDATION_CHECKS,
     fit_checks,
     moment_rows,
@@ -355,6 +356,20 @@ def test_validation_relative_error_names_the_worst_bin_and_counts_empty_bins_as_
     )
 
 
+def test_validation_names_the_same_bin_of_equal_worst_values_in_any_order_of_the_bins():
+    """Two empty bins in 0.01 <= v <= 5 (infinite relative errors, an exact tie): the row
+    names the one of the smaller v, with the bins in order and reversed."""
+    rng = np.random.default_rng(16)
+    p0v, _ = _simulated_bins(Fraction(1, 2), 0.01, rng)
+    inside = p0v.index[(p0v.v >= 0.01) & (p0v.v <= 5.0)]
+    p0v.loc[[inside[8], inside[4]], ["p0v", "p0v_err"]] = [0.0, np.nan]
+    for table in (p0v, p0v.iloc[::-1].reset_index(drop=True)):
+        row = _by_check(outgoing_speed_checks(table, Fraction(1, 2), shards=8)).loc[
+            "p0v_largest_relative_error"
+        ]
+        assert row.value == np.inf and row.bin_centre == p0v.loc[inside[4], "v"]
+
+
 def test_validation_at_an_r_without_exact_solution_uses_the_solver_and_skips_p_x():
     """At r = 0.6 the reference of P(0, v) is the solver's curve (here a curve 1% high, which
     the residuals must show); there is no P(x) row."""
@@ -459,13 +474,85 @@ def test_sign_flip_p_value_is_small_for_a_bias():
     assert p_biased < 1e-3
 
 
-def test_sign_flip_test_is_reproducible_and_counts_the_observed_statistic():
+@pytest.mark.parametrize("zero_shards", [0, 1])
+def test_sign_flip_test_counts_every_pattern_that_ties_with_the_observed_statistic(zero_shards):
+    """A shift of 100 standard deviations in every bin of 8 shards: a flipped pattern ties
+    with the observed statistic exactly when it gives every shifted shard the same sign (all
+    + or all -: z^2 does not see the overall sign; a shard of zero deviations, whatever its
+    sign), and every other pattern is far below.  p = (1 + the ties drawn) / (1 + flips),
+    on any BLAS."""
     rng = np.random.default_rng(23)
-    deviations = _correlated_deviations(rng, 8, 12)
+    deviations = _correlated_deviations(rng, 8, 12) + 100.0
+    deviations[8 - zero_shards :] = 0.0
     assert sign_flip_test(deviations) == sign_flip_test(deviations)
-    # every flipped statistic is below an observed one of a large shift: p = 1 / (1 + flips)
-    _, p_chi2, p_worst = sign_flip_test(deviations + 100.0, flips=500)
-    assert p_chi2 == p_worst == pytest.approx(1.0 / 501.0)
+    # the patterns sign_flip_test draws: one block of 500 from its seed
+    signs = np.random.default_rng(SIGN_FLIP_SEED).choice([-1.0, 1.0], size=(500, 8))
+    shifted = signs[:, : 8 - zero_shards]
+    ties = int(np.sum(np.all(shifted == shifted[:, :1], axis=1)))
+    assert ties >= 2  # the draws hold such patterns: the count below is tested
+    _, p_chi2, p_worst = sign_flip_test(deviations, flips=500)
+    assert p_chi2 == p_worst == (1 + ties) / 501
+
+
+def test_sign_flip_test_is_the_same_however_the_blas_blocks_the_sums(monkeypatch):
+    """The flips in blocks of 1000, 7 and 1 (a matrix product or a vector product, other
+    BLAS kernels and roundings): the same statistic and p-values to the last bit."""
+    from bouncing_ball import comparison
+
+    rng = np.random.default_rng(27)
+    deviations = _correlated_deviations(rng, 8, 12) + 100.0
+    results = set()
+    for block in (1000, 7, 1):
+        monkeypatch.setattr(comparison, "_FLIPS_PER_BLOCK", block)
+        results.add(sign_flip_test(deviations, flips=300))
+    assert len(results) == 1
+
+
+def test_sign_flip_sums_over_shards_are_exact():
+    """The deviations as ``_integer_deviations`` rounds them: integers whose sum under any
+    signs (here every one of the 2^10 patterns) is the exact integer sum, in any order."""
+    from itertools import product
+
+    from bouncing_ball.comparison import _integer_deviations
+
+    rng = np.random.default_rng(28)
+    deviations = rng.standard_normal((10, 5)) * np.array([1e-300, 1e-8, 1.0, 1e8, 1e300])
+    integers = _integer_deviations(deviations)
+    # each bin scaled by a power of 2 to a largest |integer| of 52 - ceil(log2(10)) bits and
+    # rounded: the integers' ratios are the deviations' to 2^-47
+    top = np.max(np.abs(integers), axis=0)
+    assert np.all(integers == np.rint(integers)) and np.all((top >= 2.0**47) & (top <= 2.0**48))
+    np.testing.assert_array_less(
+        np.abs(integers / top - deviations / np.max(np.abs(deviations), axis=0)), 2.0**-47
+    )
+    signs = np.array(list(product([-1, 1], repeat=10)))
+    exact = [
+        [sum(int(s) * int(q) for s, q in zip(row, column)) for column in integers.T]
+        for row in signs
+    ]
+    assert np.array_equal(signs.astype(float) @ integers, np.array(exact, dtype=float))
+    assert np.array_equal(
+        signs[:, ::-1].astype(float) @ integers[::-1], np.array(exact, dtype=float)
+    )
+
+
+@pytest.mark.parametrize(
+    "deviations, flips, message",
+    [
+        (np.ones((1, 3)), 10, "shards >= 2"),
+        (np.ones(4), 10, "shards >= 2"),
+        (np.array([[1.0, np.nan], [0.0, 1.0]]), 10, "finite"),
+        (np.array([[1.0, 2.0], [0.0, 2.0], [3.0, 2.0]]), 10, r"bin\(s\) \[1\]"),
+        (np.array([[1.0, 0.0], [0.0, 0.0]]), 10, r"bin\(s\) \[1\]"),
+        (np.array([[1.0], [-1.0]]), 0, "flips"),
+        (np.array([[1.0], [-1.0]]), 2.5, "flips"),
+    ],
+)
+def test_sign_flip_test_refuses_what_it_cannot_test(deviations, flips, message):
+    """No shards to flip, non-finite deviations, a bin without scatter between the shards
+    (z is 0/0 or infinite), no flips."""
+    with pytest.raises(ValueError, match=message):
+        sign_flip_test(deviations, flips=flips)
 
 
 def test_ratio_deviations_add_up_to_the_merged_estimate_minus_the_reference():
@@ -573,3 +660,73 @@ def test_validation_refuses_tallies_of_another_number_of_shards():
         outgoing_speed_checks(
             outgoing_speed_histogram(shards), Fraction(1, 2), 5, per_shard=shard_ratios(shards)
         )
+
+
+def _validation_inputs(permutation_seed=None):
+    """The arguments of ``validation_rows`` for 16 synthetic shards at r = 1/2, the bins of
+    the merged tables and of the shards' tallies shuffled alike by ``permutation_seed``
+    (None: in order)."""
+    restitution = Fraction(1, 2)
+    shards = _synthetic_shards(restitution, 16, np.random.default_rng(29))
+    p0v, position = outgoing_speed_histogram(shards), position_histogram(shards)
+    per_shard = shard_ratios(shards)
+    if permutation_seed is not None:
+        order = np.random.default_rng(permutation_seed)
+        speeds, heights = order.permutation(len(p0v)), order.permutation(len(position))
+        p0v = p0v.iloc[speeds].reset_index(drop=True)
+        position = position.iloc[heights].reset_index(drop=True)
+        columns = {"p0v": speeds, "px": heights, "v2_given_x": heights}
+        per_shard = {
+            key: tuple(part[:, columns[key]] for part in parts) for key, parts in per_shard.items()
+        }
+    return ("0.5", restitution, p0v, position, _fits_table(), len(shards), None, per_shard)
+
+
+def _numbers(rows):
+    """The validation rows' value, bin_centre and p_sign_flip, to the last bit (float.hex)."""
+    return {
+        row["check"]: [float(row[key]).hex() for key in ("value", "bin_centre", "p_sign_flip")]
+        for row in rows
+    }
+
+
+def test_validation_numbers_do_not_depend_on_the_order_of_the_bins_nor_the_blas_threads(
+    tmp_path,
+):
+    """The table's chi^2/n, worst z and its bin, p_sign_flip, ... to the last bit: with the
+    bins in order, shuffled twice, and computed in a process with another number of BLAS
+    threads (2 where this one has 1, else 1)."""
+    import os
+    import pickle
+    import subprocess
+    import sys
+
+    arguments = tmp_path / "arguments.pickle"
+    arguments.write_bytes(pickle.dumps(_validation_inputs()))
+    threads = "2" if os.environ.get("OPENBLAS_NUM_THREADS") == "1" else "1"
+    other = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import pickle, sys\n"
+            "from bouncing_ball.comparison import validation_rows\n"
+            f"arguments = pickle.loads(open({str(arguments)!r}, 'rb').read())\n"
+            "sys.stdout.buffer.write(pickle.dumps(validation_rows(*arguments)))\n",
+        ],
+        env=dict(
+            os.environ,
+            OPENBLAS_NUM_THREADS=threads,
+            OMP_NUM_THREADS=threads,
+            MKL_NUM_THREADS=threads,
+        ),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    in_order = _numbers(validation_rows(*_validation_inputs()))
+    flipped = [p for _, _, p in in_order.values() if p != float("nan").hex()]
+    assert len(flipped) == 3  # P(0, v), P(x), <v^2>_x
+    for seed in (30, 31):
+        assert _numbers(validation_rows(*_validation_inputs(seed))) == in_order, seed
+    out, err = other.communicate(timeout=120)
+    assert other.returncode == 0, err.decode()
+    assert _numbers(pickle.loads(out)) == in_order

@@ -141,3 +141,13 @@ def test_a_short_equilibration_near_r_1_is_refused(equilibration_time, verdict):
     assert early_check_record(check)["verdict"] == verdict
     if verdict == "refuse":  # <x> and I refused, <x^2> (heavier-tailed) at least warned of
         assert "ok" not in set(check["verdict"])
+
+
+@pytest.mark.parametrize("shards, early_x", [(7, 1.0819470478723894), (6, 2.6317071082430643)])
+def test_shards_whose_differences_agree_have_no_scatter_and_are_not_refused(shards, early_x):
+    """Every shard with the same early - rest difference: its standard error is exactly 0,
+    so z = 0 and the verdict "ok" (no scatter to hold the difference against), not a z of
+    1e16 from a mean of equal values rounded in its last bit."""
+    check = early_check([_shard((early_x, 8.0, 1.0), (2.0, 8.0, 1.0))] * shards)
+    assert (check.difference_err == 0.0).all()
+    assert (check.z == 0.0).all() and (check.verdict == "ok").all()

@@ -202,6 +202,17 @@ def test_jackknife_of_a_mean_is_the_standard_error():
     assert error == pytest.approx(samples.std(ddof=1) / np.sqrt(12))
 
 
+def test_jackknife_error_of_shards_that_agree_is_exactly_zero():
+    """n shards with the same count and time: every delete-one estimate is the same, so the
+    error is exactly 0 (fits.fit_errors and the comparison's ``error > 0`` rely on it), for
+    counts and times where the plain mean of the equal estimates is off in its last bit."""
+    rng = np.random.default_rng(4)
+    for _ in range(200):
+        n, count, time = int(rng.integers(3, 12)), float(rng.integers(1, 50)), rng.uniform(10, 100)
+        _, error = jackknife(lambda c, t: c / t, np.full((n, 2), count), np.full((n, 1), time))
+        assert np.all(error == 0.0), (n, count, time, error)
+
+
 def test_outgoing_speed_density_counts_rate_over_bin():
     # one shard, 10 collisions in [1, 10) over time 2: p0v = 10 / (2 * (100 - 1) / 2)
     bins = LogBins(1.0, 10.0, 1)
