@@ -12,6 +12,8 @@ lowest row, where gravity is negligible (relative O(u)), from the lowest row's l
 they are recorded.
 """
 
+import functools
+
 import numpy as np
 from scipy import integrate
 
@@ -28,6 +30,7 @@ def _jacobian(u):
     return u / (1.0 + 0.5 * np.sqrt(u))
 
 
+@functools.cache
 def return_law_table():
     """Rows U_a, their return-speed coordinates s_v[a, :] and CDFs[a, :] (normalised; the raw
     totals returned too, 1 to the table's accuracy by eq. (normG))."""
