@@ -1139,8 +1139,10 @@ class Equilibrium(_EquilibriumState):
         """The solve rule's summary row: ``solver.solution_summary`` (with the accuracy
         estimate), the collision statistics (``flight_time.flight_time_summary``), <x>, Delta x
         and the normalisation from P(x) (eqs. (P(x)1), (xandDeltax)), the interpolation error
-        of w(F) (``WeightFunction.interpolation_error``), and the measured and predicted
-        exponents of P(x) with the large-x fit window (``distribution.measured_exponents``).
+        of w(F) (``WeightFunction.interpolation_error``), the measured and predicted
+        exponents of P(x) with the large-x fit window (``distribution.measured_exponents``),
+        and the relaxation of the bounce-speed chain (``relaxation.RELAXATION_COLUMNS``; NaN
+        below r_c, where it is not defined).
 
         Returns
         -------

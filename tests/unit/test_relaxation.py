@@ -10,6 +10,7 @@ from test_solver_range import _passing_tables
 
 from bouncing_ball import Equilibrium, ExactEquilibrium, distribution, relaxation, solver
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION, small_speed_exponent
+from bouncing_ball.equilibrium import _relaxation_columns
 from bouncing_ball.flight_time import mean_flight_time_given_speed
 
 TARGET = solver.ACCURACY_TARGET
@@ -143,3 +144,13 @@ def test_the_summary_relaxation_columns_may_be_nan_only_below_r_c():
     assert defects == [f"summary: {key} is NaN" for key in relaxation.RELAXATION_COLUMNS]
     summary["collision_rate"] = math.inf
     assert distribution.solve_table_defects(summary, tables) == []
+
+
+def test_the_summary_has_the_relaxation_columns_and_nan_below_r_c():
+    columns = _relaxation_columns(Equilibrium("1/2"))
+    assert tuple(columns) == relaxation.RELAXATION_COLUMNS
+    assert columns["relaxation_eigenvalue"] == columns["continuum_edge"]
+    assert columns["relaxation_time"] == Equilibrium("1/2").relaxation_time
+    below = _relaxation_columns(Equilibrium(0.1))
+    assert tuple(below) == relaxation.RELAXATION_COLUMNS
+    assert all(math.isnan(value) for value in below.values())
