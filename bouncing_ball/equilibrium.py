@@ -666,6 +666,90 @@ class _EquilibriumState:
         v, u = _broadcast(v, u, ("v", "u"))
         return _out(return_speed_density(v, u))
 
+    # --- the relaxation of the bounce-speed chain (``relaxation``), computed on first use
+    _relaxation_step = None  # the solver's step of the matrix (``Equilibrium``: its own)
+
+    @property
+    def _relaxation(self):
+        return _chain_relaxation(self.restitution, self._relaxation_step)
+
+    @property
+    def relaxation_eigenvalue(self) -> float:
+        """lambda: how much of a correlation between the outgoing speeds of two bounces
+        survives one more bounce, at large separations (``relaxation.bounce_chain_relaxation``).
+
+        The second eigenvalue of the collision-to-collision operator of eq. (inteq), from the
+        solver's Nystrom matrix, where it is isolated (r above ~0.6: near r = 1, lambda =
+        r + O((1 - r)^3)); else the top of the continuum of low-speed cascades,
+        ``relaxation.continuum_edge`` (closed form).  Built on first use (the solver's matrix
+        and its eigenvalues; a second at r = 0.999), then kept for the process.
+
+        Defined for r_c < r <= 0.9999 (eq. (rc)); below r_c the outgoing speeds collapse to 0
+        and the chain has no relaxation: ValueError.  Its error estimate is
+        ``relaxation_accuracy``.
+
+        Examples
+        --------
+        At r = 1/2 the continuum edge, min over 1 <= b <= 2 of 2^(2 - b) / (2 sin((2 b + 1)
+        pi / 6)):
+
+        >>> from bouncing_ball import Equilibrium
+        >>> print(round(Equilibrium("1/2").relaxation_eigenvalue, 6))
+        0.814364
+        """
+        return self._relaxation.eigenvalue
+
+    @property
+    def correlation_bounces(self) -> float:
+        """n_c = -1 / ln lambda: the number of bounces over which correlations of the outgoing
+        speeds fall by e (``relaxation_eigenvalue``); ~1 / (1 - r) as r -> 1.
+
+        Defined for r_c < r <= 0.9999; ValueError below r_c.
+
+        Examples
+        --------
+        >>> from bouncing_ball import Equilibrium
+        >>> print(round(Equilibrium("1/2").correlation_bounces, 4))
+        4.8698
+        """
+        return self._relaxation.correlation_bounces
+
+    @property
+    def relaxation_time(self) -> float:
+        """n_c <T>: the time the ball takes for ``correlation_bounces`` bounces, in the paper's
+        units (g = Lambda = 1); of order (1 - r)^-2 as r -> 1.
+
+        The time scale on which the state at the floor forgets its past (docs/methods.md,
+        "Relaxation of the bounce chain"): n bounces take n <T> (``mean_flight_time``) up to
+        relative fluctuations n^(-1/2).  It sets the scale, not the exact exponential rate of
+        time correlations, which differs by a factor of order 1.  Where lambda is the continuum
+        edge (r below ~0.6) the slow correlations are carried by cascades of short low-speed
+        flights, so the forgetting in time is faster than n_c <T>.
+
+        Defined for r_c < r <= 0.9999; ValueError below r_c (there <T> = 0).
+
+        Examples
+        --------
+        >>> from bouncing_ball import Equilibrium
+        >>> print(round(Equilibrium("1/2").relaxation_time, 4))
+        14.6093
+        """
+        return self._relaxation.correlation_bounces * self.mean_flight_time
+
+    @property
+    def relaxation_accuracy(self) -> float:
+        """The error estimate of ``relaxation_eigenvalue``: its change against a finer matrix
+        (step x 0.8, lowest node x 1e-4; ``relaxation.relaxation_accuracy``).  Built on first
+        use, then kept for the process.  ValueError below r_c.
+
+        Examples
+        --------
+        >>> from bouncing_ball import Equilibrium
+        >>> Equilibrium("1/2").relaxation_accuracy < 1e-8
+        True
+        """
+        return _chain_relaxation_accuracy(self.restitution, self._relaxation_step)
+
     def observables(self) -> dict:
         """The scalars: r, beta, m, q, collision_rate, mean_x, delta_x, mean_flight_time,
         flight_time_second_moment and accuracy, as a dict.
@@ -691,6 +775,42 @@ class _EquilibriumState:
             f"<T> = {self.mean_flight_time:.10g}, <T^2> = {self.flight_time_second_moment:.10g}; "
             f"beta = {self.beta:.6g}, m = {self.m:.6g}, q = {self.q:.6g}"
         )
+
+
+def _relaxation_columns(equilibrium) -> dict:
+    """The summary's ``relaxation.RELAXATION_COLUMNS`` of an ``Equilibrium``: NaN at r <= r_c."""
+    from .asymptotics import CRITICAL_RESTITUTION
+    from .relaxation import RELAXATION_COLUMNS
+
+    if equilibrium.r <= CRITICAL_RESTITUTION:
+        return dict.fromkeys(RELAXATION_COLUMNS, math.nan)
+    return {
+        "relaxation_eigenvalue": equilibrium.relaxation_eigenvalue,
+        "relaxation_eigenvalue_accuracy": equilibrium.relaxation_accuracy,
+        "continuum_edge": equilibrium._relaxation.continuum_edge,
+        "correlation_bounces": equilibrium.correlation_bounces,
+        "relaxation_time": equilibrium.relaxation_time,
+    }
+
+
+@functools.lru_cache(maxsize=16)
+def _chain_relaxation(exact: Fraction, step):
+    """``relaxation.bounce_chain_relaxation`` at (r, step), once per process (step None: the
+    solver's default)."""
+    from . import relaxation, solver
+
+    return relaxation.bounce_chain_relaxation(
+        exact, step=solver.DEFAULT_STEP if step is None else step
+    )
+
+
+@functools.lru_cache(maxsize=16)
+def _chain_relaxation_accuracy(exact: Fraction, step) -> float:
+    """``relaxation.relaxation_accuracy`` of ``_chain_relaxation(exact, step)``, once per
+    process."""
+    from . import relaxation
+
+    return relaxation.relaxation_accuracy(_chain_relaxation(exact, step))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -837,6 +957,9 @@ class Equilibrium(_EquilibriumState):
     position_accuracy : float
         The largest of ``|int P dx - 1|`` and the relative differences of <x>, Delta x from P(x)
         (eq. (P(x)1)) and from the Ito identities (builds w(F) on first use).
+    relaxation_eigenvalue, correlation_bounces, relaxation_time, relaxation_accuracy : float
+        The relaxation of the bounce-speed chain (``relaxation``): lambda, n_c = -1 / ln lambda,
+        n_c <T> and the error estimate of lambda (built on first use; ValueError below r_c).
     distribution_available : bool
         Whether r lies in ``restitution.DISTRIBUTION_RESTITUTION_RANGE``, where P(x), <v^2>_x,
         P(x, v) and w(F) are computed.
@@ -899,6 +1022,7 @@ class Equilibrium(_EquilibriumState):
         self.delta_x = float(averages["delta_x"])
         self.mean_flight_time = float(flight_time.mean_flight_time(self.solution))
         self.flight_time_second_moment = float(flight_time.flight_time_second_moment(self.solution))
+        self._relaxation_step = self.quadrature_step
 
     def __reduce__(self):
         """Pickled and copied as its state: r, the settings, the solve and what has been
@@ -1011,14 +1135,17 @@ class Equilibrium(_EquilibriumState):
         for key, value in distribution.predicted_exponents(self.restitution).items():
             row[f"{key}_measured"], row[f"{key}_predicted"] = measured[key], value
         row["large_x_window_lo"], row["large_x_window_hi"] = measured["large_x_window"]
+        row.update(_relaxation_columns(self))
         return row
 
     def summary(self) -> dict:
         """The solve rule's summary row: ``solver.solution_summary`` (with the accuracy
         estimate), the collision statistics (``flight_time.flight_time_summary``), <x>, Delta x
         and the normalisation from P(x) (eqs. (P(x)1), (xandDeltax)), the interpolation error
-        of w(F) (``WeightFunction.interpolation_error``), and the measured and predicted
-        exponents of P(x) with the large-x fit window (``distribution.measured_exponents``).
+        of w(F) (``WeightFunction.interpolation_error``), the measured and predicted
+        exponents of P(x) with the large-x fit window (``distribution.measured_exponents``),
+        and the relaxation of the bounce-speed chain (``relaxation.RELAXATION_COLUMNS``; NaN
+        below r_c, where it is not defined).
 
         Returns
         -------

@@ -461,41 +461,19 @@ def _kernel_sums(incoming, u, weights, density, nodes, tau_weights):
     return out
 
 
-def solve_outgoing_speed_density(
-    restitution, step=DEFAULT_STEP, lowest_speed=None, highest_speed=None
-):
-    """Solve eq. (inteq) for P(0, v), v > 0, normalised by the momentum balance M_2 = r / (1 + r).
+def _scaled_operator(restitution, step, lowest_speed, highest_speed):
+    """The solver's Nystrom matrix of eq. (inteq), checked arguments, in the scaled unknowns.
 
-    Parameters
-    ----------
-    restitution : float or str
-        r, a float or an exact fraction string ("1/3"), in ``SOLVER_RESTITUTION_RANGE``.
-    step : float
-        Trapezoidal step in s = ln u + u^(1/2), 0 < step <= ``LARGEST_STEP``.
-    lowest_speed, highest_speed : float, optional
-        The lowest and highest node; at most ``default_lowest_speed`` (the built-in power law
-        below it holds only there) and between ``default_highest_speed`` and where P(0, v)
-        leaves the range of doubles (UNDERFLOW_EFOLDS / q).
+    A_ij = r^-2 G_g(u_i / r, u_j) u_j w_j (plus the lower tail in column 0) acts on
+    P(0, u_j); the matrix returned is S^-1 A S with S = diag(u^-beta e^(-q u)), which keeps
+    relative digits where P spans many decades (the same eigenvalues).  The one home of the
+    discretisation: ``solve_outgoing_speed_density`` takes its eigenvector of eigenvalue 1,
+    ``bounce_chain_spectrum`` its other eigenvalues.
 
     Returns
     -------
-    OutgoingSpeedSolution
-        P(0, v) at the nodes, normalised, with the eigenvalue of the discrete operator.
-
-    Raises
-    ------
-    ValueError
-        Naming the argument, for an r, step or node the solver cannot answer to its accuracy.
-
-    Examples
-    --------
-    Compiles the kernel on its first call (so not run as a doctest); at r = 1/2 the solution
-    is eq. (P(0,v)), e^(-v) / (3 v):
-
-    >>> from bouncing_ball.solver import solve_outgoing_speed_density
-    >>> solution = solve_outgoing_speed_density("1/2")  # doctest: +SKIP
-    >>> print(solution.outgoing_speed_density([0.5, 1.0]).round(8))  # doctest: +SKIP
-    [0.40435377 0.12262648]
+    tuple
+        (r, beta, speeds u_j, log of the scale S, the scaled matrix).
     """
     exact = parse_restitution(restitution, "restitution")
     r = float(exact)
@@ -542,6 +520,49 @@ def solve_outgoing_speed_density(
     with np.errstate(divide="ignore"):
         log_entries = np.log(operator) + log_scale[None, :] - log_scale[:, None]
     scaled = np.exp(log_entries)
+    return r, beta, speeds, log_scale, scaled
+
+
+def solve_outgoing_speed_density(
+    restitution, step=DEFAULT_STEP, lowest_speed=None, highest_speed=None
+):
+    """Solve eq. (inteq) for P(0, v), v > 0, normalised by the momentum balance M_2 = r / (1 + r).
+
+    Parameters
+    ----------
+    restitution : float or str
+        r, a float or an exact fraction string ("1/3"), in ``SOLVER_RESTITUTION_RANGE``.
+    step : float
+        Trapezoidal step in s = ln u + u^(1/2), 0 < step <= ``LARGEST_STEP``.
+    lowest_speed, highest_speed : float, optional
+        The lowest and highest node; at most ``default_lowest_speed`` (the built-in power law
+        below it holds only there) and between ``default_highest_speed`` and where P(0, v)
+        leaves the range of doubles (UNDERFLOW_EFOLDS / q).
+
+    Returns
+    -------
+    OutgoingSpeedSolution
+        P(0, v) at the nodes, normalised, with the eigenvalue of the discrete operator.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument, for an r, step or node the solver cannot answer to its accuracy.
+
+    Examples
+    --------
+    Compiles the kernel on its first call (so not run as a doctest); at r = 1/2 the solution
+    is eq. (P(0,v)), e^(-v) / (3 v):
+
+    >>> from bouncing_ball.solver import solve_outgoing_speed_density
+    >>> solution = solve_outgoing_speed_density("1/2")  # doctest: +SKIP
+    >>> print(solution.outgoing_speed_density([0.5, 1.0]).round(8))  # doctest: +SKIP
+    [0.40435377 0.12262648]
+    """
+    r, beta, speeds, log_scale, scaled = _scaled_operator(
+        restitution, step, lowest_speed, highest_speed
+    )
+    count = speeds.size
     factors = linalg.lu_factor(scaled - np.eye(count), check_finite=False)
     y = np.ones(count)
     for _ in range(3):

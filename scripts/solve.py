@@ -58,6 +58,16 @@ with job_log(snakemake.log[0], exit_when_done=True):
         row["eigenvalue_residual"],
         accuracy,
     )
+    logging.info(
+        "r=%s: bounce chain: relaxation eigenvalue %.10g (error estimate %.1e, continuum edge "
+        "%.6g), %.6g bounces, relaxation time %.6g (NaN below r_c)",
+        label,
+        row["relaxation_eigenvalue"],
+        row["relaxation_eigenvalue_accuracy"],
+        row["continuum_edge"],
+        row["correlation_bounces"],
+        row["relaxation_time"],
+    )
     if not accuracy <= solver.ACCURACY_TARGET:
         logging.warning(
             "r=%s: accuracy estimate %.1e misses the %.0e target (solver.quadrature_step %g)",
