@@ -246,15 +246,19 @@ class BounceChainRelaxation:
         return -1.0 / math.log(self.eigenvalue)
 
 
-def _eigen(restitution, step, lowest_speed):
+def _eigen(restitution, step, lowest_speed, vectors=True):
     """The solver's matrix at (r, step, lowest node), its nodes, eigenvalues and left
-    eigenvectors; the leading eigenvalue (nearest 1) first, the rest by decreasing modulus."""
+    eigenvectors (None without ``vectors``: the eigenvalues alone cost a fraction of it); the
+    leading eigenvalue (nearest 1) first, the rest by decreasing modulus."""
     r, beta, speeds, log_scale, scaled = _scaled_operator(restitution, step, lowest_speed, None)
-    values, left = linalg.eig(scaled, left=True, right=False, check_finite=False)
+    if vectors:
+        values, left = linalg.eig(scaled, left=True, right=False, check_finite=False)
+    else:
+        values, left = linalg.eigvals(scaled, check_finite=False), None
     leading = int(np.argmin(np.abs(values - 1.0)))
     rest = [i for i in np.argsort(-np.abs(values)) if i != leading]
     order = np.array([leading, *rest])
-    return r, beta, speeds, log_scale, values[order], left[:, order]
+    return r, beta, speeds, log_scale, values[order], None if left is None else left[:, order]
 
 
 def _checked_step(step) -> float:
@@ -301,7 +305,7 @@ def bounce_chain_relaxation(restitution, step=DEFAULT_STEP, lowest_speed=None):
     """
     r = _chain_restitution(restitution)
     step = _checked_step(step)
-    _, beta, speeds, _, values, _ = _eigen(restitution, step, lowest_speed)
+    _, beta, speeds, _, values, _ = _eigen(restitution, step, lowest_speed, vectors=False)
     return BounceChainRelaxation(
         restitution=r,
         step=step,
