@@ -360,7 +360,7 @@ def order_free_mean(values):
 
     The values are sorted and then added one by one in ascending order (``numpy.cumsum``
     is sequential), so neither their order nor the machine changes the rounding (numpy's
-    pairwise sum depends on the order).  The sum is off by at most (m - 1) u sum |x|
+    pairwise sum depends on the order).  The sum is off by at most (m - 1) u sum abs(x)
     (u = 2^-53, m values).
 
     Parameters

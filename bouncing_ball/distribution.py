@@ -1576,11 +1576,11 @@ FORCE_PANEL_SIGMAS = 2.5
 #: spacing of doubles.
 SMALLEST_POSITION = 1e-300
 LARGEST_POSITION = 1e12
-#: Beyond this |v|, P(x, v) is 0 to every double (``Equilibrium.pxv``): on the floor P(0, v) ~
+#: Beyond this speed abs(v), P(x, v) is 0 to every double (``Equilibrium.pxv``): on the floor P(0, v) ~
 #: e^(-q v) and P(0, -v) = r^2 P(0, r v) fall below e^-1400 at every r of
 #: DISTRIBUTION_RESTITUTION_RANGE (r q = 0.148 at r = 0.9), and above it P(x, v) is a Gaussian
 #: in v of variance <v^2>_x < 4e4 wherever P(x) is a double (x below ~1e7), e^-1000 down at
-#: |v| = 1e4.
+#: abs(v) = 1e4.
 LARGEST_VELOCITY = 1e4
 #: The smallest F of the config's ``solver.forces``: above ``Equilibrium.smallest_force`` (below
 #: which w(F) ~ F^gamma e^(-S/F), S < 0, exceeds the largest double) at every r of

@@ -211,7 +211,7 @@ MOMENT_POWERS = range(4)  # k of (timemoments)
 SECH_SERIES_FROM = 80.0  # x above which S0 and S0' are summed from their asymptotic series
 SECH_SERIES_TERMS = 35  # terms of that series: truncation about 1e-14 relative at x = 80
 #: Below this flight time nu(T) is its short-flight law A C_beta T^(-beta/2), eq. (short),
-#: whose relative correction (c1 T^(1/2), |c1| ~ 0.1 at r = 1/2 and 1/3) is below 1e-15
+#: whose relative correction (c1 T^(1/2), abs(c1) ~ 0.1 at r = 1/2 and 1/3) is below 1e-15
 #: there; above it nu(T) is the quadrature of eq. (rate), which needs P(0, u) down to
 #: 1e-4 T^(1/2) (1e-19 here).
 SHORT_FLIGHT_TIME = 1e-30
