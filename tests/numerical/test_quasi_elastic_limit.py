@@ -1,0 +1,45 @@
+"""The solver near r = 1 against the quasi-elastic forms of bouncing_ball.quasi_elastic: I, <x>,
+Delta x and the scaled P(0, v) at r = 0.99, 0.999, 0.9999 approach their limits with the
+predicted first correction.  Split from the unit tier because each r costs a solve of eq. (inteq)."""
+
+import numpy as np
+import pytest
+
+import bouncing_ball as bb
+from bouncing_ball import quasi_elastic as qe
+
+RESTITUTIONS = qe.TABLE_RESTITUTIONS
+
+
+@pytest.mark.parametrize("r", RESTITUTIONS)
+@pytest.mark.parametrize("name", ["collision_rate", "mean_x", "delta_x"])
+def test_first_correction_matches_the_solver(name, r):
+    """c1 measured = (solver / leading - 1) / epsilon is the predicted c1 plus c2 epsilon +
+    O(epsilon^2): within 2 |c2| epsilon (the factor 2 leaves room for |c3| epsilon < |c2|).  The
+    solver's own error (1e-8 relative at most) adds 1e-8 / epsilon^2 <= 1e-4 |c2| at 0.9999."""
+    epsilon = qe.quasi_elastic_epsilon(r)
+    scaling = qe.SCALINGS[name]
+    solver = getattr(bb.Equilibrium(r), name)
+    measured = (solver / qe.quasi_elastic_form(name, r, order=0) - 1.0) / epsilon
+    assert measured == pytest.approx(scaling.first, abs=2.0 * abs(scaling.second) * epsilon)
+
+
+@pytest.mark.parametrize("r", RESTITUTIONS)
+def test_scaled_speed_density_collapses_onto_the_limit(r):
+    """epsilon^-3 P(0, w / epsilon) against (27/32) e^(-3w/2) for 0.1 <= w <= 12: within twice
+    the first correction's terms, 2 epsilon (5/2 + 3w/2) (not 2 epsilon |p1(w)|, which vanishes
+    at w = 5/3 where the next order does not)."""
+    epsilon = qe.quasi_elastic_epsilon(r)
+    w = np.geomspace(0.1, 12.0, 25)
+    scaled = bb.Equilibrium(r).p0v(w / epsilon) / epsilon**3
+    deviation = np.abs(scaled / qe.scaled_speed_density(w) - 1.0)
+    assert np.all(deviation <= 2.0 * epsilon * (2.5 + 1.5 * w))
+
+
+def test_the_table_holds_every_quantity_at_every_r():
+    """``quasi_elastic_table``: one row per quantity and r, measured c1 next to the predicted."""
+    table = qe.quasi_elastic_table()
+    quantities = 3 + len(qe.TABLE_SCALED_SPEEDS)
+    assert len(table) == quantities * len(RESTITUTIONS)
+    assert set(table["r"]) == set(RESTITUTIONS)
+    assert np.all(np.isfinite(table[["scaled", "limit", "c1_measured", "c1_predicted"]]))
