@@ -138,6 +138,8 @@ comes back after a flight time in [t, t + dt] with speed (incoming velocity -v) 
    T >> (q - 3/4)^-2); B is read off the solver at its highest node (approximate).
 """
 
+import functools
+
 import numpy as np
 import pandas as pd
 from scipy import integrate, special
@@ -1119,6 +1121,7 @@ def time_weighted_mean_flight_time(solution):
 # --- asymptotic forms ----------------------------------------------------------------------------
 
 
+@functools.lru_cache(maxsize=256)  # a pure function of beta, asked for at each call of nu(T)
 def short_time_constant(beta):
     """The constant C_beta of the short-flight law, eq. (short).
 

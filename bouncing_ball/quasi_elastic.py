@@ -39,6 +39,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .asymptotics import _restitution
+
 __all__ = [
     "RETURN_SPEED_MOMENTS",
     "QuasiElasticScaling",
@@ -132,10 +134,7 @@ def quasi_elastic_epsilon(restitution) -> float:
     >>> quasi_elastic_epsilon(0.75)
     0.25
     """
-    r = float(restitution)
-    if not 0.0 < r < 1.0:
-        raise ValueError(f"restitution must lie in (0, 1), got {restitution!r}")
-    return 1.0 - r
+    return 1.0 - _restitution(restitution)
 
 
 def _scaled_speeds(w) -> np.ndarray:
