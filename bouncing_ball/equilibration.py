@@ -18,7 +18,27 @@ quantity and each shard it takes the difference d_k of the early part's estimate
 rest's, and Student's t-test of mean d = 0 over the independent shards.  Its p-value says
 how likely a difference this large is in equilibrium: below ``WARN_P`` the merge warns,
 below ``REFUSE_P`` it refuses, since the errors cannot be trusted.
+
+How long to discard, and how long a shard must be, follow from the relaxation time of the
+process (``equilibration_relaxation_time``: ``Equilibrium(r).relaxation_time``, the bounce
+chain's correlation length in bounces times the mean flight time, docs/methods.md):
+
+* ``default_equilibration_time``: ``EQUILIBRATION_RELAXATION_TIMES`` relaxation times, never
+  less than ``MIN_EQUILIBRATION_TIME``.  Near r -> 1 the slowest decay in continuous time is
+  8/3 times slower than the bounce chain's (docs/quasi_elastic.md), so the default discards
+  20 / (8/3) = 7.5 of those decay times: what is left of the start, e^-7.5 = 6e-4 of it,
+  decays within the first of the recorded ones.
+* ``SHARD_RELAXATION_TIMES``: the shortest shard whose errors are trusted, so that the early
+  part of its recording (``EARLY_FRACTION``) spans at least one relaxation time: a transient
+  shorter than the shard but longer than its early part would straddle the two and escape
+  ``early_check``.
+* ``equilibration_problems`` says what in a shard's settings falls short of these, naming r,
+  the relaxation time and the setting; the workflow's config check refuses it before any job
+  runs, ``simulate`` warns (``EquilibrationWarning``), and the merge records the settings in
+  relaxation times beside its check (``relaxation_record``).
 """
+
+import warnings
 
 import numpy as np
 import pandas as pd
@@ -35,6 +55,15 @@ __all__ = [
     "WARN_P",
     "REFUSE_P",
     "QUANTITIES",
+    "EQUILIBRATION_RELAXATION_TIMES",
+    "MIN_EQUILIBRATION_TIME",
+    "SHARD_RELAXATION_TIMES",
+    "EquilibrationWarning",
+    "equilibration_relaxation_time",
+    "default_equilibration_time",
+    "equilibration_problems",
+    "warn_equilibration_problems",
+    "relaxation_record",
 ]
 
 #: The p-value of ``early_check`` below which the merge warns.
@@ -44,6 +73,201 @@ REFUSE_P = 1.0e-6
 #: The quantities compared: <x>, <x^2> and the collision rate I of eq. (collrate).
 QUANTITIES = ("mean_x", "mean_x2", "collision_rate")
 _SUMS = ("time", "collisions", "int_x", "int_x2")
+
+#: The default ``equilibration_time`` in relaxation times (``default_equilibration_time``).
+EQUILIBRATION_RELAXATION_TIMES = 20
+#: The least default ``equilibration_time``, where the relaxation time is short or undefined.
+MIN_EQUILIBRATION_TIME = 1.0e3
+#: The shortest ``shard_time`` in relaxation times whose errors are trusted: the early part of
+#: the recording (``EARLY_FRACTION`` of it) spans one relaxation time.
+SHARD_RELAXATION_TIMES = round(1.0 / EARLY_FRACTION)
+
+
+class EquilibrationWarning(RuntimeWarning):
+    """``simulate`` run with settings shorter than the relaxation time asks for
+    (``equilibration_problems``): its estimates may carry the start's transient, or errors
+    that cannot be trusted."""
+
+
+def equilibration_relaxation_time(restitution) -> float | None:
+    """The relaxation time that sets the equilibration of the simulation at r.
+
+    ``Equilibrium(r).relaxation_time`` (the bounce chain's correlation length times the mean
+    flight time, ``relaxation.bounce_chain_relaxation``) where the solver answers it,
+    r_c < r <= 0.9999; above 0.9999 the quasi-elastic limit of the slowest decay in
+    continuous time, 64 / (9 (1 - r)^2) (``quasi_elastic.relaxation_time``, longer than the
+    chain's by 8/3: a safe side).  None at or below r_c (eq. (rc)), where the outgoing speeds
+    collapse and the chain has no relaxation eigenvalue.
+
+    Parameters
+    ----------
+    restitution : float, str or fractions.Fraction
+        r, 0 < r < 1.
+
+    Returns
+    -------
+    float or None
+        In the paper's time units.
+
+    Examples
+    --------
+    >>> from bouncing_ball.equilibration import equilibration_relaxation_time
+    >>> print(round(equilibration_relaxation_time("1/2"), 4))
+    14.6093
+    >>> print(equilibration_relaxation_time(0.1))
+    None
+    >>> print(f"{equilibration_relaxation_time(0.99999):.4g}")
+    7.111e+10
+    """
+    from .asymptotics import CRITICAL_RESTITUTION
+    from .restitution import SOLVER_RESTITUTION_RANGE, parse_restitution
+
+    exact = parse_restitution(restitution, "r")
+    if exact <= CRITICAL_RESTITUTION:
+        return None
+    if exact > SOLVER_RESTITUTION_RANGE[1]:
+        from .quasi_elastic import relaxation_time
+
+        return float(relaxation_time(exact))
+    from .equilibrium import Equilibrium
+
+    return float(Equilibrium(exact).relaxation_time)
+
+
+def default_equilibration_time(restitution) -> float:
+    """The simulated time a shard discards before it records, unless told otherwise:
+    ``EQUILIBRATION_RELAXATION_TIMES`` relaxation times (``equilibration_relaxation_time``)
+    rounded up to two significant digits, and at least ``MIN_EQUILIBRATION_TIME``.
+
+    Parameters
+    ----------
+    restitution : float, str or fractions.Fraction
+        r, 0 < r < 1.
+
+    Returns
+    -------
+    float
+        In the paper's time units.
+
+    Examples
+    --------
+    >>> from bouncing_ball.equilibration import default_equilibration_time
+    >>> default_equilibration_time("1/2"), default_equilibration_time(0.1)
+    (1000.0, 1000.0)
+    >>> default_equilibration_time(0.95), default_equilibration_time(0.99)
+    (21000.0, 530000.0)
+    """
+    relaxation = equilibration_relaxation_time(restitution)
+    if relaxation is None:
+        return MIN_EQUILIBRATION_TIME
+    return max(MIN_EQUILIBRATION_TIME, _two_digits_up(EQUILIBRATION_RELAXATION_TIMES * relaxation))
+
+
+def _two_digits_up(time: float) -> float:
+    """``time`` rounded up to two significant digits: a setting that does not move with the
+    last bits of the eigenvalue it comes from (they differ between LAPACK builds)."""
+    unit = 10.0 ** (int(np.floor(np.log10(time))) - 1)
+    return float(np.ceil(time / unit * (1.0 - 1e-9)) * unit)
+
+
+def equilibration_problems(
+    restitution, shard_time: float, equilibration_time: float, where: str = ""
+) -> list[str]:
+    """What in a shard's times falls short of the relaxation time at r, one sentence each.
+
+    ``equilibration_time`` below ``default_equilibration_time`` (r above r_c, where it is
+    ``EQUILIBRATION_RELAXATION_TIMES`` relaxation times and more than the least; a shorter
+    time chosen below that is the user's), and ``shard_time`` below
+    ``SHARD_RELAXATION_TIMES`` relaxation times.
+
+    Parameters
+    ----------
+    restitution : float, str or fractions.Fraction
+        r, 0 < r < 1.
+    shard_time, equilibration_time : float
+        The shard's settings, in the paper's time units.
+    where : str, optional
+        The prefix of the settings' names in the messages (e.g. ``"simulation."``).
+
+    Returns
+    -------
+    list of str
+        Empty where both are long enough, and at or below r_c.
+
+    Examples
+    --------
+    >>> from bouncing_ball.equilibration import equilibration_problems
+    >>> equilibration_problems("1/2", 2e3, 1e3)
+    []
+    >>> for problem in equilibration_problems(0.95, 2e3, 50.0):
+    ...     print(problem)  # doctest: +ELLIPSIS
+    r = 0.95: equilibration_time = 50 is shorter than 20 relaxation times (1016.13 each): ...
+    r = 0.95: shard_time = 2000 is shorter than 8 relaxation times (1016.13 each): ...
+    """
+    from .restitution import parse_restitution, restitution_label
+
+    relaxation = equilibration_relaxation_time(restitution)
+    if relaxation is None:
+        return []
+    label = restitution_label(parse_restitution(restitution, "r"))
+    problems = []
+    needed = EQUILIBRATION_RELAXATION_TIMES * relaxation
+    if equilibration_time < needed and needed > MIN_EQUILIBRATION_TIME:
+        problems.append(
+            f"r = {label}: {where}equilibration_time = {equilibration_time:g} is shorter "
+            f"than {EQUILIBRATION_RELAXATION_TIMES} relaxation times ({relaxation:.6g} each): "
+            "the shards may record the start's transient; use the default (the workflow's "
+            f"equilibration_time: auto), {needed:.3g}"
+        )
+    shortest = SHARD_RELAXATION_TIMES * relaxation
+    if shard_time < shortest:
+        problems.append(
+            f"r = {label}: {where}shard_time = {shard_time:g} is shorter than "
+            f"{SHARD_RELAXATION_TIMES} relaxation times ({relaxation:.6g} each): the early "
+            "part of a recording, which the equilibration check compares with the rest, "
+            f"spans less than one, and the errors cannot be trusted; use at least {shortest:.3g}"
+        )
+    return problems
+
+
+def warn_equilibration_problems(restitution, shard_time, equilibration_time) -> None:
+    """Each of ``equilibration_problems`` as an ``EquilibrationWarning`` (``simulate``)."""
+    for problem in equilibration_problems(restitution, shard_time, equilibration_time):
+        warnings.warn(problem, EquilibrationWarning, stacklevel=3)
+
+
+def relaxation_record(restitution, shard_time: float, equilibration_time: float) -> dict:
+    """The shards' times in relaxation times, as a JSON-ready record for a merge's provenance.
+
+    Parameters
+    ----------
+    restitution : float, str or fractions.Fraction
+        r, 0 < r < 1.
+    shard_time, equilibration_time : float
+        The shards' settings.
+
+    Returns
+    -------
+    dict
+        ``relaxation_time`` (None at or below r_c), ``equilibration_relaxation_times`` and
+        ``shard_relaxation_times`` (the settings divided by it; None likewise), and
+        ``problems`` (``equilibration_problems``).
+
+    Examples
+    --------
+    >>> from bouncing_ball.equilibration import relaxation_record
+    >>> record = relaxation_record("1/2", 2e3, 1e3)
+    >>> round(record["shard_relaxation_times"], 1), record["problems"]
+    (136.9, [])
+    """
+    relaxation = equilibration_relaxation_time(restitution)
+    ratio = (lambda time: None) if relaxation is None else (lambda time: time / relaxation)
+    return {
+        "relaxation_time": relaxation,
+        "equilibration_relaxation_times": ratio(equilibration_time),
+        "shard_relaxation_times": ratio(shard_time),
+        "problems": equilibration_problems(restitution, shard_time, equilibration_time),
+    }
 
 
 def _estimates(time, collisions, int_x, int_x2) -> dict:

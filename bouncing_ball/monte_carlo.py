@@ -32,18 +32,20 @@ from .settings import MAX_SHARDS, ShardSettings, real_number
 __all__ = ["simulate", "SimulationResult", "SimulationInterrupted", "DEFAULT_SETTINGS"]
 
 # the shard settings ``simulate`` uses where it is not told otherwise (the default config's
-# ``simulation`` section holds the workflow's); every bin set is ``ShardSettings``' default
+# ``simulation`` section holds the workflow's); every bin set is ``ShardSettings``' default,
+# and equilibration_time follows from the relaxation time at r
+# (``equilibration.default_equilibration_time``)
 DEFAULT_SETTINGS = {
-    "equilibration_time": 1.0e3,
     "criterion_c": 3.0,
     "min_step_divisor": 500.0,
     "max_steps": 10**9,
 }
 
 
-def _shard_settings(shard_time, settings):
-    """The ``ShardSettings`` of a call: ``settings`` (a ShardSettings, or a mapping of
-    overrides of DEFAULT_SETTINGS) with ``shard_time``."""
+def _shard_settings(shard_time, settings, restitution):
+    """The ``ShardSettings`` of a call at r = ``restitution``: ``settings`` (a ShardSettings,
+    or a mapping of overrides of DEFAULT_SETTINGS and of the default equilibration time) with
+    ``shard_time``."""
     if isinstance(settings, ShardSettings):
         if shard_time is None:
             return settings
@@ -71,6 +73,10 @@ def _shard_settings(shard_time, settings):
     shard_time = real_number(shard_time, "shard_time")
     if not 0.0 < shard_time < math.inf:
         raise ValueError(f"shard_time must be positive and finite, got {shard_time!r}")
+    if "equilibration_time" not in overrides:
+        from .equilibration import default_equilibration_time
+
+        overrides["equilibration_time"] = default_equilibration_time(restitution)
     try:
         return ShardSettings.from_mapping(
             {**DEFAULT_SETTINGS, **overrides, "shard_time": shard_time}
@@ -350,7 +356,9 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
         The shard settings (``settings.ShardSettings``), or a dict overriding some of
         ``DEFAULT_SETTINGS`` and ``ShardSettings``' defaults (equilibration_time, criterion_c,
         min_step_divisor, max_steps, speed_bins, position_bins, velocity_bins,
-        flight_time_bins, min_step_floor).  Their ranges are ``ShardSettings``', the
+        flight_time_bins, min_step_floor).  equilibration_time defaults to
+        ``equilibration.default_equilibration_time(r)``: 20 relaxation times of the process
+        at r, at least 1e3.  Their ranges are ``ShardSettings``', the
         workflow's config check's: c of eq. (criterion) at least ``MIN_CRITERION_C``,
         min_step_floor at most ``MAX_MIN_STEP_FLOOR``.
     processes : int, optional
@@ -365,6 +373,15 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
     -------
     SimulationResult
         The merged tables and the observables with their errors.
+
+    Warns
+    -----
+    equilibration.EquilibrationWarning
+        Where equilibration_time is shorter than the default at an r above r_c, or
+        shard_time is shorter than ``equilibration.SHARD_RELAXATION_TIMES`` relaxation times
+        (``equilibration.equilibration_problems``): the estimates may carry the start's
+        transient, or errors that cannot be trusted.  The message names r, the relaxation
+        time and the setting.
 
     Raises
     ------
@@ -382,10 +399,9 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
     Examples
     --------
     >>> from bouncing_ball import simulate
-    >>> result = simulate("1/2", shards=4, shard_time=200.0, seed=1,
-    ...                   settings={"equilibration_time": 20.0}, progress=False)
-    >>> result.shards, result.total_time, result.partial
-    (4, 800.0, False)
+    >>> result = simulate("1/2", shards=4, shard_time=200.0, seed=1, progress=False)
+    >>> result.shards, result.total_time, result.partial, result.settings.equilibration_time
+    (4, 800.0, False, 1000.0)
     >>> sorted(result.summary.columns)[:4]
     ['collision_rate', 'collision_rate_controlled', 'collision_rate_controlled_err', 'collision_rate_err']
 
@@ -402,13 +418,16 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
     label = restitution_label(exact)
     shards = _whole_number(shards, "shards", 2, MAX_SHARDS)
     processes = _whole_number(processes, "processes", 1)
-    run_settings = _shard_settings(shard_time, settings)
+    run_settings = _shard_settings(shard_time, settings, exact)
     if exact < CRITICAL_RESTITUTION and not run_settings.min_step_floor > 0.0:
         raise ValueError(
             f"r = {r!r} is below r_c = {CRITICAL_RESTITUTION:.4f}: the ball collapses onto the "
             "floor (infinitely many collisions in a finite time); give settings="
             '{"min_step_floor": 1e-10} (or another positive floor) to regularise it'
         )
+    from .equilibration import warn_equilibration_problems
+
+    warn_equilibration_problems(r, run_settings.shard_time, run_settings.equilibration_time)
     if seed is None:
         seed = int(np.random.SeedSequence().entropy)
     seed = _whole_number(seed, "seed", 0)
@@ -482,8 +501,7 @@ class SimulationResult:
     Examples
     --------
     >>> from bouncing_ball import simulate
-    >>> result = simulate(0.6, shards=2, shard_time=100.0, seed=3,
-    ...                   settings={"equilibration_time": 10.0}, progress=False)
+    >>> result = simulate(0.6, shards=2, shard_time=200.0, seed=3, progress=False)
     >>> list(result.px.columns)
     ['x_lo', 'x_hi', 'x', 'px', 'px_err']
     """

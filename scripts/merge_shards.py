@@ -6,7 +6,12 @@ summary}.parquet.  Refused where the shards' early parts disagree with the rest 
 
 import logging
 
-from bouncing_ball.equilibration import early_check, early_check_message, early_check_record
+from bouncing_ball.equilibration import (
+    early_check,
+    early_check_message,
+    early_check_record,
+    relaxation_record,
+)
 from bouncing_ball.histograms import (
     distribution_histogram,
     flight_time_histogram,
@@ -35,7 +40,12 @@ with job_log(snakemake.log[0], exit_when_done=True):
         "simulation_code": first["code"],
         **{key: first[key] for key in ("seed", *ShardSettings.names())},
     }
-    # the shards' own evidence of equilibration: the early part of each against the rest
+    # the shards' times against the relaxation time at r, and their own evidence of
+    # equilibration: the early part of each against the rest
+    relaxation = relaxation_record(exact, first["shard_time"], first["equilibration_time"])
+    provenance["relaxation"] = relaxation
+    for problem in relaxation["problems"]:
+        logging.warning(problem)
     equilibration = early_check(shards)
     provenance["equilibration_check"] = early_check_record(equilibration)
     verdict = provenance["equilibration_check"]["verdict"]
@@ -44,8 +54,8 @@ with job_log(snakemake.log[0], exit_when_done=True):
             f"{early_check_message(equilibration, label)}. The shards "
             f"{'are not' if verdict == 'refuse' else 'may not be'} in equilibrium when they "
             "start recording: raise simulation.equilibration_time for this r "
-            f'(simulation.per_restitution: {{"{label}": {{equilibration_time: ...}}}}) and '
-            "rerun its shards"
+            f'(simulation.per_restitution: {{"{label}": {{equilibration_time: ...}}}}; the '
+            f"relaxation time there is {relaxation['relaxation_time']}) and rerun its shards"
         )
         if verdict == "refuse":
             raise RuntimeError(f"{message}. Their errors cannot be trusted: nothing is written")

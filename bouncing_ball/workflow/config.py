@@ -20,6 +20,11 @@ import jsonschema
 import yaml
 
 from ..bins import linear_bins, log_bins
+from ..equilibration import (
+    MIN_EQUILIBRATION_TIME,
+    default_equilibration_time,
+    equilibration_problems,
+)
 from ..equilibrium import check_solver_settings
 from ..restitution import (
     EXACT_RESTITUTIONS,
@@ -216,6 +221,7 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
                 f"({label}); add r = {key} to restitution, or key the override by {label}"
             )
     check_shard_settings(config)
+    check_equilibration(config)
     check_memory(config)
     return grid
 
@@ -426,15 +432,61 @@ def known_restitutions(config: dict) -> dict[str, Fraction]:
     return {**figure_restitutions(config, grid), **grid}
 
 
+#: ``simulation.equilibration_time`` (or an override's) that follows from the relaxation time
+#: at each r: ``equilibration.default_equilibration_time``
+AUTO_EQUILIBRATION = "auto"
+
+
 def simulation_settings(config: dict, label: str) -> dict:
-    """The simulation parameters of one r: the defaults with its overrides applied."""
+    """The simulation parameters of one r: the defaults with its overrides applied, and
+    ``equilibration_time: auto`` replaced by ``equilibration.default_equilibration_time`` at
+    that r (the r of ``restitution`` or the figures with that label; for the label "", which
+    no r has, by ``equilibration.MIN_EQUILIBRATION_TIME``)."""
     simulation = config["simulation"]
     settings = {"min_step_floor": 0.0}  # optional key: the paper's rule alone
     settings.update({k: v for k, v in simulation.items() if k != "per_restitution"})
     for key, override in per_restitution(config).items():
         if restitution_label(parse_restitution(key)) == label:
             settings.update(override)
+    if settings["equilibration_time"] == AUTO_EQUILIBRATION:
+        settings["equilibration_time"] = (
+            default_equilibration_time(_restitution_of_label(config, label))
+            if label
+            else MIN_EQUILIBRATION_TIME
+        )
     return settings
+
+
+def _restitution_of_label(config: dict, label: str) -> Fraction:
+    """The r the config names by ``label`` (``restitution``, the figures' lists, the
+    overrides' keys), or the label read as r."""
+    named = [*config["restitution"], *per_restitution(config)]
+    for figure in SIMULATED_FIGURES:
+        named.extend(config["figures"].get(figure) or [])
+    for value in named:
+        try:
+            exact = parse_restitution(value)
+        except ValueError:
+            continue  # check_config names it
+        if restitution_label(exact) == label:
+            return exact
+    return parse_restitution(label)
+
+
+def check_equilibration(config: dict) -> None:
+    """Refuse, naming r, the relaxation time and the key, a simulated r whose shards
+    (``simulation_settings``) are too short for the relaxation time there
+    (``equilibration.equilibration_problems``), before any job runs."""
+    for label, exact in known_restitutions(config).items():
+        settings = simulation_settings(config, label)
+        problems = equilibration_problems(
+            exact_string(exact),
+            settings["shard_time"],
+            settings["equilibration_time"],
+            f'simulation.per_restitution."{label}".',
+        )
+        if problems:
+            raise ValueError("; ".join(problems))
 
 
 def shard_settings(config: dict, label: str) -> ShardSettings:

@@ -120,9 +120,9 @@ def test_solver_settings_are_held_to_the_library_bounds(key, value):
 
 def test_per_r_overrides_apply_by_label():
     config = _default_config()
-    config["simulation"]["per_restitution"] = {"3/4": {"shard_time": 123.0}}
+    config["simulation"]["per_restitution"] = {"3/4": {"shard_time": 1234.0}}
     check_config(config)
-    assert simulation_settings(config, "0.75")["shard_time"] == 123.0
+    assert simulation_settings(config, "0.75")["shard_time"] == 1234.0
     assert simulation_settings(config, "0.5")["shard_time"] == config["simulation"]["shard_time"]
 
 

@@ -9,12 +9,20 @@ import pytest
 import yaml
 from workflow_support import REPOSITORY
 
+from bouncing_ball import Equilibrium, simulate
 from bouncing_ball.bins import LinearBins, LogBins
 from bouncing_ball.equilibration import (
+    EQUILIBRATION_RELAXATION_TIMES,
+    MIN_EQUILIBRATION_TIME,
     QUANTITIES,
+    SHARD_RELAXATION_TIMES,
+    EquilibrationWarning,
+    default_equilibration_time,
     early_check,
     early_check_message,
     early_check_record,
+    equilibration_problems,
+    relaxation_record,
     window_estimates,
 )
 from bouncing_ball.tallies import EARLY_FRACTION, ShardTallies
@@ -122,16 +130,22 @@ def test_the_equilibration_time_can_be_set_per_r():
         check_config(config, schema)
 
 
-@pytest.mark.parametrize("equilibration_time, verdict", [(1.0e3, "refuse"), (1.0e5, "ok")])
+@pytest.mark.parametrize(
+    "equilibration_time, verdict", [(1.0e3, "refuse"), (1.0e5, "ok"), ("auto", "ok")]
+)
 def test_a_short_equilibration_near_r_1_is_refused(equilibration_time, verdict):
-    """r = 0.99 with the default config's shard settings: the ball starts at rest and its
-    energy relaxes over ~1e4-1e5 time units, so with the default equilibration time every
+    """r = 0.99 with the default config's shard time: the ball starts at rest and its
+    energy relaxes over ~1e4-1e5 time units, so with 1e3 time units of equilibration every
     shard records the same transient and the merged <x> and Delta x are biased (z of about -3
     and -5 against the solver) with errors that do not show it.  The check refuses those
-    shards; with 1e5 time units of equilibration it passes them."""
+    shards; with 1e5 time units of equilibration, or the default (20 relaxation times), it
+    passes them."""
     from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 
     config = _default_config()
+    if equilibration_time == "auto":
+        equilibration_time = shard_settings(config, "0.99").equilibration_time
+        assert equilibration_time == default_equilibration_time(0.99)
     settings = shard_settings(config, "0.99").replace(equilibration_time=equilibration_time)
     shards = [
         simulate_shard(0.99, shard_seed_sequence(config["seed"], "0.99", k), settings)
@@ -151,3 +165,54 @@ def test_shards_whose_differences_agree_have_no_scatter_and_are_not_refused(shar
     check = early_check([_shard((early_x, 8.0, 1.0), (2.0, 8.0, 1.0))] * shards)
     assert (check.difference_err == 0.0).all()
     assert (check.z == 0.0).all() and (check.verdict == "ok").all()
+
+
+@pytest.mark.parametrize("r", [0.25, "1/3", 0.5, 0.75, 0.95, 0.99])
+def test_the_default_equilibration_is_twenty_relaxation_times_and_at_least_1e3(r):
+    relaxation = Equilibrium(r).relaxation_time
+    default = default_equilibration_time(r)
+    needed = EQUILIBRATION_RELAXATION_TIMES * relaxation
+    assert default >= max(MIN_EQUILIBRATION_TIME, needed)
+    assert default == MIN_EQUILIBRATION_TIME or default <= 1.1 * needed  # two digits, rounded up
+    assert default_equilibration_time(0.1) == MIN_EQUILIBRATION_TIME  # below r_c: no relaxation
+
+
+def test_shards_too_short_for_the_relaxation_time_are_named():
+    """The equilibration time and the shard time against the relaxation time at r = 0.95
+    (about 1e3 time units): each problem names r, the relaxation time and the setting."""
+    relaxation = Equilibrium(0.95).relaxation_time
+    assert equilibration_problems(0.95, SHARD_RELAXATION_TIMES * relaxation * 1.01, 2.1e4) == []
+    short = equilibration_problems(0.95, 2e3, 50.0, "simulation.")
+    assert len(short) == 2
+    assert all(f"{relaxation:.6g}" in problem and "r = 0.95" in problem for problem in short)
+    assert "simulation.equilibration_time = 50" in short[0]
+    assert "simulation.shard_time = 2000" in short[1]
+    record = relaxation_record(0.95, 2e3, 50.0)
+    assert record["problems"] == equilibration_problems(0.95, 2e3, 50.0)
+    assert record["shard_relaxation_times"] == pytest.approx(2e3 / relaxation, rel=1e-12)
+    # where the relaxation time is short the least equilibration time governs, not 20 of them
+    assert equilibration_problems(0.5, 2e3, 50.0) == []
+
+
+def test_the_config_refuses_shards_too_short_near_r_1_before_any_job():
+    """r = 0.9 (relaxation time about 240) with shards shorter than 8 relaxation times, or an
+    equilibration time shorter than 20: the config check refuses them, naming r and the key
+    (at r = 0.95 shards of 2e3 give <x> = 330 +- 87 against the solver's 678 while the
+    early-versus-rest check passes)."""
+    config = _default_config()
+    config["restitution"] = [0.5, 0.9]
+    schema = read_yaml(REPOSITORY / "workflow/schemas/config.schema.yaml")
+    check_config(config, schema)  # auto equilibration, the default shard time: long enough
+    assert shard_settings(config, "0.9").equilibration_time == default_equilibration_time(0.9)
+    config["simulation"]["per_restitution"] = {"0.9": {"shard_time": 1e3}}
+    with pytest.raises(ValueError, match=r'r = 0.9: simulation.per_restitution."0.9".shard_time'):
+        check_config(config, schema)
+    config["simulation"]["per_restitution"] = {"0.9": {"equilibration_time": 50.0}}
+    with pytest.raises(ValueError, match="equilibration_time = 50 is shorter than 20 relaxation"):
+        check_config(config, schema)
+
+
+def test_simulate_warns_of_shards_too_short_for_the_relaxation_time():
+    with pytest.warns(EquilibrationWarning, match="r = 0.95: shard_time = 2000 is shorter"):
+        result = simulate(0.95, shards=2, shard_time=2e3, seed=1, progress=False)
+    assert result.settings.equilibration_time == default_equilibration_time(0.95)

@@ -14,7 +14,7 @@ def test_a_shard_that_recorded_nothing_is_refused_by_the_merge_with_the_reason_i
     merge log names the shard, the reason and the way out, with the traceback."""
     config = copy.deepcopy(SMALL)
     config["restitution"] = [0.5, 0.05]
-    config["simulation"].update(shards=2, shard_time=100.0, equilibration_time=50.0)
+    config["simulation"].update(shards=2, shard_time=200.0, equilibration_time=50.0)
     config["simulation"]["per_restitution"] = {
         "0.5": {"max_steps": 100},
         "0.05": {"max_steps": 200000},

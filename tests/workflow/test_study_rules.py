@@ -8,6 +8,7 @@ import pytest
 import yaml
 from workflow_support import SMALL, copy_repository, planned_jobs, snakemake
 
+from bouncing_ball.equilibration import default_equilibration_time
 from bouncing_ball.workflow.io import read_table
 
 # 2-4 shards per run of 1e3-2e3 time units; batches and groups of 2 shards so that every
@@ -78,7 +79,9 @@ def test_criterion_bias_report_has_every_r_and_c(studies_run):
     )
     assert provenance["rule"] == "study_shard" and provenance["seed"] == 7
     assert provenance["criterion_c"] == 5.0 and provenance["shard_time"] == 2.0e3
-    assert provenance["equilibration_time"] == SMALL["simulation"]["equilibration_time"]
+    # the test config's equilibration_time: auto, at r = 1/2 the least, 1e3
+    assert SMALL["simulation"]["equilibration_time"] == "auto"
+    assert provenance["equilibration_time"] == default_equilibration_time("1/2") == 1.0e3
     # a batch of one shard (scripts/simulate_shards.py): its cost, one entry per shard
     assert (provenance["first_shard"], provenance["last_shard"]) == (1, 1)
     assert len(provenance["cpu_seconds"]) == 1 and provenance["cpu_seconds"][0] > 0
