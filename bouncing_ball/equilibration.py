@@ -84,9 +84,11 @@ SHARD_RELAXATION_TIMES = round(1.0 / EARLY_FRACTION)
 
 
 class EquilibrationWarning(RuntimeWarning):
-    """``simulate`` run with settings shorter than the relaxation time asks for
-    (``equilibration_problems``): its estimates may carry the start's transient, or errors
-    that cannot be trusted."""
+    """A ``simulate`` run whose times fall short of the relaxation time at r.
+
+    See ``equilibration_problems``: its estimates may carry the start's transient, or errors
+    that cannot be trusted.
+    """
 
 
 def equilibration_relaxation_time(restitution) -> float | None:
@@ -135,7 +137,8 @@ def equilibration_relaxation_time(restitution) -> float | None:
 
 
 def default_equilibration_time(restitution) -> float:
-    """The simulated time a shard discards before it records, unless told otherwise:
+    """The simulated time a shard discards before it records, unless told otherwise.
+
     ``EQUILIBRATION_RELAXATION_TIMES`` relaxation times (``equilibration_relaxation_time``)
     rounded up to two significant digits, and at least ``MIN_EQUILIBRATION_TIME``.
 
@@ -231,7 +234,20 @@ def equilibration_problems(
 
 
 def warn_equilibration_problems(restitution, shard_time, equilibration_time) -> None:
-    """Each of ``equilibration_problems`` as an ``EquilibrationWarning`` (``simulate``)."""
+    """Warn of each of ``equilibration_problems`` (``simulate``).
+
+    Parameters
+    ----------
+    restitution : float, str or fractions.Fraction
+        r, 0 < r < 1.
+    shard_time, equilibration_time : float
+        The shard's settings.
+
+    Returns
+    -------
+    None
+        Each problem is an ``EquilibrationWarning``, attributed to the caller's caller.
+    """
     for problem in equilibration_problems(restitution, shard_time, equilibration_time):
         warnings.warn(problem, EquilibrationWarning, stacklevel=3)
 

@@ -425,12 +425,12 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
             "floor (infinitely many collisions in a finite time); give settings="
             '{"min_step_floor": 1e-10} (or another positive floor) to regularise it'
         )
-    from .equilibration import warn_equilibration_problems
-
-    warn_equilibration_problems(r, run_settings.shard_time, run_settings.equilibration_time)
     if seed is None:
         seed = int(np.random.SeedSequence().entropy)
     seed = _whole_number(seed, "seed", 0)
+    from .equilibration import warn_equilibration_problems
+
+    warn_equilibration_problems(r, run_settings.shard_time, run_settings.equilibration_time)
     progress_line = _Progress(label, shards, progress)
     finished = {}
     arguments = (float(exact), seed, label, run_settings)

@@ -20,11 +20,6 @@ import jsonschema
 import yaml
 
 from ..bins import linear_bins, log_bins
-from ..equilibration import (
-    MIN_EQUILIBRATION_TIME,
-    default_equilibration_time,
-    equilibration_problems,
-)
 from ..equilibrium import check_solver_settings
 from ..restitution import (
     EXACT_RESTITUTIONS,
@@ -449,6 +444,10 @@ def simulation_settings(config: dict, label: str) -> dict:
         if restitution_label(parse_restitution(key)) == label:
             settings.update(override)
     if settings["equilibration_time"] == AUTO_EQUILIBRATION:
+        # imported here: the relaxation time needs the solver (scipy, numba), which importing
+        # this module does not load
+        from ..equilibration import MIN_EQUILIBRATION_TIME, default_equilibration_time
+
         settings["equilibration_time"] = (
             default_equilibration_time(_restitution_of_label(config, label))
             if label
@@ -477,6 +476,8 @@ def check_equilibration(config: dict) -> None:
     """Refuse, naming r, the relaxation time and the key, a simulated r whose shards
     (``simulation_settings``) are too short for the relaxation time there
     (``equilibration.equilibration_problems``), before any job runs."""
+    from ..equilibration import equilibration_problems
+
     for label, exact in known_restitutions(config).items():
         settings = simulation_settings(config, label)
         problems = equilibration_problems(

@@ -174,12 +174,12 @@ def test_simulation_result_has_the_observables():
     result = bb.simulate(
         "1/3",
         shards=2,
-        shard_time=100.0,
+        shard_time=200.0,
         seed=2,
         settings={"equilibration_time": 5.0},
         progress=False,
     )
-    assert result.shards == 2 and result.total_time == pytest.approx(200.0)
+    assert result.shards == 2 and result.total_time == pytest.approx(400.0)
     for name in (
         "collision_rate",
         "mean_x",
@@ -306,7 +306,7 @@ def test_simulate_defaults_are_the_default_config():
 
     config = read_config(REPOSITORY / "config" / "config.yaml")
     default = shard_settings(config, "0.5").replace(shard_time=1.0)
-    assert _shard_settings(1.0, None) == default
+    assert _shard_settings(1.0, None, Fraction(1, 2)) == default
     assert set(DEFAULT_SETTINGS) < set(default.names())
 
 

@@ -17,6 +17,9 @@ import pytest
 import bouncing_ball as bb
 from bouncing_ball.monte_carlo import SimulationResult
 
+# shards of a few relaxation times: what is tested is how runs stop, not their errors
+pytestmark = pytest.mark.filterwarnings("ignore::bouncing_ball.equilibration.EquilibrationWarning")
+
 # a child that interrupts itself (SIGINT, as a terminal or a notebook kernel gets it) `delay`
 # seconds after `after` shards have finished, and reports what simulate raised and how long it
 # took to stop
