@@ -1014,13 +1014,16 @@ def _bounce_lag_covariances(sums):
     pairs = named["lag_pairs"][..., None]
     leading = np.stack([named["lag_log_speed_leading"], named["lag_speed_leading"]], -1) / pairs
     trailing = np.stack([named["lag_log_speed_trailing"], named["lag_speed_trailing"]], -1) / pairs
-    products = np.stack(
-        [
-            np.stack([named["lag_log_log"], named["lag_log_speed"]], -1),
-            np.stack([named["lag_speed_log"], named["lag_speed_speed"]], -1),
-        ],
-        -2,
-    ) / pairs[..., None]
+    products = (
+        np.stack(
+            [
+                np.stack([named["lag_log_log"], named["lag_log_speed"]], -1),
+                np.stack([named["lag_speed_log"], named["lag_speed_speed"]], -1),
+            ],
+            -2,
+        )
+        / pairs[..., None]
+    )
     return products - leading[..., :, None] * trailing[..., None, :]
 
 
@@ -1106,9 +1109,10 @@ def _fitted_decay_rate(correlation, lags, weights):
     mean_lag = (weights * lags).sum() / total
     mean_log = (weights * log_correlation).sum(axis=-1, keepdims=True) / total
     centred = lags - mean_lag
-    return -(weights * centred * (log_correlation - mean_log)).sum(axis=-1) / (
-        weights * centred**2
-    ).sum()
+    return (
+        -(weights * centred * (log_correlation - mean_log)).sum(axis=-1)
+        / (weights * centred**2).sum()
+    )
 
 
 def bounce_chain_decay(shards: list[ShardTallies]) -> dict:
