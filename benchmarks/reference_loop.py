@@ -169,6 +169,8 @@ def _load(library: str):
         _double_array,  # position_velocity_time, row-major
         _int64_array,  # return_speed_counts, row-major
         _int64_array,  # return_law_speed_counts
+        _double_array,  # bounce_lag_sums, row-major
+        ctypes.c_int64,  # lags 0 .. BOUNCE_LAGS: their number
         _double_array,  # scalars
     ]
     return function
@@ -219,6 +221,8 @@ def reference_shard(
         arrays["position_velocity_time"].ravel(),  # C-contiguous: a view
         arrays["return_speed_counts"].ravel(),
         arrays["return_law_speed_counts"],
+        arrays["bounce_lag_sums"].ravel(),  # C-contiguous: a view
+        arrays["bounce_lag_sums"].shape[1],
         arrays["scalars"],
     )
     if status != 0:

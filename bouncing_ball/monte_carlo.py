@@ -495,6 +495,17 @@ class SimulationResult:
         rho(T) per flight on the flight-time bins (t_lo, t_hi, t, density, density_err).
     return_speed : pandas.DataFrame
         The return speed's bin probabilities given the outgoing speed's bin.
+    bounce_autocorrelation : pandas.DataFrame
+        The bounce chain's autocorrelation over lags 1 .. ``tallies.BOUNCE_LAGS`` (lag,
+        autocorrelation of ln u_n, principal_correlation of (ln u_n, u_n), each with its
+        ``_err``; ``histograms.bounce_autocorrelation``).
+    bounce_chain_decay : dict
+        The fitted decay rate -ln lambda of the bounce chain's correlations, lambda
+        (``relaxation_eigenvalue``), n_c = 1 / rate (``correlation_bounces``), each with its
+        ``_err``, and the lags of the fit (``histograms.bounce_chain_decay``); against
+        ``Equilibrium.relaxation_eigenvalue``.
+    relaxation_eigenvalue, relaxation_eigenvalue_err : float
+        lambda of ``bounce_chain_decay`` and its jackknife error.
     summary : pandas.DataFrame
         One row: the scalars, their errors, the counts (as the workflow's summary table).
 
@@ -628,6 +639,23 @@ class SimulationResult:
         from .histograms import return_speed_table
 
         return return_speed_table(list(self.tallies))
+
+    @cached_property
+    def bounce_autocorrelation(self):
+        from .histograms import bounce_autocorrelation
+
+        return bounce_autocorrelation(list(self.tallies))
+
+    @cached_property
+    def bounce_chain_decay(self):
+        from .histograms import bounce_chain_decay
+
+        return bounce_chain_decay(list(self.tallies))
+
+    relaxation_eigenvalue = property(lambda self: self.bounce_chain_decay["relaxation_eigenvalue"])
+    relaxation_eigenvalue_err = property(
+        lambda self: self.bounce_chain_decay["relaxation_eigenvalue_err"]
+    )
 
     def batch_frame(self):
         """The shards as one table in the workflow's batch format (``batches.batch_to_frame``;

@@ -71,6 +71,12 @@ depends on the state):
     I x (recorded time) x E[f(T)] with E the equilibrium average per
     collision (Palm): unbiased, with no edge effect at either end of the
     recording (docs/methods.md, 'Flights').
+  * the bounce chain: for each recorded collision n and lag k = 0 .. BOUNCE_LAGS, the pair
+    of outgoing speeds (u_{n-k}, u_n), the earlier from a ring buffer of the last
+    BOUNCE_LAGS + 1 collisions (equilibration included): the sums of ln u and u of each and
+    of their four products (``tallies.BOUNCE_LAG_SUMS``), which give the autocorrelation of
+    ln u_n and the relaxation eigenvalue of the chain (``histograms.bounce_autocorrelation``).
+    Counted at the later collision, as a flight is: unbiased, no edge effect.
   * control variates: sums over the recorded steps of the velocity noise
     xi = sqrt(2 dt) normal_r of eq. (vstep) (noise_sum), of v xi (noise_v_sum),
     of v xi / (x + v^2/2 + 4 dt) (noise_scaled_sum) and of normal_r
@@ -615,6 +621,30 @@ class ShardStopped(Exception):
     time."""
 
 
+@njit(cache=True, inline="always")
+def _tally_bounce_lags(sums, ring_log, ring_speed, newest, history, log_u, u):
+    """Add the pairs (u_{n-k}, u_n), k = 0 .. history - 1, of the collision n of outgoing
+    speed u (logarithm ``log_u``) to the bounce-lag sums (``tallies.BOUNCE_LAG_SUMS``, rows
+    of ``sums``): u_{n-k} is the ring buffer's entry k places before ``newest``, where u_n
+    itself is."""
+    size = ring_log.shape[0]
+    for k in range(history):
+        j = newest - k
+        if j < 0:
+            j += size
+        lead_log = ring_log[j]
+        lead_u = ring_speed[j]
+        sums[0, k] += 1.0
+        sums[1, k] += lead_log
+        sums[2, k] += lead_u
+        sums[3, k] += log_u
+        sums[4, k] += u
+        sums[5, k] += lead_log * log_u
+        sums[6, k] += lead_log * u
+        sums[7, k] += lead_u * log_u
+        sums[8, k] += lead_u * u
+
+
 # a step this short only happens in a collapse (v ~ 1e-37); much shorter ones overflow the bridge's
 # cubic coefficients (~ x / dt^2) before the speed underflows to zero
 COLLAPSED_STEP = 1.0e-80
@@ -643,6 +673,7 @@ def _run(
     position_velocity_time,
     return_speed_counts,
     return_law_speed_counts,
+    bounce_lag_sums,
     scalars,
     parts,
     stop,
@@ -700,6 +731,12 @@ def _run(
     since_collision = 0.0  # time since the last collision (equilibration included)
     collided_before = False
     last_out_bin = 0  # speed bin of the last collision's outgoing speed
+    # the outgoing speeds of the last collisions and their logarithms (the bounce-lag sums)
+    ring_size = bounce_lag_sums.shape[1]
+    ring_log = np.zeros(ring_size)
+    ring_speed = np.zeros(ring_size)
+    ring_newest = ring_size - 1  # where the latest collision is
+    ring_history = 0  # collisions in the ring
     # the control variates (martingales of mean 0, see the module docstring)
     noise_sum = 0.0
     noise_v_sum = 0.0
@@ -919,7 +956,21 @@ def _run(
             v_out = restitution * v_in  # eq. (restitution)
             log_v_out = math.log(v_out)  # the bins of v_out, and of v_in = v_out / r, from it
             out_bin = _log_bin_index(v_out, log_v_out, v_log_lo, v_per_ln, nv, v_edges)
+            ring_newest = 0 if ring_newest == ring_size - 1 else ring_newest + 1
+            ring_log[ring_newest] = log_v_out
+            ring_speed[ring_newest] = v_out
+            if ring_history < ring_size:
+                ring_history += 1
             if recording:
+                _tally_bounce_lags(
+                    bounce_lag_sums,
+                    ring_log,
+                    ring_speed,
+                    ring_newest,
+                    ring_history,
+                    log_v_out,
+                    v_out,
+                )
                 collisions += 1
                 speed_counts[out_bin] += 1
                 return_law_speed_counts[
@@ -1080,6 +1131,7 @@ def simulate_shard(
         arrays["position_velocity_time"],
         arrays["return_speed_counts"],
         arrays["return_law_speed_counts"],
+        arrays["bounce_lag_sums"],
         arrays["scalars"],
         parts,
         (ShardStop() if stop is None else stop).flag,

@@ -11,6 +11,8 @@ A shard is stored as one long table, a row per tally entry::
     position_velocity_time  x_lo   x_hi   v_lo   v_hi   time spent in that cell of (x, v)
     return_speed            u_lo   u_hi   v_lo   v_hi   flights leaving the floor at speed u
                                                         and returning at speed v in the cell
+    lag_pairs, ...          k      k + 1  NaN    NaN    the bounce-chain sums at lag k
+      (BOUNCE_LAG_SUMS)                                 (k = 0 .. BOUNCE_LAGS)
     time, collisions, steps, int_x, int_x2, budget_exhausted,
     flights, flight_time_sum, flight_time_squared_sum,
     noise_sum, noise_v_sum, noise_scaled_sum, normal_sum,
@@ -79,6 +81,9 @@ __all__ = [
     "SCALARS",
     "SCALAR_INDEX",
     "BINS",
+    "BOUNCE_LAGS",
+    "BOUNCE_LAG_SUMS",
+    "bounce_lag_pair_sums",
     "tally_seed_sequence",
     "ShardTallies",
     "merge_shards",
@@ -165,6 +170,48 @@ _INTEGER = ("collisions", "steps", "budget_exhausted", "flights", "early_collisi
 #: The four bins a shard is recorded on, fields of ``ShardTallies`` and of
 #: ``settings.ShardSettings``.
 BINS = ("speed_bins", "position_bins", "velocity_bins", "flight_time_bins")
+#: The largest lag K, in bounces, of the bounce chain's sums (``BOUNCE_LAG_SUMS``).  At
+#: r = 0.99 (n_c ~ 100 bounces) the correlation falls by 1 - lambda_2^16 ~ 15 % over the
+#: lags, far above its statistical error, so the decay rate is resolved; at r <= 0.75
+#: (n_c < 4) it falls below its error well before lag 16, so longer lags add noise only.
+#: The cost is per collision (a few hundred flops), not per step.
+BOUNCE_LAGS = 16
+#: The sums over pairs of bounces (n - k, n), for each lag k = 0 .. BOUNCE_LAGS, of the
+#: functions f = (ln u, u) of the outgoing speeds u_{n-k}, u_n: the pairs, the sums of
+#: f(u_{n-k}) ("leading") and of f(u_n) ("trailing"), and of the products
+#: f_a(u_{n-k}) f_b(u_n).  A pair is counted at its later bounce n, a recorded one; the
+#: earlier may lie in the equilibration (as a flight is counted at the collision that ends it),
+#: so in a stationary shard every sum has expectation (recorded collisions) x its
+#: equilibrium average, with no edge effect.  Lag 0 holds the sums of f and of f_a f_b.
+BOUNCE_LAG_SUMS = (
+    "lag_pairs",
+    "lag_log_speed_leading",
+    "lag_speed_leading",
+    "lag_log_speed_trailing",
+    "lag_speed_trailing",
+    "lag_log_log",
+    "lag_log_speed",
+    "lag_speed_log",
+    "lag_speed_speed",
+)
+
+
+def bounce_lag_pair_sums(sums):
+    """The bounce-lag sums of ``BOUNCE_LAG_SUMS`` by name: views of rows of ``sums``.
+
+    Parameters
+    ----------
+    sums : numpy.ndarray
+        A shard's ``bounce_lag_sums``, shape (..., len(BOUNCE_LAG_SUMS), lags), e.g.
+        stacked over shards.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        Each name of ``BOUNCE_LAG_SUMS`` -> its row, shape (..., lags).
+    """
+    sums = np.asarray(sums)
+    return {name: sums[..., row, :] for row, name in enumerate(BOUNCE_LAG_SUMS)}
 
 
 def _bins(holder, attribute):
@@ -227,6 +274,10 @@ class ShardTallies:
     return_law_speed_counts : numpy.ndarray of int64
         Collisions by outgoing speed on the fine ``settings.RETURN_LAW_SPEED_BINS``, for the
         return-law control of P(0, v) (``histograms.return_law_prediction``).
+    bounce_lag_sums : numpy.ndarray
+        Shape (len(BOUNCE_LAG_SUMS), BOUNCE_LAGS + 1): for each sum of ``BOUNCE_LAG_SUMS``
+        (a row) and lag k = 0 .. BOUNCE_LAGS (a column), the sum over the pairs of bounces k
+        apart; the autocorrelations of the bounce chain (``histograms.bounce_autocorrelation``).
     position_time, position_v2_time : numpy.ndarray
         Time spent in each height bin (P(x)) and int v^2 dt over it (<v^2>_x, eq. (moment2)).
     position_velocity_time : numpy.ndarray
@@ -269,6 +320,7 @@ class ShardTallies:
     position_velocity_time: np.ndarray  # (x bins, v bins): time per cell (sampled on the bridge)
     return_speed_counts: np.ndarray  # (u bins, v bins): outgoing speed u, return speed v
     return_law_speed_counts: np.ndarray  # outgoing speeds again, on RETURN_LAW_SPEED_BINS
+    bounce_lag_sums: np.ndarray  # (BOUNCE_LAG_SUMS, lags 0 .. BOUNCE_LAGS): bounce-chain sums
     time: float
     collisions: int
     steps: int
@@ -318,8 +370,8 @@ class ShardTallies:
         Returns
         -------
         dict of str to numpy.ndarray
-            By field name, each histogram with under- and overflow bins, and ``scalars`` in
-            the order of ``SCALARS``.
+            By field name, each histogram with under- and overflow bins, ``bounce_lag_sums``
+            and ``scalars`` in the order of ``SCALARS``.
         """
         arrays = {}
         for bins_attr, values_attr, integer in HISTOGRAMS.values():
@@ -329,6 +381,7 @@ class ShardTallies:
         for (first, second), values_attr, integer in HISTOGRAMS_2D.values():
             shape = (getattr(settings, first).n + 2, getattr(settings, second).n + 2)
             arrays[values_attr] = np.zeros(shape, dtype=np.int64 if integer else np.float64)
+        arrays["bounce_lag_sums"] = np.zeros((len(BOUNCE_LAG_SUMS), BOUNCE_LAGS + 1))
         arrays["scalars"] = np.zeros(len(SCALARS))
         return arrays
 
@@ -418,8 +471,8 @@ def tallies_to_columns(tallies: ShardTallies) -> dict:
     -------
     dict
         ``COLUMNS`` -> 1-d numpy.ndarray: ``tally`` the names (object), the rest float64; a
-        row per bin of each histogram (a 2-D one's second variable fastest), then a row per
-        scalar of ``SCALARS``.
+        row per bin of each histogram (a 2-D one's second variable fastest), a row per lag
+        of each of ``BOUNCE_LAG_SUMS``, then a row per scalar of ``SCALARS``.
     """
     names, lo, hi, lo2, hi2, value = [], [], [], [], [], []
     for name, (bins_attr, values_attr, _) in HISTOGRAMS.items():
@@ -439,6 +492,14 @@ def tallies_to_columns(tallies: ShardTallies) -> dict:
         lo2.append(np.tile(inner.lower, outer.n + 2))
         hi2.append(np.tile(inner.upper, outer.n + 2))
         value.append(np.asarray(getattr(tallies, values_attr), dtype=float).ravel())
+    lags = np.arange(BOUNCE_LAGS + 1, dtype=float)
+    for name, row in zip(BOUNCE_LAG_SUMS, tallies.bounce_lag_sums, strict=True):
+        names.append(np.full(lags.size, name, dtype=object))
+        lo.append(lags)
+        hi.append(lags + 1.0)
+        lo2.append(np.full(lags.size, np.nan))
+        hi2.append(np.full(lags.size, np.nan))
+        value.append(np.asarray(row, dtype=float))
     names.append(np.array(SCALARS, dtype=object))
     for column in (lo, hi, lo2, hi2):
         column.append(np.full(len(SCALARS), np.nan))
@@ -492,15 +553,16 @@ def tallies_from_columns(columns, settings, source: str = "shard") -> ShardTalli
     Raises
     ------
     ValueError
-        Naming ``source``, if a column is missing, a tally is not on the bins of ``settings``,
-        or a scalar is missing or repeated.
+        Naming ``source``, if a column is missing, a tally is not on the bins of ``settings``
+        (or a bounce-lag sum not on the lags 0 .. ``BOUNCE_LAGS``: a table of a layout
+        without them), or a scalar is missing or repeated.
     """
     missing = set(COLUMNS) - set(columns)
     if missing:
         raise ValueError(f"{source}: missing columns {sorted(missing)}")
     lo, lo2, value = (np.asarray(columns[key]) for key in ("lo", "lo2", "value"))
     # each row's tally as an index of the names: one pass over the strings, then integer masks
-    names = [*HISTOGRAMS, *HISTOGRAMS_2D, *SCALARS]
+    names = [*HISTOGRAMS, *HISTOGRAMS_2D, *BOUNCE_LAG_SUMS, *SCALARS]
     index = {name: k for k, name in enumerate(names)}
     codes = np.fromiter(
         (index.get(name, -1) for name in np.asarray(columns["tally"], dtype=object)),
@@ -533,6 +595,17 @@ def tallies_from_columns(columns, settings, source: str = "shard") -> ShardTalli
             )
         column = value[selected].reshape(shape)
         values[values_attr] = column.astype(np.int64) if integer else column
+    lags = np.arange(BOUNCE_LAGS + 1, dtype=float)
+    lag_sums = []
+    for name in BOUNCE_LAG_SUMS:
+        selected = rows[name]
+        if not _on_bins(lo[selected], lags):
+            raise ValueError(
+                f"{source}: tally '{name}' is not on the lags 0 .. {BOUNCE_LAGS} "
+                f"({len(selected)} rows, expected {lags.size}); re-run the shard"
+            )
+        lag_sums.append(value[selected])
+    values["bounce_lag_sums"] = np.array(lag_sums)
     for name in SCALARS:
         selected = rows[name]
         if len(selected) != 1:

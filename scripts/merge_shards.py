@@ -1,7 +1,8 @@
 """Rule merge_shards: the shards of one r merged into P(0, v), P(x) and <v^2>_x, P(x, v), the
 flight-time density, the return speeds, and the summary (<x>, Delta x, I, the flight-time
-moments) -> results/simulation/r{r}/{p0v,position,distribution,flight_time,return_speed,
-summary}.parquet.  Refused where the shards' early parts disagree with the rest beyond doubt
+moments), the bounce chain's autocorrelation and decay rate ->
+results/simulation/r{r}/{p0v,position,distribution,flight_time,return_speed,summary,
+bounce_chain}.parquet.  Refused where the shards' early parts disagree with the rest beyond doubt
 (``equilibration``), a warning where they disagree less; the check goes into the provenance."""
 
 import logging
@@ -13,6 +14,8 @@ from bouncing_ball.equilibration import (
     relaxation_record,
 )
 from bouncing_ball.histograms import (
+    bounce_autocorrelation,
+    bounce_chain_decay,
     distribution_histogram,
     flight_time_histogram,
     outgoing_speed_histogram,
@@ -71,6 +74,9 @@ with job_log(snakemake.log[0], exit_when_done=True):
             snakemake.output.flight_time: flight_time_histogram(shards),
             snakemake.output.return_speed: return_speed_table(shards),
             snakemake.output.summary: summary,
+            snakemake.output.bounce_chain: bounce_autocorrelation(shards).assign(
+                **bounce_chain_decay(shards)
+            ),
         },
         provenance,
     )

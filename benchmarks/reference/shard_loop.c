@@ -652,7 +652,8 @@ static inline int64_t tally_step(double a0, double a1, double a2, double a3, dou
  * speed_counts, position_time, position_v2_time, flight_time_counts and
  * return_law_speed_counts have nv + 2, nx + 2, nx + 2, nf + 2 and nw + 2 entries,
  * position_velocity_time (nx + 2) x (nu + 2) and return_speed_counts (nv + 2) x (nv + 2),
- * row-major (all zeroed by the caller); scalars has 13.  Returns 0, or -1 if the two small
+ * row-major, bounce_lag_sums 9 x lag_size (lags 0 .. lag_size - 1, tallies.BOUNCE_LAG_SUMS),
+ * row-major (all zeroed by the caller); scalars has len(tallies.SCALARS).  Returns 0, or -1 if the two small
  * bin-bound arrays cannot be allocated.
  */
 int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitution, double c,
@@ -664,7 +665,7 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
                              double *position_time, double *position_v2_time,
                              int64_t *flight_time_counts, double *position_velocity_time,
                              int64_t *return_speed_counts, int64_t *return_law_speed_counts,
-                             double *scalars)
+                             double *bounce_lag_sums, int64_t lag_size, double *scalars)
 {
     double v_log_lo = log(v_edges[0]);
     double v_per_ln = (double)nv / (log(v_edges[nv]) - v_log_lo);
@@ -715,6 +716,15 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
     double since_collision = 0.0; /* time since the last collision (equilibration included) */
     int collided_before = 0;
     int64_t last_out_bin = 0; /* speed bin of the last collision's outgoing speed */
+    /* the outgoing speeds of the last collisions and their logarithms (the bounce-lag sums) */
+    double ring_log[lag_size];
+    double ring_speed[lag_size];
+    for (int64_t j = 0; j < lag_size; j++) {
+        ring_log[j] = 0.0;
+        ring_speed[j] = 0.0;
+    }
+    int64_t ring_newest = lag_size - 1; /* where the latest collision is */
+    int64_t ring_history = 0;           /* collisions in the ring */
     /* the control variates (martingales of mean 0) */
     double noise_sum = 0.0;
     double noise_v_sum = 0.0;
@@ -879,7 +889,29 @@ int bouncing_ball_shard_loop(bitgen_t *rng, bitgen_t *rng_tally, double restitut
             double v_out = restitution * v_in; /* eq. (restitution) */
             double log_v_out = log(v_out); /* the bins of v_out, and of v_in = v_out / r, from it */
             int64_t out_bin = log_bin_index(v_out, log_v_out, v_log_lo, v_per_ln, nv, v_edges);
+            ring_newest = ring_newest == lag_size - 1 ? 0 : ring_newest + 1;
+            ring_log[ring_newest] = log_v_out;
+            ring_speed[ring_newest] = v_out;
+            if (ring_history < lag_size)
+                ring_history += 1;
             if (recording) {
+                /* _tally_bounce_lags: the pairs (u_{n-k}, u_n), k = 0 .. ring_history - 1 */
+                for (int64_t k = 0; k < ring_history; k++) {
+                    int64_t j = ring_newest - k;
+                    if (j < 0)
+                        j += lag_size;
+                    double lead_log = ring_log[j];
+                    double lead_u = ring_speed[j];
+                    bounce_lag_sums[0 * lag_size + k] += 1.0;
+                    bounce_lag_sums[1 * lag_size + k] += lead_log;
+                    bounce_lag_sums[2 * lag_size + k] += lead_u;
+                    bounce_lag_sums[3 * lag_size + k] += log_v_out;
+                    bounce_lag_sums[4 * lag_size + k] += v_out;
+                    bounce_lag_sums[5 * lag_size + k] += lead_log * log_v_out;
+                    bounce_lag_sums[6 * lag_size + k] += lead_log * v_out;
+                    bounce_lag_sums[7 * lag_size + k] += lead_u * log_v_out;
+                    bounce_lag_sums[8 * lag_size + k] += lead_u * v_out;
+                }
                 collisions += 1;
                 speed_counts[out_bin] += 1;
                 return_law_speed_counts[log_bin_index(v_out, log_v_out, w_log_lo, w_per_ln, nw,

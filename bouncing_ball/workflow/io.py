@@ -139,6 +139,28 @@ SIMULATED_RETURN_SPEED = TableKind(
     "merge_shards",
     ("u_lo", "u_hi", "v_lo", "v_hi", "probability", "probability_err"),
 )
+SIMULATED_BOUNCE_CHAIN = TableKind(
+    "simulated bounce chain",
+    "merge_shards",
+    (
+        "lag",
+        "autocorrelation",
+        "autocorrelation_err",
+        "principal_correlation",
+        "principal_correlation_err",
+        "decay_rate",
+        "decay_rate_err",
+        "relaxation_eigenvalue",
+        "relaxation_eigenvalue_err",
+        "first_lag",
+        "last_lag",
+    ),
+)
+RELAXATION = TableKind(
+    "relaxation of the bounce chain",
+    "relaxation",
+    ("r", "relaxation_eigenvalue", "correlation_bounces", "simulated"),
+)
 SOLVER_P0V = TableKind("solver P(0,v)", "solve", ("v", "p0v"))
 SOLVER_POSITION = TableKind("solver P(x)", "solve", ("x", "px", "v2_given_x"))
 SOLVER_DISTRIBUTION = TableKind("solver P(x,v)", "solve", ("x", "v", "pxv"))

@@ -1,7 +1,7 @@
 """The figures: pure functions from the workflow's tables to matplotlib Figures.
 
-One function per figure of the paper (Figs. 1-5) and two past it (Figs. 6,
-7); `save_figure` writes PDF and PNG atomically.  No pyplot state: each
+One function per figure of the paper (Figs. 1-5) and one per figure past it (Figs.
+6-12); `save_figure` writes PDF and PNG atomically.  No pyplot state: each
 function builds its own ``Figure``, so the scripts can run side by side.
 """
 
@@ -675,4 +675,77 @@ def return_speed_figure(panels, outgoing_speeds):
         axis.set_xlabel(r"return speed $v$")
         axis.set_ylabel(r"$v\, G_g(v, u)$")
         axis.legend(loc="lower left")
+    return figure
+
+
+@_styled
+def relaxation_figure(theory, panels):
+    """Fig. 12 (past the paper): the relaxation of the bounce chain.  Left: the correlation
+    length n_c = -1 / ln lambda_2 in bounces against 1 - r, from the solver's matrix of
+    eq. (inteq) (line; ``theory``: r, correlation_bounces, simulated), with the quasi-elastic
+    asymptote -1 / ln r, and the simulated decay rates (points, one-sigma errors).  Right:
+    the simulated principal correlation mu_k of (ln u_n, u_n) over lags k (filled) and the
+    autocorrelation rho_k of ln u_n (open) at each simulated r, against lambda_2^k (lines).
+
+    ``panels``: dicts with ``restitution``, ``eigenvalue`` (the theory's lambda_2) and
+    ``simulated`` (the merged bounce_chain table: lag, autocorrelation,
+    principal_correlation with their _err, correlation_bounces from decay_rate).
+    """
+    figure, axes = new_figure(1, 2, width=9.0, height=3.8)
+    left, right = axes[0, 0], axes[0, 1]
+    curve = theory[~theory.simulated].sort_values("r")
+    eps = 1.0 - curve.r.to_numpy()
+    left.plot(eps, curve.correlation_bounces, color="k", label=r"$-1/\ln\lambda_2$, solver")
+    left.plot(eps, -1.0 / np.log(curve.r), color="0.5", linestyle="--", label=r"$-1/\ln r$")
+    for index, panel in enumerate(panels):
+        table = panel["simulated"]
+        rate = float(table.decay_rate.iloc[0])
+        rate_err = float(table.decay_rate_err.iloc[0])
+        if not np.isfinite(rate):
+            continue
+        marker = SIMULATION_MARKERS[index % len(SIMULATION_MARKERS)]
+        style = {"color": f"C{index}", "marker": marker}
+        _error_bars(
+            left,
+            [1.0 - float(panel["restitution"])],
+            [1.0 / rate],
+            [rate_err / rate**2],
+            label=restitution_text(panel["restitution"]),
+            zorder=3,
+            **style,
+        )
+        lags = table.lag.to_numpy()
+        shown = table.principal_correlation > 0
+        _error_bars(
+            right,
+            lags[shown],
+            table.principal_correlation[shown],
+            table.principal_correlation_err[shown],
+            label=restitution_text(panel["restitution"]),
+            zorder=3,
+            **style,
+        )
+        positive = table.autocorrelation > 0
+        right.plot(
+            lags[positive],
+            table.autocorrelation[positive],
+            linestyle="none",
+            marker=marker,
+            markersize=3.0,
+            markerfacecolor="white",
+            markeredgecolor=f"C{index}",
+            alpha=0.6,
+        )
+        k = np.linspace(0.0, lags.max(), 50)
+        right.plot(k, panel["eigenvalue"] ** k, color=f"C{index}", linewidth=0.9)
+    left.set_xscale("log")
+    left.set_yscale("log")
+    left.set_xlabel(r"$1 - r$")
+    left.set_ylabel(r"$n_c$ (bounces)")
+    left.legend(loc="upper right")
+    right.set_yscale("log")
+    right.set_ylim(1e-2, 1.2)
+    right.set_xlabel(r"lag $k$ (bounces)")
+    right.set_ylabel(r"$\mu_k$ (filled), $\rho_k$ of $\ln u$ (open)")
+    right.legend(loc="lower left")
     return figure

@@ -20,14 +20,16 @@ from bouncing_ball.histograms import (
 )
 from bouncing_ball.settings import ShardSettings
 from bouncing_ball.tallies import (
-    CONTROL_VARIATE_SUMS as CONTROL_VARIATES,
-)
-from bouncing_ball.tallies import (
+    BOUNCE_LAG_SUMS,
+    BOUNCE_LAGS,
     EARLY_FRACTION,
     ShardTallies,
     merge_shards,
     tallies_from_frame,
     tallies_to_frame,
+)
+from bouncing_ball.tallies import (
+    CONTROL_VARIATE_SUMS as CONTROL_VARIATES,
 )
 from bouncing_ball.workflow.batches import (
     batch_from_frame,
@@ -42,6 +44,8 @@ SPEED_BINS = LogBins(1e-2, 1e1, 2)
 POSITION_BINS = LogBins(1e-1, 1e2, 1)
 VELOCITY_BINS = LinearBins(-1.0, 2.0, 1.0)
 FLIGHT_TIME_BINS = LogBins(1e-2, 1e1, 1)
+LAG_SHAPE = (len(BOUNCE_LAG_SUMS), BOUNCE_LAGS + 1)
+LAG_SIZE = LAG_SHAPE[0] * LAG_SHAPE[1]
 BIN_SET = SimpleNamespace(
     speed_bins=SPEED_BINS,
     position_bins=POSITION_BINS,
@@ -74,6 +78,7 @@ def shard_tallies(draw):
         flight_time_counts=array(counts, nf, np.int64),
         position_velocity_time=array(times, nx * nu, shape=(nx, nu)),
         return_speed_counts=array(counts, nv * nv, np.int64, shape=(nv, nv)),
+        bounce_lag_sums=array(noise, len(BOUNCE_LAG_SUMS) * (BOUNCE_LAGS + 1), shape=LAG_SHAPE),
         time=draw(st.floats(1.0, 1e6)),
         collisions=draw(counts),
         steps=draw(counts),
@@ -126,6 +131,21 @@ def test_merge_is_an_order_independent_sum(shards, random):
 @given(shard_tallies())
 def test_frame_round_trip(shard):
     _same_tallies(shard, tallies_from_frame(tallies_to_frame(shard), BIN_SET))
+
+
+def test_a_table_without_the_bounce_lag_sums_is_refused():
+    # a shard table of a layout without them: refused by name, as a tally off its bins is
+    frame = tallies_to_frame(_shard())
+    old_layout = frame[~frame.tally.isin(BOUNCE_LAG_SUMS)]
+    with pytest.raises(ValueError, match="'lag_pairs' is not on the lags 0 .. 16.*re-run"):
+        tallies_from_frame(old_layout, BIN_SET)
+
+
+def test_the_bounce_lag_sums_merge_lag_by_lag():
+    one = _shard(bounce_lag_sums=np.arange(LAG_SIZE, dtype=float).reshape(LAG_SHAPE))
+    merged = merge_shards([one, one])
+    assert np.array_equal(merged.bounce_lag_sums, 2.0 * one.bounce_lag_sums)
+    _same_tallies(merged, tallies_from_frame(tallies_to_frame(merged), BIN_SET))
 
 
 def _same_tallies(ours, theirs):

@@ -161,6 +161,7 @@ SIMULATION_TABLES = (
     "flight_time",
     "return_speed",
     "summary",
+    "bounce_chain",
 )
 
 
@@ -225,7 +226,7 @@ def figure_labels(figure):
     return list(restitution_grid(config["figures"][figure], f"figures.{figure}"))
 
 
-FIGURE_NUMBERS = range(1, 12)  # Figs. 1-5 the paper's, 6-11 past it
+FIGURE_NUMBERS = range(1, 13)  # Figs. 1-5 the paper's, 6-12 past it
 
 
 def figure_targets():

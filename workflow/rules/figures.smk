@@ -327,3 +327,32 @@ rule fig11:
         code=code(stages.PLOTTING, "figures/fig11.py"),
     script:
         "../../scripts/figures/fig11.py"
+
+
+# Fig. 12: the relaxation of the bounce chain, the solver's lambda_2 over r against the
+# simulated decay rates and correlations at every simulated r.
+rule fig12:
+    input:
+        relaxation="results/theory/relaxation.parquet",
+        simulation=expand("results/simulation/r{r}/bounce_chain.parquet", r=RESTITUTION),
+    output:
+        "results/figures/fig12.pdf",
+        report(
+            "results/figures/fig12.png",
+            caption="../report/fig12.rst",
+            category="Figures",
+        ),
+    log:
+        "logs/figures/fig12.log",
+    localrule: True
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=1000,
+        cpus_per_task=1,
+    params:
+        dpi=config["figures"]["png_dpi"],
+        code=code(stages.PLOTTING, "figures/fig12.py"),
+    script:
+        "../../scripts/figures/fig12.py"

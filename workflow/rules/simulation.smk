@@ -37,6 +37,7 @@ rule merge_shards:
         flight_time="results/simulation/r{r}/flight_time.parquet",
         return_speed="results/simulation/r{r}/return_speed.parquet",
         summary="results/simulation/r{r}/summary.parquet",
+        bounce_chain="results/simulation/r{r}/bounce_chain.parquet",
     log:
         "logs/simulation/r{r}/merge.log",
     # a second or two, and most figures and tables wait for it: before them

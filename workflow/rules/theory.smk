@@ -46,3 +46,29 @@ rule fit:
         code=code(stages.FITS, "fit.py"),
     script:
         "../../scripts/fit.py"
+
+
+# The relaxation of the bounce chain, lambda_2 and n_c = -1 / ln lambda_2, from the solver's
+# matrix over r = 1 - eps on the log grid figures.fig12_inelasticity and at every simulated r
+# (Fig. 12).
+rule relaxation:
+    output:
+        "results/theory/relaxation.parquet",
+    log:
+        "logs/theory/relaxation.log",
+    localrule: True
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=10,
+        mem_mb=1000,
+        cpus_per_task=1,
+    params:
+        inelasticity=config["figures"]["fig12_inelasticity"],
+        simulated=[exact_string(value) for value in RESTITUTION.values()],
+        code=code(
+            ("relaxation", "solver", "asymptotics", "restitution", "bins"),
+            "relaxation.py",
+        ),
+    script:
+        "../../scripts/relaxation.py"

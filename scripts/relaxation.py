@@ -1,0 +1,37 @@
+"""Rule relaxation: the relaxation eigenvalue lambda of the bounce chain and its correlation
+length n_c = -1 / ln lambda (``relaxation.bounce_chain_relaxation``) at r = 1 - eps on the log
+grid of eps figures.fig12_inelasticity, and at each simulated r -> results/theory/relaxation.parquet
+(r, relaxation_eigenvalue, correlation_bounces, isolated, simulated)."""
+
+import logging
+
+import pandas as pd
+
+from bouncing_ball.bins import log_grid
+from bouncing_ball.relaxation import bounce_chain_relaxation
+from bouncing_ball.workflow.io import write_table
+from bouncing_ball.workflow.jobs import job_log
+
+with job_log(snakemake.log[0], exit_when_done=True):
+    grid = [(1.0 - float(eps), False) for eps in log_grid(snakemake.params.inelasticity)]
+    rows = []
+    for r, simulated in [*grid, *((value, True) for value in snakemake.params.simulated)]:
+        relaxation = bounce_chain_relaxation(r)
+        rows.append(
+            {
+                "r": relaxation.restitution,
+                "relaxation_eigenvalue": relaxation.eigenvalue,
+                "correlation_bounces": relaxation.correlation_bounces,
+                "isolated": relaxation.isolated,
+                "simulated": simulated,
+            }
+        )
+    table = pd.DataFrame(rows)
+    provenance = {
+        "rule": "relaxation",
+        "inelasticity_grid": snakemake.params.inelasticity,
+        "simulated": list(snakemake.params.simulated),
+        "code": snakemake.params.code,
+    }
+    write_table(table, snakemake.output[0], provenance)
+    logging.info("lambda_2 at %d values of r in [%g, %g]", len(table), table.r.min(), table.r.max())
