@@ -55,6 +55,7 @@ __all__ = [
     "correlation_bounces",
     "relaxation_time",
     "quasi_elastic_table",
+    "scaled_speed_curves",
 ]
 
 #: E[V^k | u] = sum_j RETURN_SPEED_MOMENTS[k][j] u^j up to O(e^(-u/2)): the moments of the return
@@ -429,6 +430,69 @@ def quasi_elastic_table(restitutions=TABLE_RESTITUTIONS):
                 }
             )
     return pd.DataFrame.from_records(records)
+
+
+def scaled_speed_curves(restitutions, scaled_speeds, quadrature_step=None):
+    """The solver's P(0, v) in the quasi-elastic scaling, beside its limit and first correction.
+
+    For each r, epsilon^-3 P(0, w / epsilon) (``Equilibrium(r).p0v``, eq. (inteq)) at the
+    scaled speeds w = epsilon v, the limit (27/32) e^(-3w/2) (``scaled_speed_density``), and
+    the measured first coefficient (scaled / limit - 1) / epsilon beside the predicted
+    p1(w) = 5/2 - 3w/2 (``speed_density_first_correction``): the curves collapse onto the limit
+    as r -> 1, and their departure from it onto p1.
+
+    Parameters
+    ----------
+    restitutions : sequence of float or str
+        Each r in the solver's range (``restitution.SOLVER_RESTITUTION_RANGE``).
+    scaled_speeds : array_like
+        w = (1 - r) v, positive and finite.
+    quadrature_step : float, optional
+        The solver's step (``Equilibrium``'s default if None).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns r, epsilon, w, scaled_p0v, limit, c1_measured, c1_predicted.
+
+    Raises
+    ------
+    ValueError
+        If an r is outside the solver's range, or a w is not positive and finite.
+
+    Examples
+    --------
+    >>> from bouncing_ball.quasi_elastic import scaled_speed_curves
+    >>> curves = scaled_speed_curves([0.999], [1.0])  # doctest: +SKIP
+    """
+    import pandas as pd
+
+    from .equilibrium import Equilibrium
+
+    w = np.asarray(scaled_speeds, dtype=float)
+    if w.ndim != 1 or w.size == 0 or not np.all(np.isfinite(w) & (w > 0.0)):
+        raise ValueError(f"scaled_speeds: positive and finite w = (1 - r) v, got {scaled_speeds!r}")
+    options = {} if quadrature_step is None else {"quadrature_step": quadrature_step}
+    frames = []
+    for r in restitutions:
+        equilibrium = Equilibrium(r, **options)
+        epsilon = quasi_elastic_epsilon(equilibrium.r)
+        scaled = np.asarray(equilibrium.p0v(w / epsilon)) / epsilon**3
+        limit = scaled_speed_density(w)
+        frames.append(
+            pd.DataFrame(
+                {
+                    "r": equilibrium.r,
+                    "epsilon": epsilon,
+                    "w": w,
+                    "scaled_p0v": scaled,
+                    "limit": limit,
+                    "c1_measured": (scaled / limit - 1.0) / epsilon,
+                    "c1_predicted": speed_density_first_correction(w),
+                }
+            )
+        )
+    return pd.concat(frames, ignore_index=True)
 
 
 if __name__ == "__main__":

@@ -11,7 +11,7 @@ REPOSITORY = Path(__file__).resolve().parents[1]
 # the small config shared by the workflow tests, CI and the SLURM stage
 TEST_CONFIG = REPOSITORY / ".test" / "config" / "config.yaml"
 SMALL = yaml.safe_load(TEST_CONFIG.read_text())
-FIGURES = [f"results/figures/fig{n}.{ext}" for n in range(1, 13) for ext in ("pdf", "png")]
+FIGURES = [f"results/figures/fig{n}.{ext}" for n in range(1, 14) for ext in ("pdf", "png")]
 
 
 def copy_repository(tmp_path, config):

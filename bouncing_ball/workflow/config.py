@@ -26,6 +26,7 @@ from ..restitution import (
     SOLVER_RESTITUTION_RANGE,
     check_solver_restitution,
     exact_string,
+    in_range,
     parse_restitution,
     restitution_grid,
     restitution_label,
@@ -191,6 +192,13 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
         )
     for index, value in enumerate(config["restitution"]):
         check_solver_restitution(value, f"restitution[{index}]")  # every r of the run is solved
+    for index, value in enumerate(config["figures"]["fig13"]):  # P(0, v) alone
+        where = f"figures.fig13[{index}]"
+        if not in_range(parse_restitution(value, where), SOLVER_RESTITUTION_RANGE):
+            raise ValueError(
+                f"{where}: r = {value!r} is outside the solver's range {low} <= r <= {high} "
+                "for P(0, v) (solver.restitution_grid)"
+            )
     known = {**figure_restitutions(config, grid), **grid}
     for side in ("small_speed_window", "large_speed_window"):
         window = config["fits"][side]

@@ -161,6 +161,11 @@ RELAXATION = TableKind(
     "relaxation",
     ("r", "relaxation_eigenvalue", "correlation_bounces", "simulated"),
 )
+QUASI_ELASTIC_CURVES = TableKind(
+    "P(0,v) in the quasi-elastic scaling",
+    "quasi_elastic",
+    ("r", "epsilon", "w", "scaled_p0v", "limit", "c1_measured", "c1_predicted"),
+)
 SOLVER_P0V = TableKind("solver P(0,v)", "solve", ("v", "p0v"))
 SOLVER_POSITION = TableKind("solver P(x)", "solve", ("x", "px", "v2_given_x"))
 SOLVER_DISTRIBUTION = TableKind("solver P(x,v)", "solve", ("x", "v", "pxv"))

@@ -749,3 +749,34 @@ def relaxation_figure(theory, panels):
     right.set_ylabel(r"$\mu_k$ (filled), $\rho_k$ of $\ln u$ (open)")
     right.legend(loc="lower left")
     return figure
+
+
+def quasi_elastic_figure(curves):
+    """Fig. 13 (past the paper): the collapse of P(0, v) as r -> 1.  Left: the solver's
+    (1 - r)^-3 P(0, w / (1 - r)) against w = (1 - r) v at each r of ``curves`` (the table of
+    ``quasi_elastic.scaled_speed_curves``: r, w, scaled_p0v, limit, c1_measured, c1_predicted),
+    with the limit (27/32) e^(-3w/2).  Right: (scaled / limit - 1) / (1 - r) against the
+    predicted first correction p1(w) = 5/2 - 3w/2.
+    """
+    figure, axes = new_figure(1, 2, width=9.0, height=3.8)
+    left, right = axes[0, 0], axes[0, 1]
+    for index, (r, curve) in enumerate(curves.groupby("r", sort=True)):
+        style = {"color": f"C{index}", "linewidth": 1.2}
+        label = f"$r = {r:g}$"
+        left.plot(curve.w, curve.scaled_p0v, label=label, **style)
+        right.plot(curve.w, curve.c1_measured, label=label, **style)
+    limit = curves.drop_duplicates("w").sort_values("w")
+    left.plot(limit.w, limit.limit, color="k", linestyle="--", linewidth=1.0, label="limit")
+    right.plot(
+        limit.w, limit.c1_predicted, color="k", linestyle="--", linewidth=1.0, label=r"$p_1(w)$"
+    )
+    left.set_xscale("log")
+    left.set_yscale("log")
+    left.set_xlabel(r"$w = (1 - r)\,v$")
+    left.set_ylabel(r"$(1 - r)^{-3} P(0, w/(1 - r))$")
+    left.legend(loc="lower left")
+    right.set_xscale("log")
+    right.set_xlabel(r"$w = (1 - r)\,v$")
+    right.set_ylabel(r"(scaled / limit $- 1$) / $(1 - r)$")
+    right.legend(loc="lower left")
+    return figure

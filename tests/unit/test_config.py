@@ -412,3 +412,11 @@ def test_the_schema_and_the_readme_bound_flight_times_by_the_library_range():
     readme = (REPOSITORY / "config" / "README.md").read_text()
     stated = f"{low:.1e} <= min < max <= {high:.1e}".replace("e+0", "e+")  # 1.0e+4
     assert stated in readme
+
+
+@pytest.mark.parametrize("value", [0.99999, 0.01, "one"])
+def test_a_fig13_r_outside_the_solver_range_is_refused(value):
+    config = _default_config()
+    config["figures"]["fig13"] = [0.99, value]
+    with pytest.raises(ValueError, match=r"figures.fig13\[1\]"):
+        check_config(config)

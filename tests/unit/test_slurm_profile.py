@@ -62,8 +62,9 @@ def test_every_submitted_rule_sets_its_resources_and_local_rules_exist():
         "solve_grid",
         "moments_table",
         "validation_table",
-        *(f"fig{n}" for n in range(1, 13)),
+        *(f"fig{n}" for n in range(1, 14)),
         "relaxation",
+        "quasi_elastic",
     }
     assert quick <= local, f"not local: {sorted(quick - local)}"
     submitted = set(blocks) - local

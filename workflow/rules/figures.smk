@@ -356,3 +356,30 @@ rule fig12:
         code=code(stages.PLOTTING, "figures/fig12.py"),
     script:
         "../../scripts/figures/fig12.py"
+
+
+# Fig. 13: the collapse of the solver's P(0,v) onto its quasi-elastic limit as r -> 1.
+rule fig13:
+    input:
+        "results/theory/quasi_elastic.parquet",
+    output:
+        "results/figures/fig13.pdf",
+        report(
+            "results/figures/fig13.png",
+            caption="../report/fig13.rst",
+            category="Figures",
+        ),
+    log:
+        "logs/figures/fig13.log",
+    localrule: True
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=5,
+        mem_mb=1000,
+        cpus_per_task=1,
+    params:
+        dpi=config["figures"]["png_dpi"],
+        code=code(stages.PLOTTING, "figures/fig13.py"),
+    script:
+        "../../scripts/figures/fig13.py"

@@ -72,3 +72,32 @@ rule relaxation:
         ),
     script:
         "../../scripts/relaxation.py"
+
+
+# The quasi-elastic limit r -> 1: the solver's P(0,v) in the scaling (1 - r)^-3 P(0, w / (1 - r))
+# at every r of figures.fig13 (Fig. 13), and the scaled I, <x>, Delta x against their limits.
+rule quasi_elastic:
+    output:
+        curves="results/theory/quasi_elastic.parquet",
+        csv=report(
+            "results/tables/quasi_elastic.csv",
+            caption="../report/quasi_elastic.rst",
+            category="Tables",
+        ),
+        md="results/tables/quasi_elastic.md",
+    log:
+        "logs/theory/quasi_elastic.log",
+    localrule: True
+    conda:
+        "../envs/bouncing-ball.yaml"
+    resources:
+        runtime=10,
+        mem_mb=1000,
+        cpus_per_task=1,
+    params:
+        restitution=config["figures"]["fig13"],
+        scaled_speeds=config["figures"]["fig13_scaled_speeds"],
+        quadrature_step=config["solver"]["quadrature_step"],
+        code=code((*stages.SOLVER, "quasi_elastic"), "quasi_elastic.py"),
+    script:
+        "../../scripts/quasi_elastic.py"
