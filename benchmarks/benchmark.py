@@ -22,7 +22,8 @@ Measured here (about 3 minutes; ``--scaling`` adds about 2.5 more, outside that 
     numba's speed over C's at r = 1/2, with the tallies and stepping only
     (target: at least 90%);
   * statistical efficiency per observable (``efficiency``; about 2 minutes, alone with
-    ``--efficiency-only``): (relative standard error)^2 x CPU seconds at r = 1/4, 1/2, 3/4 of
+    ``--efficiency-only``): (relative standard error)^2 x CPU seconds at r = 1/4, 1/2, 3/4, 0.95
+    and 0.99 (``efficiency.RESTITUTIONS``) of
     I, <x>, Delta x, <T>, <T^2> and the median bin of P(0, v), P(x), <v^2>_x, P(x, v), for
     the paper's estimator (c = 5, plain tallies) and the project's default (the default c,
     every control variate), their gain and the uncertainty of each;

@@ -21,12 +21,15 @@ import time
 
 import numpy as np
 
-RESTITUTIONS = (0.25, 0.5, 0.75)
+RESTITUTIONS = (0.25, 0.5, 0.75, 0.95, 0.99)
 ESTIMATORS = ("paper", "default")
 # shards per (r, estimator): as many as the default run's, so the cross-fitted slopes are as
-# noisy as there; the simulated time per shard gives about 0.1-0.4 CPU s each at c = 3
 SHARDS = 64
-SHARD_TIMES = {0.25: 4.0e4, 0.5: 1.0e5, 0.75: 4.0e5}
+# noisy as there; the simulated time per shard gives a fraction of a CPU second each at c = 3.
+# Near r = 1 (0.95, 0.99) a shard spans hundreds of relaxation times (``Equilibrium(r).
+# relaxation_time``), and every shard discards the default equilibration time at its r
+# (``equilibration.default_equilibration_time``), counted in its CPU seconds.
+SHARD_TIMES = {0.25: 4.0e4, 0.5: 1.0e5, 0.75: 4.0e5, 0.95: 1.0e6, 0.99: 1.0e7}
 # the bins over which the median is taken
 SPEEDS = (0.01, 5.0)
 POSITIONS = (1.0e-3, 50.0)
@@ -163,9 +166,19 @@ def efficiency_rows(measurements):
 def _timed_shard(arguments):
     from .benchmark import _shard
 
+    from bouncing_ball.equilibration import default_equilibration_time
+
     r, recorded_time, shard, criterion_c = arguments
+    equilibration_time = default_equilibration_time(r)
     started = time.process_time()
-    tallies = _shard(r, recorded_time, shard=shard, seed=7, criterion_c=criterion_c)
+    tallies = _shard(
+        r,
+        recorded_time,
+        shard=shard,
+        seed=7,
+        criterion_c=criterion_c,
+        equilibration_time=equilibration_time,
+    )
     return tallies, time.process_time() - started
 
 
