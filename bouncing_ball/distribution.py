@@ -412,6 +412,8 @@ class _OutgoingDensity:
     nodes: np.ndarray  # u grid of the complex Nystrom sum
     log_weights: np.ndarray  # ln(weight u P(0, u))
     remainder: float  # closed-form part of the lower tail, times P(0, u_0)
+    # P(0, v) on the ray arg v = RAY_ANGLE where r > RAY_RESTITUTION (``_RayDensity``), else None
+    ray: object = None
     # cells of the interpolant of P(0, v) e^(q v) in the wedge (``_wedge_cell``), built on use
     cells: dict = field(default_factory=dict, compare=False, repr=False)
 
@@ -767,8 +769,9 @@ def _outgoing_density(solution, panel_width=1.0, panel_order=20) -> _OutgoingDen
         / -np.expm1(-alpha * step)
         * main_density[0]
     )
+    ray = _ray_density(solution) if r > RAY_RESTITUTION else None
     return _OutgoingDensity(
-        r, beta, q, log_amplitude, u0, largest, edges, coefficients, nodes, log_weights, remainder
+        r, beta, q, log_amplitude, u0, largest, edges, coefficients, nodes, log_weights, remainder, ray
     )
 
 
@@ -890,6 +893,9 @@ class _RayDensity:
     eigenvalue: complex
     panel_edges: np.ndarray  # in s, of the Chebyshev interpolant of ln(P e^(q v) v^beta)
     coefficients: np.ndarray
+    #: relative error estimate of P(0, v) from ``log_density``: the interpolant against the
+    #: Nystrom formula between its nodes, and |eigenvalue - 1| of the discrete operator
+    error: float = np.nan
 
     def log_density(self, rho):
         """ln P(0, rho ray) for 0 < rho <= largest (complex): the interpolant from the lowest
@@ -985,7 +991,17 @@ def _ray_density(solution, panel_width=1.0, panel_order=20) -> _RayDensity:
     coefficients = np.array(
         [np.polynomial.chebyshev.chebfit(cheb, row, panel_order - 1) for row in logs]
     )
-    return _RayDensity(r, beta, q, ray, log_amplitude, nodes, log_columns, largest, eigenvalue, edges, coefficients)
+    density = _RayDensity(
+        r, beta, q, ray, log_amplitude, nodes, log_columns, largest, eigenvalue, edges, coefficients
+    )
+    probes = speed_of_coordinate(0.5 * (edges[:-1] + edges[1:]) + 0.37 * np.diff(edges))
+    deviation = np.abs(np.exp(density.log_density(probes) - np.log(density.nystrom(probes))
+                              + q * probes * ray + beta * np.log(probes * ray)) - 1.0)
+    error = float(max(np.max(deviation), abs(eigenvalue - 1.0)))
+    return _RayDensity(
+        r, beta, q, ray, log_amplitude, nodes, log_columns, largest, eigenvalue, edges, coefficients,
+        error,
+    )
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1249,6 +1265,8 @@ def _log_contour_part(density, force, with_noise=True):
     """ln |A(F)|, its sign, and ln of an estimate of its rounding error (NaN without
     ``with_noise``): the real segment plus 2 Re of the complex path.  Raises ValueError where
     P(0, v) would be needed beyond the range in which the solution's is accurate."""
+    if density.ray is not None:
+        return _log_ray_contour_part(density.ray, force, with_noise)
     q = density.q
     v1 = _split_point(q, force)
     cut = min(v1, density.largest)
@@ -1293,6 +1311,85 @@ def _log_contour_part(density, force, with_noise=True):
         return top + np.log(abs(total)), float(np.sign(total)), np.nan
     noise = 2.0 * np.sum(np.exp(np.log(magnitude) + log_rest.real - top)) * EPSILON
     noise += np.sum(np.exp(all_terms - top)) * ROUNDING * EPSILON
+    return top + np.log(abs(total)), float(np.sign(total)), top + np.log(noise)
+
+
+#: Panels of the ray contour of A(F): Gauss-Legendre in ln rho, RAY_PANEL_NODES nodes each, no
+#: wider than 1 in ln rho and across each of which the integrand turns through at most
+#: RAY_PANEL_TURN radians of phase plus e-folds of modulus.
+RAY_PANEL_NODES = 20
+RAY_PANEL_TURN = 10.0
+_RAY_PANEL_X, _RAY_PANEL_W = np.polynomial.legendre.leggauss(RAY_PANEL_NODES)
+
+
+def _ray_log_integrand(ray_density, force, rho):
+    """ln of v h(v) (-omega) F^(-1/6) Ai(omega zeta(v)) at v = rho ray (complex)."""
+    v = rho * ray_density.ray
+    return np.log(v) + 0.5 * v + ray_density.log_density(rho) + _log_psi_omega(force, v)
+
+
+def _ray_contour_nodes(ray_density, force):
+    """ln rho and weights (d ln rho) of the panels of the ray contour of A(F), up to where its
+    integrand has fallen by NEGLIGIBLE_EFOLDS + 10 below its largest modulus."""
+    lo = np.log(SMALLEST_SPEED)
+    coarse = np.arange(lo, np.log(ray_density.largest), 0.05)
+    level = _ray_log_integrand(ray_density, force, np.exp(coarse)).real + coarse
+    above = np.nonzero(level > np.max(level) - NEGLIGIBLE_EFOLDS - 10.0)[0]
+    if above[-1] == coarse.size - 1:
+        raise ValueError(
+            f"w({force}) needs P(0, v) on the ray beyond |v| = {ray_density.largest:.4g}"
+        )
+    top = np.exp(coarse[above[-1] + 1])
+    # fine samples: the phase turns by at most ~1.5 radians between them
+    small = np.arange(lo, 0.0, 0.05)
+    rho = [1.0]
+    while rho[-1] < top:
+        rho.append(rho[-1] + 1.5 / (1.0 + np.sqrt(force * rho[-1]) + 0.5 * force ** (1.0 / 3.0)))
+    t = np.concatenate([small, np.log(np.asarray(rho))]) if top > 1.0 else small
+    t = t[t <= np.log(top)]
+    t = np.append(t, np.log(top))
+    values = _ray_log_integrand(ray_density, force, np.exp(t)) + t
+    cost = np.concatenate(
+        [[0.0], np.cumsum(np.abs(np.diff(np.unwrap(values.imag))) + np.abs(np.diff(values.real)))]
+    )
+    edges = [t[0]]
+    mark = 0.0
+    for k in range(1, t.size):
+        if cost[k] - mark > RAY_PANEL_TURN or t[k] - edges[-1] > 1.0:
+            edges.append(t[k - 1] if t[k - 1] > edges[-1] else t[k])
+            mark = cost[k - 1] if edges[-1] == t[k - 1] else cost[k]
+    if edges[-1] < t[-1]:
+        edges.append(t[-1])
+    edges = np.asarray(edges)
+    half = 0.5 * np.diff(edges)[:, None]
+    x = (0.5 * (edges[:-1, None] + edges[1:, None]) + half * _RAY_PANEL_X[None, :]).ravel()
+    return x, (half * _RAY_PANEL_W[None, :]).ravel()
+
+
+def _log_ray_contour_part(ray_density, force, with_noise=True):
+    """ln |A(F)|, its sign and ln of an estimate of its error (NaN without ``with_noise``):
+    A = 2 Re int_0^inf along the ray v = rho e^(i RAY_ANGLE) of v h(v) (-omega) F^(-1/6)
+    Ai(omega zeta), with P(0, v) on the ray from ``_RayDensity`` (the two halves of psi_F(-v)
+    = 2 Re[-omega F^(-1/6) Ai(omega zeta)] turned onto the ray and its mirror image, where
+    the Airy factor decays; the integrand is analytic in between).  The part below
+    SMALLEST_SPEED is C psi(0) (eps ray)^(2 - beta) / (2 - beta)."""
+    t, wt = _ray_contour_nodes(ray_density, force)
+    rho = np.exp(t)
+    beta = ray_density.beta
+    log_terms = np.log(wt * rho * ray_density.ray) + _ray_log_integrand(ray_density, force, rho)
+    small = (
+        ray_density.log_amplitude
+        + (2.0 - beta) * (np.log(SMALLEST_SPEED) + 1j * RAY_ANGLE)
+        - np.log(2.0 - beta)
+        + _log_psi_omega(force, np.array([0.0 + 0.0j]))[0]
+    )
+    log_terms = np.append(log_terms, small)
+    top = np.max(log_terms.real)
+    total = 2.0 * np.sum(np.exp(log_terms - top)).real
+    if not with_noise:
+        return top + np.log(abs(total)), float(np.sign(total)), np.nan
+    size = 2.0 * np.sum(np.exp(log_terms.real - top))
+    noise = size * (ROUNDING * EPSILON + ray_density.error)
     return top + np.log(abs(total)), float(np.sign(total)), top + np.log(noise)
 
 
