@@ -293,10 +293,10 @@ def check_restitution(restitution) -> float:
     >>> from bouncing_ball.distribution import check_restitution
     >>> print(check_restitution("1/3"), check_restitution(0.6))
     0.3333333333333333 0.6
-    >>> check_restitution(0.99)
+    >>> check_restitution(0.999)
     Traceback (most recent call last):
     ...
-    ValueError: restitution 0.99: w(F), P(x) and P(x, v) are computed to 1e-8 only for ...
+    ValueError: restitution 0.999: w(F), P(x) and P(x, v) are computed to 1e-8 only for ...
     """
     exact = parse_restitution(restitution, "restitution")
     if not in_range(exact, DISTRIBUTION_RESTITUTION_RANGE):
@@ -1330,37 +1330,32 @@ def _ray_log_integrand(ray_density, force, rho):
 
 def _ray_contour_nodes(ray_density, force):
     """ln rho and weights (d ln rho) of the panels of the ray contour of A(F), up to where its
-    integrand has fallen by NEGLIGIBLE_EFOLDS + 10 below its largest modulus."""
-    lo = np.log(SMALLEST_SPEED)
-    coarse = np.arange(lo, np.log(ray_density.largest), 0.05)
-    level = _ray_log_integrand(ray_density, force, np.exp(coarse)).real + coarse
+    integrand has fallen by NEGLIGIBLE_EFOLDS + 10 below its largest modulus.
+
+    The panels follow the integrand's log-derivative in v, (2 - beta) / v + 1/2 - q +
+    omega F^(1/3) (z + 1/2)^(1/2) with z = omega zeta (Ai'(z) / Ai(z) ~ -(z + 1/2)^(1/2): the
+    leading term at large |z|, -0.707 against -0.729 at z = 0), integrated on a grid in ln rho:
+    its imaginary and real parts along the ray measure the phase turned and the e-folds."""
+    ray = ray_density.ray
+    t = np.arange(np.log(SMALLEST_SPEED), np.log(ray_density.largest), 0.02)
+    rho = np.exp(t)
+    v = rho * ray
+    z = OMEGA * (0.25 * force ** (-2.0 / 3.0) - force ** (1.0 / 3.0) * v)
+    slope = ray * rho * (
+        (2.0 - ray_density.beta) / v + 0.5 - ray_density.q + OMEGA * np.cbrt(force) * np.sqrt(z + 0.5)
+    )
+    step = 0.5 * (slope[1:] + slope[:-1]) * np.diff(t)
+    level = np.concatenate([[0.0], np.cumsum(step.real)])
     above = np.nonzero(level > np.max(level) - NEGLIGIBLE_EFOLDS - 10.0)[0]
-    if above[-1] == coarse.size - 1:
+    if above[-1] == t.size - 1:
         raise ValueError(
             f"w({force}) needs P(0, v) on the ray beyond |v| = {ray_density.largest:.4g}"
         )
-    top = np.exp(coarse[above[-1] + 1])
-    # fine samples: the phase turns by at most ~1.5 radians between them
-    small = np.arange(lo, 0.0, 0.05)
-    rho = [1.0]
-    while rho[-1] < top:
-        rho.append(rho[-1] + 1.5 / (1.0 + np.sqrt(force * rho[-1]) + 0.5 * force ** (1.0 / 3.0)))
-    t = np.concatenate([small, np.log(np.asarray(rho))]) if top > 1.0 else small
-    t = t[t <= np.log(top)]
-    t = np.append(t, np.log(top))
-    values = _ray_log_integrand(ray_density, force, np.exp(t)) + t
-    cost = np.concatenate(
-        [[0.0], np.cumsum(np.abs(np.diff(np.unwrap(values.imag))) + np.abs(np.diff(values.real)))]
-    )
-    edges = [t[0]]
-    mark = 0.0
-    for k in range(1, t.size):
-        if cost[k] - mark > RAY_PANEL_TURN or t[k] - edges[-1] > 1.0:
-            edges.append(t[k - 1] if t[k - 1] > edges[-1] else t[k])
-            mark = cost[k - 1] if edges[-1] == t[k - 1] else cost[k]
-    if edges[-1] < t[-1]:
-        edges.append(t[-1])
-    edges = np.asarray(edges)
+    end = above[-1] + 1
+    cost = np.concatenate([[0.0], np.cumsum(np.abs(step.real) + np.abs(step.imag))])[: end + 1]
+    t = t[: end + 1]
+    by_cost = np.interp(np.arange(0.0, cost[-1], RAY_PANEL_TURN), cost, t)
+    edges = np.unique(np.concatenate([by_cost, np.arange(t[0], t[-1], 1.0), [t[-1]]]))
     half = 0.5 * np.diff(edges)[:, None]
     x = (0.5 * (edges[:-1, None] + edges[1:, None]) + half * _RAY_PANEL_X[None, :]).ravel()
     return x, (half * _RAY_PANEL_W[None, :]).ravel()
@@ -1891,13 +1886,12 @@ SMALLEST_POSITION = 1e-300
 LARGEST_POSITION = 1e12
 #: Beyond this speed abs(v), P(x, v) is 0 to every double (``Equilibrium.pxv``): on the floor P(0, v) ~
 #: e^(-q v) and P(0, -v) = r^2 P(0, r v) fall below e^-1400 at every r of
-#: DISTRIBUTION_RESTITUTION_RANGE (r q = 0.148 at r = 0.9), and above it P(x, v) is a Gaussian
-#: in v of variance <v^2>_x < 4e4 wherever P(x) is a double (x below ~1e7), e^-1000 down at
-#: abs(v) = 1e4.
-LARGEST_VELOCITY = 1e4
+#: DISTRIBUTION_RESTITUTION_RANGE (r q = 7.46e-3 at r = 0.995), and above it P(x, v) is a
+#: Gaussian in v of variance <v^2>_x < 1e7 wherever P(x) is a double, e^-2000 down there.
+LARGEST_VELOCITY = 2e5
 #: The smallest F of the config's ``solver.forces``: above ``Equilibrium.smallest_force`` (below
 #: which w(F) ~ F^gamma e^(-S/F), S < 0, exceeds the largest double) at every r of
-#: DISTRIBUTION_RESTITUTION_RANGE (1.03e-4 at r = 0.9, the largest).
+#: DISTRIBUTION_RESTITUTION_RANGE (-S / F < 1 / (12 F) = 417 < 709 at 2e-4 for every r).
 SMALLEST_WEIGHT_FORCE = 2e-4
 #: ln of the largest F of the F integrals at x = 0 (F = e^690 ~ 1e300): beyond, the power law
 #: of w(F) is summed in closed form (``_force_nodes``).
