@@ -51,6 +51,12 @@ w(F) ~ exp(-S(q) / F) with S = (3p - p^3)/24, p = min(2q - 1, 1): for q < 1
 S < 0 for q < 1/2: w then grows without bound as F -> 0, which is why
 ``log_weight_function`` exists.
 
+Near r = 1 (r > RAY_RESTITUTION) that contour fails: its sums at complex v cancel like
+exp(c |v| theta^2) with |v| ~ q / F, and its integrand on the radial leg rises above the result.
+A(F) is then 2 Re of the integral along one ray from v = 0, arg v = RAY_ANGLE, with P(0, v) on
+the ray solved from eq. (inteq) with u on the same ray (``_RayDensity``; docs/distribution.md,
+"Where it degrades").
+
 w is computed at Chebyshev nodes in ln F on [F_min, F_max] and interpolated
 (``WeightFunction``; log w + S/F is smooth); above F_max it is continued by
 its power law w ~ F^((2 beta - 5)/6) (from h ~ v^-beta), below F_min (where
@@ -771,7 +777,18 @@ def _outgoing_density(solution, panel_width=1.0, panel_order=20) -> _OutgoingDen
     )
     ray = _ray_density(solution) if r > RAY_RESTITUTION else None
     return _OutgoingDensity(
-        r, beta, q, log_amplitude, u0, largest, edges, coefficients, nodes, log_weights, remainder, ray
+        r,
+        beta,
+        q,
+        log_amplitude,
+        u0,
+        largest,
+        edges,
+        coefficients,
+        nodes,
+        log_weights,
+        remainder,
+        ray,
     )
 
 
@@ -835,7 +852,12 @@ def _ray_log_kernel(rho_v, rho_u, ray, gl_x, gl_w, hermite_x2, hermite_w):
                 cmath.exp(-z0 * t2) * (1.0 + z0 * one_t2) / (one_t2 * one_t2 * math.sqrt(2.0 + t2))
             )
         integral = tau1 * acc
-    return math.log(math.sqrt(3.0) / math.pi) + ray * exponent + cmath.log(integral) - 2.0 * cmath.log(z0)
+    return (
+        math.log(math.sqrt(3.0) / math.pi)
+        + ray * exponent
+        + cmath.log(integral)
+        - 2.0 * cmath.log(z0)
+    )
 
 
 @njit(cache=True)
@@ -886,7 +908,9 @@ class _RayDensity:
     beta: float
     q: float
     ray: complex
-    log_amplitude: complex  # ln C (real up to the solution's error), P(0, v) = C v^-beta below the lowest node
+    log_amplitude: (
+        complex  # ln C (real up to the solution's error), P(0, v) = C v^-beta below the lowest node
+    )
     nodes: np.ndarray  # rho_j of the ray's grid (with the lower tail's nodes first)
     log_columns: np.ndarray  # ln(r^-2 u_j du_j P(0, u_j)), u_j = rho_j ray
     largest: float  # the ray's P(0, v) is used up to |v| = largest
@@ -950,7 +974,10 @@ def _ray_density(solution, panel_width=1.0, panel_order=20) -> _RayDensity:
     log_measure = 2j * RAY_ANGLE - 2.0 * np.log(r)  # r^-2 u du = r^-2 ray^2 rho drho
     main_columns = log_measure + np.log(step * _jacobian(rho) * rho) + log_scale
     tail_columns = (
-        log_measure + np.log(step * _jacobian(tail) * tail) - beta * np.log(tail / u0) + log_scale[0]
+        log_measure
+        + np.log(step * _jacobian(tail) * tail)
+        - beta * np.log(tail / u0)
+        + log_scale[0]
     )
     args = (ray, _RAY_GL_X, _RAY_GL_W, _RAY_HERMITE_X2, _RAY_HERMITE_W)
     rows = np.ascontiguousarray(log_scale)
@@ -984,7 +1011,9 @@ def _ray_density(solution, panel_width=1.0, panel_order=20) -> _RayDensity:
     edges = np.linspace(s0, s_hi, panels + 1)
     cheb = np.cos(np.pi * (np.arange(panel_order) + 0.5) / panel_order)
     s = 0.5 * (edges[:-1, None] + edges[1:, None]) + 0.5 * np.diff(edges)[:, None] * cheb[None, :]
-    density = _RayDensity(r, beta, q, ray, log_amplitude, nodes, log_columns, largest, eigenvalue, edges, None)
+    density = _RayDensity(
+        r, beta, q, ray, log_amplitude, nodes, log_columns, largest, eigenvalue, edges, None
+    )
     values = density.nystrom(speed_of_coordinate(s.ravel()))
     logs = np.log(values).reshape(s.shape)
     logs.imag = np.unwrap(logs.imag, axis=1)
@@ -995,11 +1024,28 @@ def _ray_density(solution, panel_width=1.0, panel_order=20) -> _RayDensity:
         r, beta, q, ray, log_amplitude, nodes, log_columns, largest, eigenvalue, edges, coefficients
     )
     probes = speed_of_coordinate(0.5 * (edges[:-1] + edges[1:]) + 0.37 * np.diff(edges))
-    deviation = np.abs(np.exp(density.log_density(probes) - np.log(density.nystrom(probes))
-                              + q * probes * ray + beta * np.log(probes * ray)) - 1.0)
+    deviation = np.abs(
+        np.exp(
+            density.log_density(probes)
+            - np.log(density.nystrom(probes))
+            + q * probes * ray
+            + beta * np.log(probes * ray)
+        )
+        - 1.0
+    )
     error = float(max(np.max(deviation), abs(eigenvalue - 1.0)))
     return _RayDensity(
-        r, beta, q, ray, log_amplitude, nodes, log_columns, largest, eigenvalue, edges, coefficients,
+        r,
+        beta,
+        q,
+        ray,
+        log_amplitude,
+        nodes,
+        log_columns,
+        largest,
+        eigenvalue,
+        edges,
+        coefficients,
         error,
     )
 
@@ -1341,8 +1387,15 @@ def _ray_contour_nodes(ray_density, force):
     rho = np.exp(t)
     v = rho * ray
     z = OMEGA * (0.25 * force ** (-2.0 / 3.0) - force ** (1.0 / 3.0) * v)
-    slope = ray * rho * (
-        (2.0 - ray_density.beta) / v + 0.5 - ray_density.q + OMEGA * np.cbrt(force) * np.sqrt(z + 0.5)
+    slope = (
+        ray
+        * rho
+        * (
+            (2.0 - ray_density.beta) / v
+            + 0.5
+            - ray_density.q
+            + OMEGA * np.cbrt(force) * np.sqrt(z + 0.5)
+        )
     )
     step = 0.5 * (slope[1:] + slope[:-1]) * np.diff(t)
     level = np.concatenate([[0.0], np.cumsum(step.real)])

@@ -73,7 +73,7 @@ QUADRATURE_STEP_RANGE = (0.1, 0.3)
 #: solve accept (the config's ``solver.weight_panel_nodes``), bounds included.  From 10, P(x)
 #: meets the 1e-8 target at every r of ``DISTRIBUTION_RESTITUTION_RANGE`` with a margin of more
 #: than ten (``position_accuracy`` and P(x) against 16 nodes, r from 0.02 to 0.9 in steps of
-#: 0.02); at 9 the margin is 2.5, at 8 P(x) misses it (3e-8 at r = 0.15).  Above 40 the cost
+#: 0.02, and 0.99, where the step 0.3 and 10 nodes hold ``position_accuracy`` at ~3e-11); at 9 the margin is 2.5, at 8 P(x) misses it (3e-8 at r = 0.15).  Above 40 the cost
 #: grows with nothing to gain.
 WEIGHT_PANEL_NODES_RANGE = (10, 40)
 
