@@ -363,7 +363,7 @@ def solver_benchmark(repeats=7):
     }
 
 
-DISTRIBUTION_RESTITUTIONS = (0.25, 0.5, 0.75)
+DISTRIBUTION_RESTITUTIONS = (0.25, 0.5, 0.75, 0.99)
 
 
 def distribution_benchmark():

@@ -51,6 +51,12 @@ w(F) ~ exp(-S(q) / F) with S = (3p - p^3)/24, p = min(2q - 1, 1): for q < 1
 S < 0 for q < 1/2: w then grows without bound as F -> 0, which is why
 ``log_weight_function`` exists.
 
+Near r = 1 (r > RAY_RESTITUTION) that contour fails: its sums at complex v cancel like
+exp(c |v| theta^2) with |v| ~ q / F, and its integrand on the radial leg rises above the result.
+A(F) is then 2 Re of the integral along one ray from v = 0, arg v = RAY_ANGLE, with P(0, v) on
+the ray solved from eq. (inteq) with u on the same ray (``_RayDensity``; docs/distribution.md,
+"Where it degrades").
+
 w is computed at Chebyshev nodes in ln F on [F_min, F_max] and interpolated
 (``WeightFunction``; log w + S/F is smooth); above F_max it is continued by
 its power law w ~ F^((2 beta - 5)/6) (from h ~ v^-beta), below F_min (where
@@ -89,7 +95,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
-from scipy import integrate, optimize, special
+from scipy import integrate, linalg, optimize, special
 
 from .airy import (
     LARGEST_AIRY_PHASE,
@@ -101,7 +107,7 @@ from .airy import (
 from .asymptotics import large_speed_decay_rate, large_speed_exponent, small_speed_exponent
 from .jit import njit
 from .kernel import TAIL as KERNEL_TAIL
-from .kernel import TAU_NODES
+from .kernel import TAU_NODES, _full_geometry
 from .relaxation import RELAXATION_COLUMNS
 from .restitution import DISTRIBUTION_RESTITUTION_RANGE, in_range, parse_restitution
 from .restitution import restitution_value as restitution_float
@@ -293,10 +299,10 @@ def check_restitution(restitution) -> float:
     >>> from bouncing_ball.distribution import check_restitution
     >>> print(check_restitution("1/3"), check_restitution(0.6))
     0.3333333333333333 0.6
-    >>> check_restitution(0.99)
+    >>> check_restitution(0.999)
     Traceback (most recent call last):
     ...
-    ValueError: restitution 0.99: w(F), P(x) and P(x, v) are computed to 1e-8 only for ...
+    ValueError: restitution 0.999: w(F), P(x) and P(x, v) are computed to 1e-8 only for ...
     """
     exact = parse_restitution(restitution, "restitution")
     if not in_range(exact, DISTRIBUTION_RESTITUTION_RANGE):
@@ -404,7 +410,7 @@ class _OutgoingDensity:
     restitution: float
     beta: float
     q: float
-    log_amplitude: float  # ln C, P(0, v) = C v^-beta below the solution's lowest node
+    log_amplitude: complex  # ln C (real up to the solution's error), P(0, v) = C v^-beta below the solution's lowest node
     lowest: float
     largest: float  # P(0, v) is trusted up to here
     panel_edges: np.ndarray  # in s = ln v + v^(1/2)
@@ -412,6 +418,8 @@ class _OutgoingDensity:
     nodes: np.ndarray  # u grid of the complex Nystrom sum
     log_weights: np.ndarray  # ln(weight u P(0, u))
     remainder: float  # closed-form part of the lower tail, times P(0, u_0)
+    # P(0, v) on the ray arg v = RAY_ANGLE where r > RAY_RESTITUTION (``_RayDensity``), else None
+    ray: object = None
     # cells of the interpolant of P(0, v) e^(q v) in the wedge (``_wedge_cell``), built on use
     cells: dict = field(default_factory=dict, compare=False, repr=False)
 
@@ -767,8 +775,278 @@ def _outgoing_density(solution, panel_width=1.0, panel_order=20) -> _OutgoingDen
         / -np.expm1(-alpha * step)
         * main_density[0]
     )
+    ray = _ray_density(solution) if r > RAY_RESTITUTION else None
     return _OutgoingDensity(
-        r, beta, q, log_amplitude, u0, largest, edges, coefficients, nodes, log_weights, remainder
+        r,
+        beta,
+        q,
+        log_amplitude,
+        u0,
+        largest,
+        edges,
+        coefficients,
+        nodes,
+        log_weights,
+        remainder,
+        ray,
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# P(0, v) on a ray arg v = RAY_ANGLE, from eq. (inteq) with u on the same ray (r near 1)
+
+#: The angle of the ray of P(0, v) and of the contour of A(F) where r > RAY_RESTITUTION.  From
+#: v = 0 along this ray the integrand of A(F), e^(Phi(F v) / F) with
+#: Phi(w) = (1/2 - q) w - (2/3) (omega (1/4 - w))^(3/2), has its largest modulus at v = 0
+#: (Re Phi(0) = 1/12) for every q <= q(0.999) (at arg v <= 0.7 it rises above that where
+#: r >= 0.99, by e^(0.02 / F) at 0.5): the sum cancels by e^((S + 1/12) / F) only.
+RAY_ANGLE = 0.8
+#: Above this r, A(F) is taken along the ray (``_RayDensity``) instead of the wedge contour.
+RAY_RESTITUTION = 0.9
+#: The ray's nodes reach RAY_REACH / q (P(0, v) ~ e^(-RAY_REACH cos(RAY_ANGLE)) there); the
+#: values are used up to half of it (the truncated operator spoils the top of its grid).
+RAY_REACH = 400.0
+RAY_REFINE = 2  # the ray's grid is this many times finer than the solver's
+_RAY_GL = tuple(np.polynomial.legendre.leggauss(count) for count in (20, 40, 64))
+_RAY_GL_X = np.zeros((3, 64))
+_RAY_GL_W = np.zeros((3, 64))
+for _k, (_x, _w) in enumerate(_RAY_GL):
+    _RAY_GL_X[_k, : _x.size], _RAY_GL_W[_k, : _x.size] = 0.5 * (_x + 1.0), 0.5 * _w
+_RAY_HERMITE_X2 = _HERMITE_X2[-1, : TAU_HERMITE_NODES[-1]].copy()
+_RAY_HERMITE_W = _HERMITE_W[-1, : TAU_HERMITE_NODES[-1]].copy()
+
+
+@njit(cache=True)
+def _ray_log_kernel(rho_v, rho_u, ray, gl_x, gl_w, hermite_x2, hermite_w):
+    """ln G_g(V, u) of eq. (kernel3) for V = rho_v ray, u = rho_u ray on one ray (|ray| = 1,
+    |arg ray| < pi/2): with both on the ray z0 -> ray z0, the exponent -> ray exponent and tau1
+    stays real (kernel._full_geometry of rho_v, rho_u).  The tau integral: to infinity along
+    arg tau = -arg(ray)/2 by Gauss-Hermite (12 nodes, |z0| > TAIL^2) where Re(z0 tau1^2) >
+    TAIL^2, else Gauss-Legendre on [0, tau1] with 20, 40 or 64 nodes as |z0| tau1^2 (the
+    radians its phase turns, times 1/sin(arg ray)) is below 3, 15 or above."""
+    exponent, z0_real, tau1 = _full_geometry(rho_v, rho_u)
+    if tau1 <= 0.0:
+        return complex(-np.inf, 0.0)
+    z0 = ray * z0_real
+    size = z0_real * tau1 * tau1
+    if z0.real * tau1 * tau1 > KERNEL_TAIL * KERNEL_TAIL:
+        acc = 0.0 + 0.0j
+        inverse_z0 = 1.0 / z0
+        for k in range(hermite_x2.size):
+            t2 = hermite_x2[k] * inverse_z0
+            one_t2 = 1.0 + t2
+            acc += hermite_w[k] * (
+                (1.0 + z0 + hermite_x2[k]) / (one_t2 * one_t2 * _principal_sqrt(2.0 + t2))
+            )
+        integral = acc / _principal_sqrt(z0)
+    else:
+        rule = 0 if size < 3.0 else (1 if size < 15.0 else 2)
+        acc = 0.0 + 0.0j
+        for k in range(gl_x.shape[1]):
+            if gl_w[rule, k] == 0.0:
+                break
+            tau = tau1 * gl_x[rule, k]
+            t2 = tau * tau
+            one_t2 = 1.0 + t2
+            acc += gl_w[rule, k] * (
+                cmath.exp(-z0 * t2) * (1.0 + z0 * one_t2) / (one_t2 * one_t2 * math.sqrt(2.0 + t2))
+            )
+        integral = tau1 * acc
+    return (
+        math.log(math.sqrt(3.0) / math.pi)
+        + ray * exponent
+        + cmath.log(integral)
+        - 2.0 * cmath.log(z0)
+    )
+
+
+@njit(cache=True)
+def _ray_operator(rho_v, rho_u, log_columns, log_rows, ray, gl_x, gl_w, hermite_x2, hermite_w):
+    """M_ij = exp(ln G_g(rho_v_i ray, rho_u_j ray) + log_columns_j - log_rows_i), 0 where its
+    Gaussian bound (the real part of the exponent) is below e^-UNDERFLOW_EFOLDS."""
+    out = np.zeros((rho_v.size, rho_u.size), dtype=np.complex128)
+    for i in range(rho_v.size):
+        for j in range(rho_u.size):
+            exponent, _, _ = _full_geometry(rho_v[i], rho_u[j])
+            level = ray.real * exponent + log_columns[j].real - log_rows[i].real
+            if level < -UNDERFLOW_EFOLDS:
+                continue
+            log_g = _ray_log_kernel(rho_v[i], rho_u[j], ray, gl_x, gl_w, hermite_x2, hermite_w)
+            out[i, j] = cmath.exp(log_g + log_columns[j] - log_rows[i])
+    return out
+
+
+@njit(cache=True)
+def _ray_sums(rho_v, rho_u, log_columns, shift, ray, gl_x, gl_w, hermite_x2, hermite_w):
+    """sum_j exp(ln G_g(rho_v_i ray, rho_u_j ray) + log_columns_j + shift_i), skipping the terms whose
+    Gaussian bound is below e^-(2 NEGLIGIBLE_EFOLDS) of the largest."""
+    out = np.zeros(rho_v.size, dtype=np.complex128)
+    levels = np.empty(rho_u.size)
+    for i in range(rho_v.size):
+        best = -np.inf
+        for j in range(rho_u.size):
+            exponent, z0, tau1 = _full_geometry(rho_v[i], rho_u[j])
+            levels[j] = ray.real * exponent + log_columns[j].real + math.log(tau1 + 1e-300)
+            best = max(best, levels[j])
+        total = 0.0 + 0.0j
+        for j in range(rho_u.size):
+            if levels[j] < best - 2.0 * NEGLIGIBLE_EFOLDS:
+                continue
+            log_g = _ray_log_kernel(rho_v[i], rho_u[j], ray, gl_x, gl_w, hermite_x2, hermite_w)
+            total += cmath.exp(log_g + log_columns[j] + shift[i])
+        out[i] = total
+    return out
+
+
+@dataclass(frozen=True)
+class _RayDensity:
+    """P(0, v) on the ray v = rho e^(i RAY_ANGLE), solved from eq. (inteq) with u on the same
+    ray (the u contour of the Nystrom formula rotated: no cancelling sum), normalised by the
+    small-v power law C v^-beta of the real-axis solution continued to the ray."""
+
+    restitution: float
+    beta: float
+    q: float
+    ray: complex
+    log_amplitude: (
+        complex  # ln C (real up to the solution's error), P(0, v) = C v^-beta below the lowest node
+    )
+    nodes: np.ndarray  # rho_j of the ray's grid (with the lower tail's nodes first)
+    log_columns: np.ndarray  # ln(r^-2 u_j du_j P(0, u_j)), u_j = rho_j ray
+    largest: float  # the ray's P(0, v) is used up to |v| = largest
+    eigenvalue: complex
+    panel_edges: np.ndarray  # in s, of the Chebyshev interpolant of ln(P e^(q v) v^beta)
+    coefficients: np.ndarray
+    #: relative error estimate of P(0, v) from ``log_density``: the interpolant against the
+    #: Nystrom formula between its nodes, and |eigenvalue - 1| of the discrete operator
+    error: float = np.nan
+
+    def log_density(self, rho):
+        """ln P(0, rho ray) for 0 < rho <= largest (complex): the interpolant from the lowest
+        node up, the power law C v^-beta below."""
+        rho = np.asarray(rho, dtype=float)
+        s = coordinate_of_speed(rho)
+        index = np.clip(np.searchsorted(self.panel_edges, s) - 1, 0, len(self.coefficients) - 1)
+        lo, hi = self.panel_edges[index], self.panel_edges[index + 1]
+        t = (2.0 * s - lo - hi) / (hi - lo)
+        smooth = np.polynomial.chebyshev.chebval(t, self.coefficients[index].T, tensor=False)
+        v = rho * self.ray
+        power = self.log_amplitude - self.beta * np.log(v)
+        return np.where(s < self.panel_edges[0], power, smooth - self.beta * np.log(v) - self.q * v)
+
+    def nystrom(self, rho):
+        """P(0, rho ray) e^(q rho ray) (rho ray)^beta by the Nystrom formula on the ray."""
+        rho = np.ascontiguousarray(rho, dtype=float)
+        v = rho * self.ray
+        shift = self.q * v + self.beta * np.log(v)
+        return _ray_sums(
+            rho / self.restitution,
+            self.nodes,
+            self.log_columns,
+            np.ascontiguousarray(shift),
+            self.ray,
+            _RAY_GL_X,
+            _RAY_GL_W,
+            _RAY_HERMITE_X2,
+            _RAY_HERMITE_W,
+        )
+
+
+def _ray_density(solution, panel_width=1.0, panel_order=20) -> _RayDensity:
+    """Solve eq. (inteq) on the ray arg v = RAY_ANGLE (``_RayDensity``): the solver's rule in
+    s = ln rho + rho^(1/2), RAY_REFINE times finer, from its lowest node u_0 (with the power law
+    below, as the solver) to RAY_REACH / q; the eigenvector of eigenvalue nearest 1 by inverse
+    iteration on the operator scaled by u^-beta e^(-q u), normalised to C u_0^-beta at u_0
+    (relative error O(u_0), as the real axis' own power law); then ln(P e^(q v) v^beta) on
+    Chebyshev panels in s from the Nystrom formula on the ray."""
+    r = solution.restitution
+    beta = solution.small_speed_exponent
+    q = large_speed_decay_rate(r)
+    ray = complex(np.exp(1j * RAY_ANGLE))
+    step = solution.step / RAY_REFINE
+    u0 = solution.speeds[0]
+    s0 = coordinate_of_speed(u0)
+    count = int(np.floor((coordinate_of_speed(RAY_REACH / q) - s0) / step)) + 1
+    rho = speed_of_coordinate(s0 + step * np.arange(count))
+    tail_count = int(np.ceil(TAIL_EFOLDS / step))
+    tail = speed_of_coordinate(s0 - step * np.arange(1, tail_count + 1))[::-1]
+    log_scale = -beta * (np.log(rho) + 1j * RAY_ANGLE) - q * rho * ray  # ln(u^-beta e^(-q u))
+    log_measure = 2j * RAY_ANGLE - 2.0 * np.log(r)  # r^-2 u du = r^-2 ray^2 rho drho
+    main_columns = log_measure + np.log(step * _jacobian(rho) * rho) + log_scale
+    tail_columns = (
+        log_measure
+        + np.log(step * _jacobian(tail) * tail)
+        - beta * np.log(tail / u0)
+        + log_scale[0]
+    )
+    args = (ray, _RAY_GL_X, _RAY_GL_W, _RAY_HERMITE_X2, _RAY_HERMITE_W)
+    rows = np.ascontiguousarray(log_scale)
+    operator = _ray_operator(rho / r, rho, np.ascontiguousarray(main_columns), rows, *args)
+    operator[:, 0] += _ray_operator(
+        rho / r, tail, np.ascontiguousarray(tail_columns), rows, *args
+    ).sum(axis=1)
+    factors = linalg.lu_factor(operator - np.eye(count), check_finite=False)
+    y = np.ones(count, dtype=complex)
+    for _ in range(3):
+        y = linalg.lu_solve(factors, y, check_finite=False)
+        y /= y[np.argmax(np.abs(y))]
+    eigenvalue = complex(np.vdot(y, operator @ y) / np.vdot(y, y))
+    # normalised by the momentum balance M_2 = r / (1 + r) (solver.py) with its v contour
+    # rotated onto the ray: int du u^2 P(0, u) along the ray, the solver's rule and lower tail
+    log_p = np.log(y) + log_scale
+    top = np.max(log_p.real)
+    moment = np.sum(step * _jacobian(rho) * rho**2 * np.exp(log_p - top)) + (
+        step * np.exp(log_p[0] - top) * u0**3 / np.expm1((3.0 - beta) * step)
+    )
+    log_p = log_p - top - np.log(moment * ray**3) + np.log(r / (1.0 + r))
+    log_p0 = log_p[0]
+    log_amplitude = log_p0 + beta * (np.log(u0) + 1j * RAY_ANGLE)
+    nodes = np.concatenate([tail, rho])
+    log_columns = np.concatenate(
+        [tail_columns - log_scale[0] + log_p0, main_columns - log_scale + log_p]
+    )
+    largest = 0.5 * rho[-1]
+    s_hi = coordinate_of_speed(largest)
+    panels = max(1, int(np.ceil((s_hi - s0) / panel_width)))
+    edges = np.linspace(s0, s_hi, panels + 1)
+    cheb = np.cos(np.pi * (np.arange(panel_order) + 0.5) / panel_order)
+    s = 0.5 * (edges[:-1, None] + edges[1:, None]) + 0.5 * np.diff(edges)[:, None] * cheb[None, :]
+    density = _RayDensity(
+        r, beta, q, ray, log_amplitude, nodes, log_columns, largest, eigenvalue, edges, None
+    )
+    values = density.nystrom(speed_of_coordinate(s.ravel()))
+    logs = np.log(values).reshape(s.shape)
+    logs.imag = np.unwrap(logs.imag, axis=1)
+    coefficients = np.array(
+        [np.polynomial.chebyshev.chebfit(cheb, row, panel_order - 1) for row in logs]
+    )
+    density = _RayDensity(
+        r, beta, q, ray, log_amplitude, nodes, log_columns, largest, eigenvalue, edges, coefficients
+    )
+    probes = speed_of_coordinate(0.5 * (edges[:-1] + edges[1:]) + 0.37 * np.diff(edges))
+    deviation = np.abs(
+        np.exp(
+            density.log_density(probes)
+            - np.log(density.nystrom(probes))
+            + q * probes * ray
+            + beta * np.log(probes * ray)
+        )
+        - 1.0
+    )
+    error = float(max(np.max(deviation), abs(eigenvalue - 1.0)))
+    return _RayDensity(
+        r,
+        beta,
+        q,
+        ray,
+        log_amplitude,
+        nodes,
+        log_columns,
+        largest,
+        eigenvalue,
+        edges,
+        coefficients,
+        error,
     )
 
 
@@ -1033,6 +1311,8 @@ def _log_contour_part(density, force, with_noise=True):
     """ln |A(F)|, its sign, and ln of an estimate of its rounding error (NaN without
     ``with_noise``): the real segment plus 2 Re of the complex path.  Raises ValueError where
     P(0, v) would be needed beyond the range in which the solution's is accurate."""
+    if density.ray is not None:
+        return _log_ray_contour_part(density.ray, force, with_noise)
     q = density.q
     v1 = _split_point(q, force)
     cut = min(v1, density.largest)
@@ -1077,6 +1357,87 @@ def _log_contour_part(density, force, with_noise=True):
         return top + np.log(abs(total)), float(np.sign(total)), np.nan
     noise = 2.0 * np.sum(np.exp(np.log(magnitude) + log_rest.real - top)) * EPSILON
     noise += np.sum(np.exp(all_terms - top)) * ROUNDING * EPSILON
+    return top + np.log(abs(total)), float(np.sign(total)), top + np.log(noise)
+
+
+#: Panels of the ray contour of A(F): Gauss-Legendre in ln rho, RAY_PANEL_NODES nodes each, no
+#: wider than 1 in ln rho and across each of which the integrand turns through at most
+#: RAY_PANEL_TURN radians of phase plus e-folds of modulus.
+RAY_PANEL_NODES = 20
+RAY_PANEL_TURN = 10.0
+_RAY_PANEL_X, _RAY_PANEL_W = np.polynomial.legendre.leggauss(RAY_PANEL_NODES)
+
+
+def _ray_log_integrand(ray_density, force, rho):
+    """ln of v h(v) (-omega) F^(-1/6) Ai(omega zeta(v)) at v = rho ray (complex)."""
+    v = rho * ray_density.ray
+    return np.log(v) + 0.5 * v + ray_density.log_density(rho) + _log_psi_omega(force, v)
+
+
+def _ray_contour_nodes(ray_density, force):
+    """ln rho and weights (d ln rho) of the panels of the ray contour of A(F), up to where its
+    integrand has fallen by NEGLIGIBLE_EFOLDS + 10 below its largest modulus.
+
+    The panels follow the integrand's log-derivative in v, (2 - beta) / v + 1/2 - q +
+    omega F^(1/3) (z + 1/2)^(1/2) with z = omega zeta (Ai'(z) / Ai(z) ~ -(z + 1/2)^(1/2): the
+    leading term at large |z|, -0.707 against -0.729 at z = 0), integrated on a grid in ln rho:
+    its imaginary and real parts along the ray measure the phase turned and the e-folds."""
+    ray = ray_density.ray
+    t = np.arange(np.log(SMALLEST_SPEED), np.log(ray_density.largest), 0.02)
+    rho = np.exp(t)
+    v = rho * ray
+    z = OMEGA * (0.25 * force ** (-2.0 / 3.0) - force ** (1.0 / 3.0) * v)
+    slope = (
+        ray
+        * rho
+        * (
+            (2.0 - ray_density.beta) / v
+            + 0.5
+            - ray_density.q
+            + OMEGA * np.cbrt(force) * np.sqrt(z + 0.5)
+        )
+    )
+    step = 0.5 * (slope[1:] + slope[:-1]) * np.diff(t)
+    level = np.concatenate([[0.0], np.cumsum(step.real)])
+    above = np.nonzero(level > np.max(level) - NEGLIGIBLE_EFOLDS - 10.0)[0]
+    if above[-1] == t.size - 1:
+        raise ValueError(
+            f"w({force}) needs P(0, v) on the ray beyond |v| = {ray_density.largest:.4g}"
+        )
+    end = above[-1] + 1
+    cost = np.concatenate([[0.0], np.cumsum(np.abs(step.real) + np.abs(step.imag))])[: end + 1]
+    t = t[: end + 1]
+    by_cost = np.interp(np.arange(0.0, cost[-1], RAY_PANEL_TURN), cost, t)
+    edges = np.unique(np.concatenate([by_cost, np.arange(t[0], t[-1], 1.0), [t[-1]]]))
+    half = 0.5 * np.diff(edges)[:, None]
+    x = (0.5 * (edges[:-1, None] + edges[1:, None]) + half * _RAY_PANEL_X[None, :]).ravel()
+    return x, (half * _RAY_PANEL_W[None, :]).ravel()
+
+
+def _log_ray_contour_part(ray_density, force, with_noise=True):
+    """ln |A(F)|, its sign and ln of an estimate of its error (NaN without ``with_noise``):
+    A = 2 Re int_0^inf along the ray v = rho e^(i RAY_ANGLE) of v h(v) (-omega) F^(-1/6)
+    Ai(omega zeta), with P(0, v) on the ray from ``_RayDensity`` (the two halves of psi_F(-v)
+    = 2 Re[-omega F^(-1/6) Ai(omega zeta)] turned onto the ray and its mirror image, where
+    the Airy factor decays; the integrand is analytic in between).  The part below
+    SMALLEST_SPEED is C psi(0) (eps ray)^(2 - beta) / (2 - beta)."""
+    t, wt = _ray_contour_nodes(ray_density, force)
+    rho = np.exp(t)
+    beta = ray_density.beta
+    log_terms = np.log(wt * rho * ray_density.ray) + _ray_log_integrand(ray_density, force, rho)
+    small = (
+        ray_density.log_amplitude
+        + (2.0 - beta) * (np.log(SMALLEST_SPEED) + 1j * RAY_ANGLE)
+        - np.log(2.0 - beta)
+        + _log_psi_omega(force, np.array([0.0 + 0.0j]))[0]
+    )
+    log_terms = np.append(log_terms, small)
+    top = np.max(log_terms.real)
+    total = 2.0 * np.sum(np.exp(log_terms - top)).real
+    if not with_noise:
+        return top + np.log(abs(total)), float(np.sign(total)), np.nan
+    size = 2.0 * np.sum(np.exp(log_terms.real - top))
+    noise = size * (ROUNDING * EPSILON + ray_density.error)
     return top + np.log(abs(total)), float(np.sign(total)), top + np.log(noise)
 
 
@@ -1578,13 +1939,12 @@ SMALLEST_POSITION = 1e-300
 LARGEST_POSITION = 1e12
 #: Beyond this speed abs(v), P(x, v) is 0 to every double (``Equilibrium.pxv``): on the floor P(0, v) ~
 #: e^(-q v) and P(0, -v) = r^2 P(0, r v) fall below e^-1400 at every r of
-#: DISTRIBUTION_RESTITUTION_RANGE (r q = 0.148 at r = 0.9), and above it P(x, v) is a Gaussian
-#: in v of variance <v^2>_x < 4e4 wherever P(x) is a double (x below ~1e7), e^-1000 down at
-#: abs(v) = 1e4.
-LARGEST_VELOCITY = 1e4
+#: DISTRIBUTION_RESTITUTION_RANGE (r q = 7.46e-3 at r = 0.995), and above it P(x, v) is a
+#: Gaussian in v of variance <v^2>_x < 1e7 wherever P(x) is a double, e^-2000 down there.
+LARGEST_VELOCITY = 2e5
 #: The smallest F of the config's ``solver.forces``: above ``Equilibrium.smallest_force`` (below
 #: which w(F) ~ F^gamma e^(-S/F), S < 0, exceeds the largest double) at every r of
-#: DISTRIBUTION_RESTITUTION_RANGE (1.03e-4 at r = 0.9, the largest).
+#: DISTRIBUTION_RESTITUTION_RANGE (-S / F < 1 / (12 F) = 417 < 709 at 2e-4 for every r).
 SMALLEST_WEIGHT_FORCE = 2e-4
 #: ln of the largest F of the F integrals at x = 0 (F = e^690 ~ 1e300): beyond, the power law
 #: of w(F) is summed in closed form (``_force_nodes``).

@@ -73,7 +73,7 @@ QUADRATURE_STEP_RANGE = (0.1, 0.3)
 #: solve accept (the config's ``solver.weight_panel_nodes``), bounds included.  From 10, P(x)
 #: meets the 1e-8 target at every r of ``DISTRIBUTION_RESTITUTION_RANGE`` with a margin of more
 #: than ten (``position_accuracy`` and P(x) against 16 nodes, r from 0.02 to 0.9 in steps of
-#: 0.02); at 9 the margin is 2.5, at 8 P(x) misses it (3e-8 at r = 0.15).  Above 40 the cost
+#: 0.02, and 0.99, where the step 0.3 and 10 nodes hold ``position_accuracy`` at ~3e-11); at 9 the margin is 2.5, at 8 P(x) misses it (3e-8 at r = 0.15).  Above 40 the cost
 #: grows with nothing to gain.
 WEIGHT_PANEL_NODES_RANGE = (10, 40)
 
@@ -433,7 +433,7 @@ class _EquilibriumState:
             Velocities (either sign), finite, broadcast against ``x``.  At x > 0 and v > 0 the
             F integral's Airy factor oscillates, and P(x, v) is computed only where its phase
             stays below ``airy.LARGEST_AIRY_PHASE`` (x >= 60 (v^(3/2) / 6e4)^2: x >= 1e-4 up to
-            v = 18).  Beyond ``distribution.LARGEST_VELOCITY`` (1e4) in |v|, P(x, v) is 0 to
+            v = 18).  Beyond ``distribution.LARGEST_VELOCITY`` (2e5) in |v|, P(x, v) is 0 to
             every double and 0 is returned.
 
         Returns

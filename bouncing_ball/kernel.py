@@ -83,9 +83,9 @@ _WEIGHTS = 0.5 * _WEIGHTS
 
 
 @njit(cache=True)
-def _geometry(v, u):
+def _full_geometry(v, u):
     """For v, u > 0: the Gaussian's exponent -(3/4) (v - u)^2 / ((v + u) / 2 + z0), z0 and the
-    upper limit of tau, min(tau1, TAIL / z0^(1/2)), of the stable form above.
+    upper limit tau1 of the stable form above.
 
     Every quantity is formed from s = max(v, u) and the scaled (v / s)^(1/2), (u / s)^(1/2),
     (v - u) / s, so that nothing over- or underflows for any finite v, u > 0 (z0^2 and v u
@@ -97,9 +97,16 @@ def _geometry(v, u):
     difference = (v - u) / scale
     z = math.hypot(difference, a * b)  # z0 / s, in [3^(1/2) / 2, 1]
     tau1 = math.sqrt(3.0) * a * b / (math.sqrt(a * a + b * b + z) * math.sqrt(z))
-    upper = min(tau1, TAIL / (root * math.sqrt(z)))
     exponent = -0.75 * scale * difference * difference / (0.5 * (a * a + b * b) + z)
-    return exponent, scale * z, upper
+    return exponent, scale * z, tau1
+
+
+@njit(cache=True)
+def _geometry(v, u):
+    """For v, u > 0: the exponent and z0 of ``_full_geometry`` and the upper limit of tau,
+    min(tau1, TAIL / z0^(1/2)), where the Gaussian exp(-z0 tau^2) has fallen below e^-TAIL^2."""
+    exponent, z0, tau1 = _full_geometry(v, u)
+    return exponent, z0, min(tau1, TAIL / math.sqrt(z0))
 
 
 @njit(cache=True)

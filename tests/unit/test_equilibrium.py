@@ -317,12 +317,13 @@ DISTRIBUTION_HIGH = DISTRIBUTION_RESTITUTION_RANGE[1]
 
 @pytest.fixture(scope="module")
 def near_one():
-    """r = 0.95, above DISTRIBUTION_RESTITUTION_RANGE (where w(F) misses its accuracy)."""
-    return bb.Equilibrium(0.95)
+    """r = 0.999, above DISTRIBUTION_RESTITUTION_RANGE (where the ray solve of P(0, v) outgrows
+    a job)."""
+    return bb.Equilibrium(0.999)
 
 
 def test_above_the_distribution_range_the_speed_quantities_are_given(near_one):
-    """P(0, v), the time averages, the flight times and the exponents at r = 0.95: the solution
+    """P(0, v), the time averages, the flight times and the exponents at r = 0.999: the solution
     balances energy (an identity the solve does not impose) to the solver's target, and the
     exponents are the asymptotic ones."""
     eq = near_one
@@ -337,8 +338,8 @@ def test_above_the_distribution_range_the_speed_quantities_are_given(near_one):
     assert eq.mean_flight_time == pytest.approx(1.0 / eq.collision_rate, rel=1e-10)
     density = eq.flight_time_density([0.1, 1.0, 100.0])
     assert np.all(np.isfinite(density)) and np.all(density > 0.0)
-    assert eq.beta == small_speed_exponent(0.95) and eq.m == large_speed_exponent(0.95)
-    assert eq.q == large_speed_decay_rate(0.95)
+    assert eq.beta == small_speed_exponent(0.999) and eq.m == large_speed_exponent(0.999)
+    assert eq.q == large_speed_decay_rate(0.999)
     assert set(eq.p0v_table(speeds).columns) == {"v", "p0v"}
     assert np.all(np.isfinite(eq.flight_time_table([1.0, 10.0])["density"]))
 
@@ -360,9 +361,9 @@ def test_above_the_distribution_range_the_speed_quantities_are_given(near_one):
     ],
 )
 def test_above_the_distribution_range_the_position_quantities_are_refused(near_one, name, call):
-    """At r = 0.95 P(x) came out NaN: refused, naming r, the range of the whole distribution
-    and the method."""
-    with pytest.raises(ValueError, match=rf"^r: r = 0.95 .* {LOW} <= r <= {DISTRIBUTION_HIGH}\b"):
+    """Above the range of the whole distribution P(x), w(F) and P(x, v) are refused, naming r,
+    the range and the method."""
+    with pytest.raises(ValueError, match=rf"^r: r = 0.999 .* {LOW} <= r <= {DISTRIBUTION_HIGH}\b"):
         call(near_one)
     with pytest.raises(ValueError, match=rf"Equilibrium.{name} needs w\(F\)"):
         call(near_one)
