@@ -24,7 +24,7 @@ import numpy as np
 RESTITUTIONS = (0.25, 0.5, 0.75)
 ESTIMATORS = ("paper", "default")
 # shards per (r, estimator): as many as the default run's, so the cross-fitted slopes are as
-# noisy as there; the simulated time per shard gives about 0.1-0.4 CPU s each at c = 3
+# noisy as there; the CPU a shard takes is in the benchmark's report
 SHARDS = 64
 SHARD_TIMES = {0.25: 4.0e4, 0.5: 1.0e5, 0.75: 4.0e5}
 # the bins over which the median is taken

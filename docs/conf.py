@@ -108,7 +108,10 @@ def _on_source_read(app, docname, source):
 # The captions of the figures (workflow/report/fig*.rst, which Snakemake's report renders with the
 # run's config) as the gallery shows them: rendered with the config that made docs/gallery/*.png.
 CAPTIONS = REPOSITORY / "workflow" / "report"
-GALLERY_CONFIGS = [REPOSITORY / ".test" / "config" / "config.yaml", DOCS / "gallery" / "gallery.yaml"]
+GALLERY_CONFIGS = [
+    REPOSITORY / ".test" / "config" / "config.yaml",
+    DOCS / "gallery" / "gallery.yaml",
+]
 
 
 def _merged(base: dict, overlay: dict) -> dict:
