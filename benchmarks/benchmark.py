@@ -7,12 +7,12 @@ prints the tables as Markdown (``report``), or writes them to FILE with the mach
 the time of the run (e.g. ``--markdown results/benchmarks/benchmark.md``); ``--json``
 prints the results themselves.
 
-Measured here (about 3 minutes; ``--scaling`` adds about 2.5 more, outside that budget):
+Measured here (``--scaling`` adds the stage on 1 and 2 cores, outside the default run):
   * simulation throughput on one core at r = 0.25, 0.5, 0.75 with the default
     config's c and delta rule (c = 3, 1/500) and with the paper's c = 5:
     collisions and simulated time per CPU second, steps per collision, ns per
     step, and the CPU per simulated time the default c saves;
-  * where a step's time goes at r = 1/2 and c = 5, 3 (``breakdown``; about 30 seconds,
+  * where a step's time goes at r = 1/2 and c = 5, 3 (``breakdown``,
     alone with ``--breakdown-only``): ns per step of the
     stepping and of each tally, of the criterion root and of the normals, and collisions
     per CPU second against the hand-tuned C loop (``reference/hand_tuned.c``, measured in
@@ -21,7 +21,7 @@ Measured here (about 3 minutes; ``--scaling`` adds about 2.5 more, outside that 
     own ziggurat on the same PCG64 stream, so the tallies must be identical):
     numba's speed over C's at r = 1/2, with the tallies and stepping only
     (target: at least 90%);
-  * statistical efficiency per observable (``efficiency``; about 2 minutes, alone with
+  * statistical efficiency per observable (``efficiency``, alone with
     ``--efficiency-only``): (relative standard error)^2 x CPU seconds at r = 1/4, 1/2, 3/4, 0.95
     and 0.99 (``efficiency.RESTITUTIONS``) of
     I, <x>, Delta x, <T>, <T^2> and the median bin of P(0, v), P(x), <v^2>_x, P(x, v), for
@@ -76,7 +76,8 @@ def _default_shard_settings():
 
 
 SHARD_SETTINGS = _default_shard_settings()
-# simulated time per throughput shard: about 2-4 CPU seconds each
+# simulated time per throughput shard: long enough for a steady rate (the report gives the
+# simulated time per CPU second at each r, so the CPU of a shard)
 THROUGHPUT_TIMES = {0.25: 6.0e5, 0.5: 2.0e6, 0.75: 6.0e6}
 
 

@@ -24,8 +24,8 @@ import numpy as np
 RESTITUTIONS = (0.25, 0.5, 0.75, 0.95, 0.99)
 ESTIMATORS = ("paper", "default")
 # shards per (r, estimator): as many as the default run's, so the cross-fitted slopes are as
+# noisy as there; the CPU a shard takes is in the benchmark's report
 SHARDS = 64
-# noisy as there; the simulated time per shard gives a fraction of a CPU second each at c = 3.
 # Near r = 1 (0.95, 0.99) a shard spans hundreds of relaxation times (``Equilibrium(r).
 # relaxation_time``), and every shard discards the default equilibration time at its r
 # (``equilibration.default_equilibration_time``), counted in its CPU seconds.

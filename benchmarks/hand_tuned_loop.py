@@ -200,7 +200,7 @@ def criterion_root(x, v, c, start=0.0, library=None) -> tuple[float, int]:
     return root, iterations.value
 
 
-# simulated time per shard, as the benchmark's throughput shards (about 1-3 CPU s each)
+# simulated time per shard, as the benchmark's throughput shards
 THROUGHPUT_TIMES = {0.25: 6.0e5, 0.5: 2.0e6, 0.75: 6.0e6}
 
 

@@ -989,7 +989,7 @@ class Equilibrium(_EquilibriumState):
     [0.404354 0.122626 0.022556]
     >>> eq.accuracy < 1e-8
     True
-    >>> print(eq.px([0.1, 1.0]).round(6))  # builds w(F): a few seconds
+    >>> print(eq.px([0.1, 1.0]).round(6))  # builds w(F) first
     [0.503776 0.183784]
     >>> Equilibrium("1/2", exact=True)
     ExactEquilibrium(r=1/2): I = 0.3333333333, ...

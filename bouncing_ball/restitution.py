@@ -30,7 +30,7 @@ EXACT_RESTITUTIONS = (Fraction(1, 2), Fraction(1, 3))
 
 #: The r for which the solver of eq. (inteq) (bouncing_ball.solver) meets its 1e-8 accuracy
 #: target: below 0.02 P(0, v) ~ exp(-v / (2r)) leaves the range of doubles within the speeds that
-#: matter (the answer is wrong by 2% at 0.015, by 50% at 0.01); above 0.9999 the dense grid,
+#: matter (tests/unit/test_solver.py holds the solver to it); above 0.9999 the dense grid,
 #: ~ (1 - r)^(-1/2) nodes, outgrows a job.  The bounds are exact decimals: 0.02 is 1/50.
 SOLVER_RESTITUTION_RANGE = (0.02, 0.9999)
 #: The r for which the whole distribution from P(0, v) (bouncing_ball.distribution: w(F), P(x),

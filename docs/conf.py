@@ -1,9 +1,12 @@
 """Sphinx configuration of the documentation site (``python -m sphinx -W -b html docs docs/_build/html``)."""
 
 import re
+import types
 from pathlib import Path
 
+import jinja2
 import sphinx.ext.autosummary
+import yaml
 
 import bouncing_ball
 
@@ -21,11 +24,13 @@ extensions = [
     "numpydoc",  # the API reference from the numpydoc docstrings
     "sphinx.ext.autosummary",
     "sphinx.ext.mathjax",
+    "sphinx.ext.intersphinx",  # numpy.ndarray, pandas.DataFrame, ... link to their projects' pages
+    "sphinx.ext.viewcode",  # each documented name links to its highlighted source
 ]
 
 # .rst first: autosummary writes its generated pages (reStructuredText) with the first suffix
 source_suffix = {".rst": "restructuredtext", ".md": "myst-nb"}
-exclude_patterns = ["_build", "requirements.txt"]
+exclude_patterns = ["_build", "_intersphinx", "gallery", "requirements.txt"]
 root_doc = "index"
 
 # anchors for the pages' "#section" links, as GitHub makes them
@@ -46,6 +51,24 @@ templates_path = ["_templates"]
 sphinx.ext.autosummary.WELL_KNOWN_ABBREVIATIONS += ("eq.", "eqs.", "Eq.", "Eqs.", "Fig.", "Figs.")
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
+# the types of the Parameters and Returns sections link to their documentation (intersphinx below)
+numpydoc_xref_param_type = True
+numpydoc_xref_aliases = {"DataFrame": "pandas.DataFrame", "mapping": ":term:`python:mapping`"}
+numpydoc_xref_ignore = {"of", "or", "optional", "default", "shape", "to"}
+
+# The inventories are files kept in docs/_intersphinx/ (written by make_inventories.py there), not
+# fetched: a build reads no network, so it neither waits nor fails where there is none.
+intersphinx_mapping = {
+    project: (site, str(DOCS / "_intersphinx" / f"{project}.inv"))
+    for project, site in {
+        "python": "https://docs.python.org/3/",
+        "numpy": "https://numpy.org/doc/stable/",
+        "scipy": "https://docs.scipy.org/doc/scipy/",
+        "pandas": "https://pandas.pydata.org/docs/",
+        "matplotlib": "https://matplotlib.org/stable/",
+    }.items()
+}
+intersphinx_timeout = 5  # seconds, for a mapping that names a URL instead of a file
 
 html_theme = "pydata_sphinx_theme"
 html_title = f"bouncing-ball {release}"
@@ -82,8 +105,36 @@ def _on_source_read(app, docname, source):
     source[0] = _site_links(source[0], DOCS)
 
 
+# The captions of the figures (workflow/report/fig*.rst, which Snakemake's report renders with the
+# run's config) as the gallery shows them: rendered with the config that made docs/gallery/*.png.
+CAPTIONS = REPOSITORY / "workflow" / "report"
+GALLERY_CONFIGS = [
+    REPOSITORY / ".test" / "config" / "config.yaml",
+    DOCS / "gallery" / "gallery.yaml",
+]
+
+
+def _merged(base: dict, overlay: dict) -> dict:
+    """``base`` with ``overlay`` laid over it, key by key, as Snakemake merges --configfile files."""
+    merged = dict(base)
+    for key, value in overlay.items():
+        both = isinstance(value, dict) and isinstance(base.get(key), dict)
+        merged[key] = _merged(base[key], value) if both else value
+    return merged
+
+
+def _gallery_caption(text: str) -> str:
+    config = {}
+    for path in GALLERY_CONFIGS:
+        config = _merged(config, yaml.safe_load(path.read_text()))
+    return jinja2.Template(text).render(snakemake=types.SimpleNamespace(config=config))
+
+
 def _on_include_read(app, relative_path, parent_docname, content):
-    content[0] = _site_links(content[0], (DOCS / relative_path).parent)
+    path = (DOCS / relative_path).resolve()
+    if path.parent == CAPTIONS:
+        content[0] = _gallery_caption(content[0])
+    content[0] = _site_links(content[0], path.parent)
 
 
 def setup(app):

@@ -373,7 +373,7 @@ def time_averages_figure(solved, simulated, exact, critical_restitution):
     values at r = 1/2 and 1/3.
 
     ``solved``: table r, mean_x, delta_x, collision_rate; ``simulated``: merged
-    summary rows (with *_err); ``exact``: exact summary rows.
+    summary rows (with ``*_err``); ``exact``: exact summary rows.
     """
     figure, axes = new_figure(3, 1, width=4.6, height=7.2, sharex=True)
     for axis, quantity in zip(axes[:, 0], ("mean_x", "delta_x", "collision_rate")):

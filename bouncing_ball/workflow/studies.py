@@ -161,7 +161,7 @@ def shape(values) -> tuple[float, float]:
 def outgoing_speed_check(shards, restitution, minimum_count: int) -> dict:
     """The simulated P(0, v) (bin averages, jackknife errors) against the exact one
     (``comparison.exact_outgoing_speed_residuals``) over the finite bins with at least
-    ``minimum_count`` collisions: their number, chi^2 / n of their z and the largest |z|."""
+    ``minimum_count`` collisions: their number, chi^2 / n of their z and the largest ``|z|``."""
     table = outgoing_speed_histogram(shards)
     z = exact_outgoing_speed_residuals(table[table["count"] >= minimum_count], restitution).residual
     if z.empty:

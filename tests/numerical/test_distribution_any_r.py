@@ -1,7 +1,7 @@
 """The equilibrium distribution (bouncing_ball.distribution) at any r: the moments of P(x) of
 eq. (P(x)1) against the solver's Ito time averages (moments of P(0, v) only), and the moment
 identities eqs. (moment1), (moment2) of P(x, v) of eq. (fpsol).  Split from test_distribution.py
-because every r costs a 3-12 s build of w(F)."""
+because every r costs a build of w(F) (``python -m benchmarks`` times it)."""
 
 import numpy as np
 import pytest

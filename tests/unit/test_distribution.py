@@ -14,7 +14,7 @@ from bouncing_ball import airy, distribution, exact
 
 EXACT = [Fraction(1, 2), Fraction(1, 3)]
 # the checks at any r (0.15, 0.25, 0.6, 0.75, 0.9) are in test_distribution_any_r.py: each r
-# costs a 3-12 s build of w(F)
+# costs a build of w(F) (``python -m benchmarks`` times it)
 
 
 @pytest.fixture(scope="module")

@@ -81,9 +81,9 @@ def _interrupted_run(processes, group, shards, shard_time, after=2, delay=0.0):
 
 @pytest.mark.parametrize("group", [False, True], ids=["notebook", "terminal"])
 def test_ctrl_c_stops_the_workers_at_once_and_keeps_the_finished_shards(group):
-    """With 2 workers, 100 shards of about a second's CPU each would run for about a minute:
-    a Ctrl-C after the first two stops within a few seconds, with those two (or more that
-    finished meanwhile) as a partial result."""
+    """With 2 workers, 100 shards would run far longer than the test waits: a Ctrl-C after
+    the first two stops the workers at once, with those two (or more that finished meanwhile)
+    as a partial result."""
     words = _interrupted_run(processes=2, group=group, shards=100, shard_time=2.0e6)
     name, stopped, finished, requested, partial, shown, in_summary = words
     assert name == "SimulationInterrupted"
@@ -102,9 +102,9 @@ def test_ctrl_c_in_this_process_between_shards_keeps_the_finished_ones():
 
 @pytest.mark.parametrize("group", [False, True], ids=["notebook", "terminal"])
 def test_ctrl_c_in_this_process_stops_the_shard_under_way_at_once(group):
-    """processes=1, shards of about a second's CPU each: a Ctrl-C a quarter of the way into
-    shard 1 stops it at once, its work discarded, and keeps shard 0 (too few for a result).
-    Waiting for shard 1 to end would take most of a second and keep it too."""
+    """processes=1: a Ctrl-C a quarter of the way into shard 1 stops it at once, its work
+    discarded, and keeps shard 0 (too few for a result); waiting for shard 1 to end would keep
+    it too."""
     words = _interrupted_run(
         processes=1, group=group, shards=4, shard_time=1.2e6, after=1, delay=0.25
     )

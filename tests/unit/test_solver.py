@@ -124,8 +124,8 @@ def test_refuses_restitution_too_close_to_one():
 
 @pytest.mark.parametrize("small", [0.015, 1e-3, 1e-7])
 def test_refuses_restitution_below_its_accurate_range(small):
-    """Below 0.02 the answer was wrong by percents (0.015) to factors (1e-3), or it crashed
-    (1e-7): refused, with the range, instead."""
+    """Below 0.02 P(0, v) ~ exp(-v / (2r)) leaves the range of doubles within the speeds that
+    matter, so no answer meets the accuracy target: the solver refuses, naming its range."""
     with pytest.raises(ValueError, match=r"too small for the solver.*0.02 <= r <= 0.9999"):
         solver.solve_outgoing_speed_density(small)
 

@@ -24,7 +24,7 @@ LOW, HIGH = DISTRIBUTION_RESTITUTION_RANGE
 
 def test_the_bounds_of_a_range_are_exact_decimals():
     """0.02 is 1/50, whose float lies a little above 1/50: the exact r = 1/50 is in the range
-    that starts at 0.02 (it was refused: "r = '0.02' is outside the solver's range 0.02 <= r")."""
+    that starts at 0.02, not refused as outside it."""
     assert in_range(Fraction(1, 50), SOLVER_RESTITUTION_RANGE)
     assert not in_range(Fraction(1, 50) - Fraction(1, 10**12), SOLVER_RESTITUTION_RANGE)
     for bound in ("1/50", "9/10", 0.02, LOW, HIGH):
@@ -217,7 +217,8 @@ def test_the_flight_time_density_may_be_undefined_only_below_r_c():
     ],
 )
 def test_a_table_off_its_accuracy_is_an_error_naming_the_check(key, value, check):
-    """At r = 0.99 P(x) was off by 1.4e-4 and its large-x power 0.11 against 0.25, unflagged."""
+    """A table whose P(x) misses its normalisation or whose large-x power misses the theory's
+    (as at r = 0.99, outside the distribution's range) is an error that names the check."""
     summary, tables = _passing_tables()
     summary[key] = value
     with pytest.raises(ValueError, match="r = 0.5: ") as error:
@@ -250,17 +251,17 @@ def test_the_large_x_power_is_checked_only_where_it_has_set_in():
 
 
 def test_the_coordinate_of_the_grid_inverts_beyond_the_overflow_of_its_exponential():
-    """u(s) went through (b / 2) e^(s/2), infinite above u ~ 2e6: the grid of the far solution
-    at r = 0.9999 had infinite nodes and a NaN density."""
+    """u(s) is computed without forming (b / 2) e^(s/2), which overflows above u ~ 2e6, where
+    the grid of the far solution at r = 0.9999 reaches."""
     speeds = np.array([1e-12, 1.0, 1e6, 2.1e6, 5e6, 1e8])
     back = solver.speed_of_coordinate(solver.coordinate_of_speed(speeds))
     assert np.max(np.abs(back / speeds - 1.0)) < 1e-14
 
 
 def test_position_moments_near_the_lower_end_of_the_range():
-    """At r = 0.03 (beta = 2.4, near 5/2) int P dx was off by 1e-5 and <x> by 1e-8: the
-    closed-form part of T(G) below the smallest speed lacked the linear term of psi_G(v), which
-    matters at the large G that carry B(F) when beta nears 5/2.  Now 1e-8."""
+    """At r = 0.03 (beta = 2.4, near 5/2) int P dx and <x> meet their tolerances: the
+    closed-form part of T(G) below the smallest speed keeps the linear term of psi_G(v), which
+    matters at the large G that carry B(F) when beta nears 5/2."""
     check_position_moments(0.03)
 
 

@@ -19,7 +19,7 @@ from workflow_support import SMALL, copy_repository, planned_jobs, snakemake
 
 from bouncing_ball.workflow.io import read_table
 
-# three shards of r = 1/2 that each compute for a few seconds, so a job can be killed mid-run
+# three shards of r = 1/2, each long enough that a job can be killed mid-run
 # (two jobs: shards 0-1 and 2-2, simulation.shards_per_job 2)
 LONG = yaml.safe_load(yaml.safe_dump(SMALL)) | {"restitution": [0.5]}
 LONG["simulation"]["per_restitution"] = {"0.5": {"shards": 3, "shard_time": 2.5e6}}

@@ -73,7 +73,7 @@ def restitution_value(wildcards):
 
 
 def solve_priority(wildcards):
-    """Rule solve: 11 where r > 1/2 (its w(F) takes about twice as long), else 9."""
+    """Rule solve: 11 where r > 1/2 (its w(F) takes longer), else 9."""
     return 11 if parse_restitution(restitution_value(wildcards)) > Fraction(1, 2) else 9
 
 

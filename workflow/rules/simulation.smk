@@ -11,8 +11,8 @@ rule simulate_shards:
     priority: batch_priority
     conda:
         "../envs/bouncing-ball.yaml"
-    # minutes: the step budget (simulation.max_steps, 10^9 steps) stops a shard after
-    # about 2-4 CPU minutes, so 20 per shard of the batch; raise runtime with max_steps
+    # minutes: the step budget (simulation.max_steps, 10^9 steps) bounds a shard's CPU (the
+    # ns per step: python -m benchmarks), so 20 per shard of the batch; raise runtime with max_steps
     resources:
         runtime=lambda wildcards: 20 * len(batch_shards(wildcards)),
         mem_mb=500,

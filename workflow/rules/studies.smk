@@ -50,13 +50,13 @@ rule study_shard:
     wildcard_constraints:
         study="|".join(STUDY_RUNS),
         run=r"[^/]+",
-    # one shard per job (a study shard computes for 10-30 s); several per SLURM job
+    # one shard per job; several per SLURM job
     # (profiles/slurm: group-components)
     group:
         "shards"
     conda:
         "../envs/bouncing-ball.yaml"
-    # minutes: a study shard takes 10-30 CPU s (config/studies.yaml)
+    # minutes: an upper bound on a study shard (its CPU: python -m benchmarks, config/studies.yaml)
     resources:
         runtime=20,
         mem_mb=500,
