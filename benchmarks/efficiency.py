@@ -164,9 +164,9 @@ def efficiency_rows(measurements):
 
 
 def _timed_shard(arguments):
-    from .benchmark import _shard
-
     from bouncing_ball.equilibration import default_equilibration_time
+
+    from .benchmark import _shard
 
     r, recorded_time, shard, criterion_c = arguments
     equilibration_time = default_equilibration_time(r)
