@@ -52,7 +52,7 @@ S < 0 for q < 1/2: w then grows without bound as F -> 0, which is why
 ``log_weight_function`` exists.
 
 Near r = 1 (r > RAY_RESTITUTION) that contour fails: its sums at complex v cancel like
-exp(c |v| theta^2) with |v| ~ q / F, and its integrand on the radial leg rises above the result.
+exp(c abs(v) theta^2) with abs(v) ~ q / F, and its integrand on the radial leg rises above the result.
 A(F) is then 2 Re of the integral along one ray from v = 0, arg v = RAY_ANGLE, with P(0, v) on
 the ray solved from eq. (inteq) with u on the same ray (``_RayDensity``; docs/distribution.md,
 "Where it degrades").
