@@ -139,7 +139,7 @@ def test_the_v_to_the_minus_2_mode_carries_a_flux_of_bounces_through_zero_speed(
     assert gains[1e-6] / gains[1e-10] == pytest.approx(100.0, rel=0.01)  # O(u^(1/2))
     for r in (0.5, 1.0 / 3.0):
         beta = small_speed_exponent(r)
-        mode = r ** (beta - 2.0) * _mean_over_return(lambda y: np.exp((beta - 2.0) * y), 1e-10)
+        mode = r ** (beta - 2.0) * _mean_over_return(lambda y, b=beta: np.exp((b - 2.0) * y), 1e-10)
         assert mode == pytest.approx(1.0, abs=1e-8)
 
 
