@@ -25,8 +25,11 @@ def _log_restitution_of_beta(beta):
 
     In log form eq. (asym2) reads (beta - 2) ln r = ln[2 sin((2 beta + 1) pi / 6)],
     which holds at beta = 2 for every r (both sides vanish).  Dividing by
-    beta - 2 removes that spurious root; at beta = 2 the quotient is the
-    derivative, (pi / 3) cot(5 pi / 6) = -pi / sqrt(3) = ln r_c.
+    beta - 2 removes that root: a genuine mode, v^-2, a constant density of bounces per unit
+    ln v, which carries a net flux of ln(r / r_c) bounces per bounce through every small speed
+    (from v = 0 above r_c, into it below), so a steady state holds none of it
+    (docs/methods.md#asymptotic-theory).  At beta = 2 the quotient is the derivative,
+    (pi / 3) cot(5 pi / 6) = -pi / sqrt(3) = ln r_c.
     """
     if abs(beta - 2.0) < 1e-7:
         return -np.pi / np.sqrt(3.0) + (beta - 2.0) * (-(np.pi**2) / 9.0) * 2.0  # + O((beta-2)^2)
@@ -45,7 +48,7 @@ def small_speed_exponent(restitution) -> float:
     """The exponent beta(r) of P(0, v) ~ v^-beta at small v, eqs. (asym1), (asym2).
 
     The physical root of eq. (asym2) in (0, 5/2) (the equation holds at beta = 2 for every r;
-    that root is divided out).
+    that root, the v^-2 mode with a net flux of bounces through v = 0, is divided out).
 
     Parameters
     ----------
@@ -124,7 +127,12 @@ def large_speed_exponent(restitution) -> float:
     float
         m(r) = 1 - ln r / ln(x / r) with x of eq. (asym5) for r > 1/2 (eq. (asym4)), 1 at
         r = 1/2 (x(1/2) = 0 in eq. (asym5): the limit r -> 1/2 from above), 3/2 below
-        (eq. (asym6)): m jumps at r = 1/2.
+        (eq. (asym6)): m jumps at r = 1/2.  Above 1/2, m -> 1 only logarithmically,
+        m(1/2 + delta) = 1 - ln 2 / ln(3 / (16 delta)) to relative order delta.  Near 1/2 the
+        form v^-m e^(-q v) holds only beyond a crossover speed ~ (r - 1/2)^-2:
+        1 / (1/(2r) - q) above 1/2 (the end-point term v^(-3/2) e^(-v/(2r)) competes; 83 at
+        r = 0.55, 7.6e3 at 0.505) and (1/(2r) - 1)^-2 below (81 at r = 0.45); below it
+        P(0, v) looks like the r = 1/2 form (docs/methods.md#asymptotic-theory).
 
     Raises
     ------

@@ -452,11 +452,14 @@ def sign_flip_test(deviations, flips=SIGN_FLIPS, seed=SIGN_FLIP_SEED):
     chi2_per_bin, p_chi2, p_worst : float
         z of a bin is the deviations' mean over its standard error from the scatter between
         the shards (the jackknife's, for a mean over shards); chi2_per_bin is the mean of z^2
-        over the bins.  Under the null the shards are independent and each shard's deviation
-        vector is symmetric about 0, so flipping the signs of whole shards leaves the joint
+        over the bins.  The null takes the shards as independent and each shard's deviation
+        vector as symmetric about 0; then flipping the signs of whole shards leaves the joint
         distribution unchanged: the flipped statistics are the null distribution, and it
         carries the correlations between bins (shared shards, the normalisation, cascades of
-        collisions filling neighbouring bins).
+        collisions filling neighbouring bins).  Independence gives a zero mean, not symmetry:
+        where a shard's deviation is skewed (rare bins fed by cascades, a few shards holding
+        most of a bin's content) the null is approximate, the more so the fewer the shards and
+        the rarer the bin, and the worst-bin p more than the chi^2 p.
 
         p = (1 + the number of flipped statistics >= the observed one) / (1 + flips): a
         flipped statistic equal to the observed one counts.  Every sum over shards is exact

@@ -1047,7 +1047,10 @@ class Equilibrium(_EquilibriumState):
     def accuracy(self) -> float:
         """The solver's error estimate (``solver.accuracy_estimate``): the largest relative
         change of P(0, v) over 1e-3 <= v <= 20 against a finer solve (computed on first use,
-        then kept with the solve)."""
+        then kept with the solve).  It does not cover the speeds that carry <x> and Delta x
+        near r = 1 (M_4 and M_6 peak near 4/q and 6/q, about 260 and 400 at r = 0.99); there
+        the check is the energy balance, ``solver.energy_balance_residual`` (the summary's
+        ``energy_balance_residual``)."""
         return self._solve.accuracy_estimate()
 
     @property

@@ -13,8 +13,9 @@ trapezoidal rule, uniform in
 ln u where the kernel is scale-free (u << 1: there G_g(v, u) du u is a
 function of ln(v / u), analytic in the strip abs(Im ln(v/u)) < pi / 3, so the
 rule converges like exp(-2 pi^2 / (3 h))), and u^(1/2) where a fast
-particle comes back with its speed spread by ~ 2 u^(1/2), so the spacing
-keeps pace with the kernel's width.  Below the lowest node u_0 the power
+particle comes back with its speed spread by (4u/3)^(1/2) ~ 1.15 u^(1/2) (the
+standard deviation, docs/methods.md), so the spacing keeps pace with the
+kernel's width.  Below the lowest node u_0 the power
 law of eq. (asym1), P = P(0, u_0) (u / u_0)^-beta with beta from
 eq. (asym2), is built in: the rule's nodes continue below u_0, their sum is
 done directly for 25 e-folds and in closed form (a geometric series, with

@@ -2,8 +2,9 @@
 
 import numpy as np
 import pytest
+from scipy import integrate
 
-from bouncing_ball import solver
+from bouncing_ball import Equilibrium, solver
 from bouncing_ball.asymptotics import (
     CRITICAL_RESTITUTION,
     exponents_table,
@@ -11,6 +12,7 @@ from bouncing_ball.asymptotics import (
     large_speed_exponent,
     small_speed_exponent,
 )
+from bouncing_ball.kernel import return_speed_density
 
 
 @pytest.mark.parametrize(
@@ -104,3 +106,79 @@ def test_every_exponent_refuses_an_r_outside_the_unit_interval(function, bad):
     """m(1.5) was 0.295, q(-0.5) was -1 and q(0) a ZeroDivisionError."""
     with pytest.raises(ValueError, match=r"restitution must lie in \(0, 1\)"):
         function(bad)
+
+
+def _mean_over_return(function, u):
+    """E[function(ln(v / u)) | u] over the return law v G_g(v, u) of eq. (kernel3)."""
+
+    def integrand(log_ratio):
+        v = u * np.exp(log_ratio)
+        return function(log_ratio) * v * float(return_speed_density(v, u))
+
+    edges = [-60.0, -3.0, 0.0, 3.0, 60.0]
+    return sum(
+        integrate.quad(integrand, a, b, epsabs=0.0, epsrel=1e-12, limit=200)[0]
+        for a, b in zip(edges[:-1], edges[1:])
+    )
+
+
+def test_the_v_to_the_minus_2_mode_carries_a_flux_of_bounces_through_zero_speed():
+    """At small speeds ln u_n is a random walk with steps X = ln(r v / u) (the kernel is
+    scale-free), E[e^((b - 2) X)] = Phi(b) = r^(b - 2) / (2 sin((2b + 1) pi / 6)), and the mode
+    u P(0, u) ~ u^(1 - b) carries L^(2 - b) (1 - Phi(b)) / (2 - b) bounces per bounce upward
+    across a small speed L: none for b = beta (Phi = 1), and for b = 2 (uniform in ln u)
+    Phi'(2) = E[X] = ln r + pi / sqrt(3) = ln(r / r_c), from v = 0 above r_c and into it below.
+    From the kernel at small u: E[ln(v / u)] = pi / sqrt(3) with gravity's correction of order
+    u^(1/2) (the return law's tail beyond v ~ 1), and Phi(beta) = 1 at r = 1/2 and 1/3 (a
+    correction of order u)."""
+    assert np.log(0.5) + np.pi / np.sqrt(3.0) == pytest.approx(
+        np.log(0.5 / CRITICAL_RESTITUTION), rel=1e-14
+    )
+    gains = {u: _mean_over_return(lambda y: y, u) - np.pi / np.sqrt(3.0) for u in (1e-6, 1e-10)}
+    assert abs(gains[1e-10]) < 3.0 * np.sqrt(1e-10)
+    assert gains[1e-6] / gains[1e-10] == pytest.approx(100.0, rel=0.01)  # O(u^(1/2))
+    for r in (0.5, 1.0 / 3.0):
+        beta = small_speed_exponent(r)
+        mode = r ** (beta - 2.0) * _mean_over_return(lambda y, b=beta: np.exp((b - 2.0) * y), 1e-10)
+        assert mode == pytest.approx(1.0, abs=1e-8)
+
+
+@pytest.mark.parametrize("delta", [1e-3, 1e-5, 1e-8])
+def test_m_approaches_one_only_logarithmically_above_one_half(delta):
+    """x(1/2 + delta) = (8/3) delta + O(delta^2) in eq. (asym5), so
+    m(1/2 + delta) = 1 - ln 2 / ln(3 / (16 delta)) to relative order delta."""
+    gap = 1.0 - large_speed_exponent(0.5 + delta)
+    assert gap == pytest.approx(np.log(2.0) / np.log(3.0 / (16.0 * delta)), rel=5.0 * delta)
+
+
+def _crossover_speed(r):
+    """The speed beyond which the large-v form of eqs. (asym3)-(asym6) holds near r = 1/2:
+    1 / (1/(2r) - q) above (the end-point term v^(-3/2) e^(-v/(2r)) against v^-m e^(-q v)),
+    (1/(2r) - 1)^-2 below (the return law's Gaussian spread against the end point's slope)."""
+    q = large_speed_decay_rate(r)
+    return 1.0 / (0.5 / r - q) if r > 0.5 else (0.5 / r - 1.0) ** -2
+
+
+def _local_exponent(equilibrium, v, q):
+    """(-d ln P(0, v) / dv - q) v, which tends to m(r) at large v."""
+    h = 1e-4 * v
+    slope = -(np.log(equilibrium.p0v(v + h)) - np.log(equilibrium.p0v(v - h))) / (2.0 * h)
+    return (slope - q) * v
+
+
+@pytest.mark.parametrize("r", [0.45, 0.49, 0.505, 0.52, 0.55])
+def test_large_speed_form_sets_in_beyond_the_crossover_speed(r):
+    """Near r = 1/2 the solver's local exponent is that of the r = 1/2 form (1) well below the
+    crossover speed v_c (81 at r = 0.45, 2401 at 0.49, 7575 at 0.505, 488 at 0.52, 83 at 0.55)
+    and reaches m(r) only beyond it: at v_c / 32 at least a third of the way from m(r) to 1
+    remains, at v_c (where the solver's grid reaches it) less than a quarter."""
+    equilibrium = Equilibrium(r)
+    q, m = large_speed_decay_rate(r), large_speed_exponent(r)
+    crossover = _crossover_speed(r)
+
+    def remaining(v):
+        return (_local_exponent(equilibrium, v, q) - m) / (1.0 - m)
+
+    assert remaining(crossover / 32.0) > 1.0 / 3.0
+    if crossover < 500.0:
+        assert 0.0 <= remaining(crossover) < 0.25

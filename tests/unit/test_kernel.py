@@ -80,7 +80,7 @@ def test_return_probability_is_one(u):
         v = np.exp(log_v)
         return float(v * v * return_speed_kernel(v, u))
 
-    # the return speed is ~ u +- 2 u^(1/2) for large u; for small u, scale-free around u
+    # the return speed is ~ u +- (4u/3)^(1/2) for large u; for small u, scale-free around u
     centre = np.log(u)
     spread = np.log1p(8.0 / np.sqrt(u)) if u > 1.0 else 3.0
     points = sorted({centre - spread, centre, centre + spread})
@@ -133,3 +133,31 @@ def test_tau_rule_is_converged():
     rule = return_speed_kernel_matrix(v, u)
     resolved = reference > 1e-300
     assert np.max(np.abs(rule[resolved] / reference[resolved] - 1.0)) < 1e-12
+
+
+@pytest.mark.parametrize("u", [50.0, 400.0])
+def test_return_speed_spread_is_four_thirds_of_the_outgoing_speed(u):
+    """A ball leaving with speed u returns with mean u + 4/3 and variance 4u/3 + 8/9, up to
+    terms exponentially small in u (Ito: E[v | u] = E[T | u] - u, E[v^2 | u] = u^2 + 2 E[T | u],
+    E[T | u] = 2u + 4/3 + O(e^(-u/2))), so its standard deviation is
+    (4u/3)^(1/2) (1 + 2/(3u))^(1/2), between (4u/3)^(1/2) and (4u/3)^(1/2) (1 + 1/(3u)):
+    ~1.15 u^(1/2), the spread the solver's u^(1/2) spacing follows (docs/methods.md)."""
+    spread = np.sqrt(u)
+
+    def moment(power):
+        def integrand(v):
+            return float(v**power * return_speed_density(v, u))
+
+        edges = [0.0, u - 6.0 * spread, u, u + 6.0 * spread, u + 40.0 * spread]  # u >= 50
+        return sum(
+            integrate.quad(integrand, a, b, epsabs=0.0, epsrel=1e-13, limit=200)[0]
+            for a, b in zip(edges[:-1], edges[1:])
+        )
+
+    total, first, second = (moment(power) for power in range(3))
+    mean = first / total
+    variance = second / total - mean**2
+    assert mean == pytest.approx(u + 4.0 / 3.0, rel=1e-11)
+    assert variance == pytest.approx(4.0 * u / 3.0 + 8.0 / 9.0, rel=1e-9)
+    excess = np.sqrt(variance / (4.0 * u / 3.0)) - 1.0
+    assert 0.0 < excess <= 1.0 / (3.0 * u)
