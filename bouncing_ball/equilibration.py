@@ -61,6 +61,7 @@ __all__ = [
     "EquilibrationWarning",
     "equilibration_relaxation_time",
     "default_equilibration_time",
+    "relaxation_time_bound",
     "equilibration_problems",
     "warn_equilibration_problems",
     "relaxation_record",
@@ -96,10 +97,9 @@ def equilibration_relaxation_time(restitution) -> float | None:
 
     ``Equilibrium(r).relaxation_time`` (the bounce chain's correlation length times the mean
     flight time, ``relaxation.bounce_chain_relaxation``) where the solver answers it,
-    r_c < r <= 0.9999; above 0.9999 the quasi-elastic limit of the slowest decay in
-    continuous time, 64 / (9 (1 - r)^2) (``quasi_elastic.relaxation_time``, longer than the
-    chain's by 8/3: a safe side).  None at or below r_c (eq. (rc)), where the outgoing speeds
-    collapse and the chain has no relaxation eigenvalue.
+    r_c < r <= 0.9999; above 0.9999 its quasi-elastic form, (8/3) (1 - r)^-2 to first order
+    (``quasi_elastic.quasi_elastic_form("bounce_chain_time", r)``).  None at or below r_c
+    (eq. (rc)), where the outgoing speeds collapse and the chain has no relaxation eigenvalue.
 
     Parameters
     ----------
@@ -119,7 +119,7 @@ def equilibration_relaxation_time(restitution) -> float | None:
     >>> print(equilibration_relaxation_time(0.1))
     None
     >>> print(f"{equilibration_relaxation_time(0.99999):.4g}")
-    7.111e+10
+    2.667e+10
     """
     from .asymptotics import CRITICAL_RESTITUTION
     from .restitution import SOLVER_RESTITUTION_RANGE, parse_restitution
@@ -128,12 +128,59 @@ def equilibration_relaxation_time(restitution) -> float | None:
     if exact <= CRITICAL_RESTITUTION:
         return None
     if exact > SOLVER_RESTITUTION_RANGE[1]:
-        from .quasi_elastic import relaxation_time
+        from .quasi_elastic import quasi_elastic_form
 
-        return float(relaxation_time(exact))
+        return quasi_elastic_form("bounce_chain_time", exact)
     from .equilibrium import Equilibrium
 
     return float(Equilibrium(exact).relaxation_time)
+
+
+def relaxation_time_bound(restitution) -> float:
+    """An upper bound of the relaxation time at r that needs no solve: 3 / (r - r_c) + 4 / (1 - r)^2.
+
+    The relaxation time (``equilibration_relaxation_time``) diverges as 1.93 / (r - r_c) at
+    r_c (eq. (rc)) and as (8/3) / (1 - r)^2 at r -> 1 (docs/quasi_elastic.md); this sum of
+    the two, with margins, lies above it by a factor of at least 1.4 at every r_c < r < 1
+    (``tests/unit/test_equilibration.py`` holds it against the solver from r_c + 1e-5 to
+    0.9999, and the quasi-elastic limit beyond).  ``default_equilibration_time`` and
+    ``equilibration_problems`` solve eq. (inteq) only where the bound leaves the answer open.
+
+    Parameters
+    ----------
+    restitution : float, str or fractions.Fraction
+        r, r_c < r < 1.
+
+    Returns
+    -------
+    float
+        In the paper's time units.
+
+    Raises
+    ------
+    ValueError
+        If r is not above r_c, where there is no relaxation time.
+
+    Examples
+    --------
+    >>> from bouncing_ball.equilibration import relaxation_time_bound
+    >>> print(round(relaxation_time_bound("1/2"), 3))
+    24.903
+    """
+    from .asymptotics import CRITICAL_RESTITUTION
+    from .restitution import parse_restitution
+
+    r = float(parse_restitution(restitution, "r"))
+    if not r > CRITICAL_RESTITUTION:
+        raise ValueError(f"r = {restitution}: at or below r_c there is no relaxation time")
+    return 3.0 / (r - CRITICAL_RESTITUTION) + 4.0 / (1.0 - r) ** 2
+
+
+def _above_critical(restitution) -> bool:
+    from .asymptotics import CRITICAL_RESTITUTION
+    from .restitution import parse_restitution
+
+    return parse_restitution(restitution, "r") > CRITICAL_RESTITUTION
 
 
 def default_equilibration_time(restitution) -> float:
@@ -160,9 +207,14 @@ def default_equilibration_time(restitution) -> float:
     >>> default_equilibration_time(0.95), default_equilibration_time(0.99)
     (21000.0, 530000.0)
     """
-    relaxation = equilibration_relaxation_time(restitution)
-    if relaxation is None:
+    if not _above_critical(restitution):
         return MIN_EQUILIBRATION_TIME
+    if (
+        EQUILIBRATION_RELAXATION_TIMES * relaxation_time_bound(restitution)
+        <= MIN_EQUILIBRATION_TIME
+    ):
+        return MIN_EQUILIBRATION_TIME  # the same answer, without solving eq. (inteq)
+    relaxation = equilibration_relaxation_time(restitution)
     return max(MIN_EQUILIBRATION_TIME, _two_digits_up(EQUILIBRATION_RELAXATION_TIMES * relaxation))
 
 
@@ -209,9 +261,14 @@ def equilibration_problems(
     """
     from .restitution import parse_restitution, restitution_label
 
-    relaxation = equilibration_relaxation_time(restitution)
-    if relaxation is None:
+    if not _above_critical(restitution):
         return []
+    bound = relaxation_time_bound(restitution)
+    needed_bound = EQUILIBRATION_RELAXATION_TIMES * bound
+    equilibrated = equilibration_time >= needed_bound or needed_bound <= MIN_EQUILIBRATION_TIME
+    if equilibrated and shard_time >= SHARD_RELAXATION_TIMES * bound:
+        return []  # the same answer, without solving eq. (inteq)
+    relaxation = equilibration_relaxation_time(restitution)
     label = restitution_label(parse_restitution(restitution, "r"))
     problems = []
     needed = EQUILIBRATION_RELAXATION_TIMES * relaxation

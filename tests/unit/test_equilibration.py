@@ -216,3 +216,18 @@ def test_simulate_warns_of_shards_too_short_for_the_relaxation_time():
     with pytest.warns(EquilibrationWarning, match="r = 0.95: shard_time = 2000 is shorter"):
         result = simulate(0.95, shards=2, shard_time=2e3, seed=1, progress=False)
     assert result.settings.equilibration_time == default_equilibration_time(0.95)
+
+
+def test_the_relaxation_time_bound_lies_above_the_relaxation_time_at_every_r():
+    """3 / (r - r_c) + 4 / (1 - r)^2 against the solver's relaxation time from just above r_c
+    to 0.9999 (and the quasi-elastic limit beyond): above it by at least the stated 1.4, so
+    that the checks it answers without a solve answer as the solve would."""
+    from bouncing_ball.asymptotics import CRITICAL_RESTITUTION
+    from bouncing_ball.equilibration import equilibration_relaxation_time, relaxation_time_bound
+
+    near_critical = CRITICAL_RESTITUTION + np.array([1e-5, 1e-3])
+    grid = [*near_critical, 0.17, 0.2, 0.25, 0.3, 0.4, 0.5, 0.55, 0.6, 0.65, 0.7, 0.8, 0.9]
+    for r in [*grid, 0.97, 0.995, 0.9999, 0.99999]:
+        assert relaxation_time_bound(r) >= 1.4 * equilibration_relaxation_time(r), r
+    with pytest.raises(ValueError, match="r_c"):
+        relaxation_time_bound(0.1)
