@@ -993,7 +993,7 @@ def _ray_sums(rho_v, rho_u, log_columns, shift, ray, gl_x, gl_w, hermite_x2, her
 class _RayDensity:
     """P(0, v) on the ray v = rho e^(i RAY_ANGLE), solved from eq. (inteq) with u on the same
     ray (the u contour of the Nystrom formula rotated: no cancelling sum), normalised by the
-    small-v power law C v^-beta of the real-axis solution continued to the ray."""
+    momentum balance M_2 = r / (1 + r) with its contour rotated onto the ray."""
 
     restitution: float
     beta: float
@@ -1047,9 +1047,9 @@ def _ray_density(solution, panel_width=1.0, panel_order=20) -> _RayDensity:
     """Solve eq. (inteq) on the ray arg v = RAY_ANGLE (``_RayDensity``): the solver's rule in
     s = ln rho + rho^(1/2), RAY_REFINE times finer, from its lowest node u_0 (with the power law
     below, as the solver) to RAY_REACH / q; the eigenvector of eigenvalue nearest 1 by inverse
-    iteration on the operator scaled by u^-beta e^(-q u), normalised to C u_0^-beta at u_0
-    (relative error O(u_0), as the real axis' own power law); then ln(P e^(q v) v^beta) on
-    Chebyshev panels in s from the Nystrom formula on the ray."""
+    iteration on the operator scaled by u^-beta e^(-q u), a sparse band (``_ray_operator``) with
+    a sparse LU, normalised by the momentum balance rotated onto the ray; then
+    ln(P e^(q v) v^beta) on Chebyshev panels in s from the Nystrom formula on the ray."""
     r = solution.restitution
     beta = solution.small_speed_exponent
     q = large_speed_decay_rate(r)
@@ -2025,9 +2025,9 @@ SMALLEST_POSITION = 1e-300
 LARGEST_POSITION = 1e12
 #: Beyond this speed abs(v), P(x, v) is 0 to every double (``Equilibrium.pxv``): on the floor P(0, v) ~
 #: e^(-q v) and P(0, -v) = r^2 P(0, r v) fall below e^-1400 at every r of
-#: DISTRIBUTION_RESTITUTION_RANGE (r q = 7.46e-3 at r = 0.995), and above it P(x, v) is a
-#: Gaussian in v of variance <v^2>_x < 1e7 wherever P(x) is a double, e^-2000 down there.
-LARGEST_VELOCITY = 2e5
+#: DISTRIBUTION_RESTITUTION_RANGE (r q = 1.5e-3 at r = 0.999), and above it P(x, v) is a
+#: Gaussian in v of variance <v^2>_x < 1e8 wherever P(x) is a double, e^-5000 down there.
+LARGEST_VELOCITY = 1e6
 #: The smallest F of the config's ``solver.forces``: above ``Equilibrium.smallest_force`` (below
 #: which w(F) ~ F^gamma e^(-S/F), S < 0, exceeds the largest double) at every r of
 #: DISTRIBUTION_RESTITUTION_RANGE (-S / F < 1 / (12 F) = 417 < 709 at 2e-4 for every r).
