@@ -95,7 +95,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
-from scipy import integrate, linalg, optimize, special
+from scipy import integrate, optimize, sparse, special
+from scipy.sparse import linalg as sparse_linalg
 
 from .airy import (
     LARGEST_AIRY_PHASE,
@@ -807,6 +808,10 @@ RAY_RESTITUTION = 0.9
 #: values are used up to half of it (the truncated operator spoils the top of its grid).
 RAY_REACH = 400.0
 RAY_REFINE = 2  # the ray's grid is this many times finer than the solver's
+#: An entry of the ray's operator whose Gaussian bound is below e^-RAY_NEGLIGIBLE_EFOLDS
+#: (~1e-52) of its row's largest is dropped: the operator is a band where rho is large (the
+#: return speed of a flight leaving at u spreads over ~(4 u / 3)^(1/2)), solved as sparse.
+RAY_NEGLIGIBLE_EFOLDS = 120.0
 _RAY_GL = tuple(np.polynomial.legendre.leggauss(count) for count in (20, 40, 64))
 _RAY_GL_X = np.zeros((3, 64))
 _RAY_GL_W = np.zeros((3, 64))
@@ -861,19 +866,105 @@ def _ray_log_kernel(rho_v, rho_u, ray, gl_x, gl_w, hermite_x2, hermite_w):
 
 
 @njit(cache=True)
-def _ray_operator(rho_v, rho_u, log_columns, log_rows, ray, gl_x, gl_w, hermite_x2, hermite_w):
-    """M_ij = exp(ln G_g(rho_v_i ray, rho_u_j ray) + log_columns_j - log_rows_i), 0 where its
-    Gaussian bound (the real part of the exponent) is below e^-UNDERFLOW_EFOLDS."""
-    out = np.zeros((rho_v.size, rho_u.size), dtype=np.complex128)
-    for i in range(rho_v.size):
-        for j in range(rho_u.size):
+def _ray_operator_band(
+    rho_v, rho_u, log_columns, log_rows, floor, cut, ray, gl_x, gl_w, hermite_x2, hermite_w
+):
+    """The entries M_ij = exp(ln G_g(rho_v_i ray, rho_u_j ray) + log_columns_j - log_rows_i)
+    that matter, as a CSR matrix (indptr, indices, data) and each row's largest Gaussian bound.
+
+    The bound of M_ij is its level ray.real (-(3/4) (v - u)^2 / ((v + u)/2 + z0)) (the kernel's
+    Gaussian, ``kernel._full_geometry``) + Re(log_columns_j - log_rows_i).  Row i keeps the
+    contiguous j from the node nearest to rho_v_i outward both ways, and stops on a side where
+    the level of every further entry is below the row's largest level (at least floor_i) by
+    cut: the Gaussian falls away from u = v on both sides (width ~ (4 u / 3)^(1/2), so the rows
+    of large rho keep a band) and the column factor beyond is at most its running maximum."""
+    count_v = rho_v.size
+    count_u = rho_u.size
+    columns = log_columns.real
+    ahead = np.empty(count_u)  # max of columns[j:]
+    behind = np.empty(count_u)  # max of columns[:j + 1]
+    ahead[count_u - 1] = columns[count_u - 1]
+    for j in range(count_u - 2, -1, -1):
+        ahead[j] = max(columns[j], ahead[j + 1])
+    behind[0] = columns[0]
+    for j in range(1, count_u):
+        behind[j] = max(columns[j], behind[j - 1])
+    lo = np.empty(count_v, dtype=np.int64)
+    hi = np.empty(count_v, dtype=np.int64)
+    best = np.empty(count_v)
+    for i in range(count_v):
+        start = np.searchsorted(rho_u, rho_v[i])  # rho_u[j] >= rho_v[i] from here
+        top = floor[i]
+        lo[i] = start
+        for j in range(start - 1, -1, -1):  # u < v: the Gaussian falls as j decreases
             exponent, _, _ = _full_geometry(rho_v[i], rho_u[j])
-            level = ray.real * exponent + log_columns[j].real - log_rows[i].real
-            if level < -UNDERFLOW_EFOLDS:
-                continue
-            log_g = _ray_log_kernel(rho_v[i], rho_u[j], ray, gl_x, gl_w, hermite_x2, hermite_w)
-            out[i, j] = cmath.exp(log_g + log_columns[j] - log_rows[i])
-    return out
+            top = max(top, ray.real * exponent + columns[j] - log_rows[i].real)
+            if ray.real * exponent + behind[j] - log_rows[i].real < top - cut:
+                break
+            lo[i] = j
+        hi[i] = start - 1
+        for j in range(start, count_u):  # u >= v: the Gaussian falls as j increases
+            exponent, _, _ = _full_geometry(rho_v[i], rho_u[j])
+            top = max(top, ray.real * exponent + columns[j] - log_rows[i].real)
+            if ray.real * exponent + ahead[j] - log_rows[i].real < top - cut:
+                break
+            hi[i] = j
+        best[i] = top
+    indptr = np.zeros(count_v + 1, dtype=np.int64)
+    for i in range(count_v):
+        indptr[i + 1] = indptr[i] + max(0, hi[i] - lo[i] + 1)
+    indices = np.empty(indptr[-1], dtype=np.int64)
+    data = np.zeros(indptr[-1], dtype=np.complex128)
+    for i in range(count_v):
+        k = indptr[i]
+        for j in range(lo[i], hi[i] + 1):
+            indices[k] = j
+            exponent, _, _ = _full_geometry(rho_v[i], rho_u[j])
+            level = ray.real * exponent + columns[j] - log_rows[i].real
+            if level >= best[i] - cut and level >= -UNDERFLOW_EFOLDS:
+                log_g = _ray_log_kernel(rho_v[i], rho_u[j], ray, gl_x, gl_w, hermite_x2, hermite_w)
+                data[k] = cmath.exp(log_g + log_columns[j] - log_rows[i])
+            k += 1
+    return indptr, indices, data, best
+
+
+def _ray_operator(rho_v, rho_u, log_columns, tail_u, tail_columns, log_rows, ray):
+    """The scaled Nystrom operator of eq. (inteq) on the ray (``_ray_density``), sparse: the
+    entries within e^-RAY_NEGLIGIBLE_EFOLDS of their row's largest Gaussian bound
+    (``_ray_operator_band``), with the lower tail's (u = tail_u, below the lowest node) summed
+    into column 0."""
+    args = (ray, _RAY_GL_X, _RAY_GL_W, _RAY_HERMITE_X2, _RAY_HERMITE_W)
+    rows = np.ascontiguousarray(log_rows)
+    count = rho_v.size
+    indptr, indices, data, best = _ray_operator_band(
+        rho_v,
+        rho_u,
+        np.ascontiguousarray(log_columns),
+        rows,
+        np.full(count, -np.inf),
+        RAY_NEGLIGIBLE_EFOLDS,
+        *args,
+    )
+    operator = sparse.csr_matrix((data, indices, indptr), shape=(count, rho_u.size))
+    indptr, indices, data, _ = _ray_operator_band(
+        rho_v,
+        tail_u,
+        np.ascontiguousarray(tail_columns),
+        rows,
+        best,
+        RAY_NEGLIGIBLE_EFOLDS,
+        *args,
+    )
+    tail = sparse.csr_matrix((data, indices, indptr), shape=(count, tail_u.size))
+    column = sparse.csr_matrix(
+        (
+            np.asarray(tail.sum(axis=1)).ravel(),
+            np.zeros(count, dtype=np.int64),
+            np.arange(count + 1),
+        ),
+        shape=(count, rho_u.size),
+    )
+    return operator + column
 
 
 @njit(cache=True)
@@ -902,7 +993,7 @@ def _ray_sums(rho_v, rho_u, log_columns, shift, ray, gl_x, gl_w, hermite_x2, her
 class _RayDensity:
     """P(0, v) on the ray v = rho e^(i RAY_ANGLE), solved from eq. (inteq) with u on the same
     ray (the u contour of the Nystrom formula rotated: no cancelling sum), normalised by the
-    small-v power law C v^-beta of the real-axis solution continued to the ray."""
+    momentum balance M_2 = r / (1 + r) with its contour rotated onto the ray."""
 
     restitution: float
     beta: float
@@ -956,9 +1047,9 @@ def _ray_density(solution, panel_width=1.0, panel_order=20) -> _RayDensity:
     """Solve eq. (inteq) on the ray arg v = RAY_ANGLE (``_RayDensity``): the solver's rule in
     s = ln rho + rho^(1/2), RAY_REFINE times finer, from its lowest node u_0 (with the power law
     below, as the solver) to RAY_REACH / q; the eigenvector of eigenvalue nearest 1 by inverse
-    iteration on the operator scaled by u^-beta e^(-q u), normalised to C u_0^-beta at u_0
-    (relative error O(u_0), as the real axis' own power law); then ln(P e^(q v) v^beta) on
-    Chebyshev panels in s from the Nystrom formula on the ray."""
+    iteration on the operator scaled by u^-beta e^(-q u), a sparse band (``_ray_operator``) with
+    a sparse LU, normalised by the momentum balance rotated onto the ray; then
+    ln(P e^(q v) v^beta) on Chebyshev panels in s from the Nystrom formula on the ray."""
     r = solution.restitution
     beta = solution.small_speed_exponent
     q = large_speed_decay_rate(r)
@@ -979,16 +1070,11 @@ def _ray_density(solution, panel_width=1.0, panel_order=20) -> _RayDensity:
         - beta * np.log(tail / u0)
         + log_scale[0]
     )
-    args = (ray, _RAY_GL_X, _RAY_GL_W, _RAY_HERMITE_X2, _RAY_HERMITE_W)
-    rows = np.ascontiguousarray(log_scale)
-    operator = _ray_operator(rho / r, rho, np.ascontiguousarray(main_columns), rows, *args)
-    operator[:, 0] += _ray_operator(
-        rho / r, tail, np.ascontiguousarray(tail_columns), rows, *args
-    ).sum(axis=1)
-    factors = linalg.lu_factor(operator - np.eye(count), check_finite=False)
+    operator = _ray_operator(rho / r, rho, main_columns, tail, tail_columns, log_scale, ray)
+    factors = sparse_linalg.splu((operator - sparse.identity(count, format="csc")).tocsc())
     y = np.ones(count, dtype=complex)
     for _ in range(3):
-        y = linalg.lu_solve(factors, y, check_finite=False)
+        y = factors.solve(y)
         y /= y[np.argmax(np.abs(y))]
     eigenvalue = complex(np.vdot(y, operator @ y) / np.vdot(y, y))
     # normalised by the momentum balance M_2 = r / (1 + r) (solver.py) with its v contour
@@ -1939,9 +2025,9 @@ SMALLEST_POSITION = 1e-300
 LARGEST_POSITION = 1e12
 #: Beyond this speed abs(v), P(x, v) is 0 to every double (``Equilibrium.pxv``): on the floor P(0, v) ~
 #: e^(-q v) and P(0, -v) = r^2 P(0, r v) fall below e^-1400 at every r of
-#: DISTRIBUTION_RESTITUTION_RANGE (r q = 7.46e-3 at r = 0.995), and above it P(x, v) is a
-#: Gaussian in v of variance <v^2>_x < 1e7 wherever P(x) is a double, e^-2000 down there.
-LARGEST_VELOCITY = 2e5
+#: DISTRIBUTION_RESTITUTION_RANGE (r q = 1.5e-3 at r = 0.999), and above it P(x, v) is a
+#: Gaussian in v of variance <v^2>_x < 1e8 wherever P(x) is a double, e^-5000 down there.
+LARGEST_VELOCITY = 1e6
 #: The smallest F of the config's ``solver.forces``: above ``Equilibrium.smallest_force`` (below
 #: which w(F) ~ F^gamma e^(-S/F), S < 0, exceeds the largest double) at every r of
 #: DISTRIBUTION_RESTITUTION_RANGE (-S / F < 1 / (12 F) = 417 < 709 at 2e-4 for every r).

@@ -433,7 +433,7 @@ class _EquilibriumState:
             Velocities (either sign), finite, broadcast against ``x``.  At x > 0 and v > 0 the
             F integral's Airy factor oscillates, and P(x, v) is computed only where its phase
             stays below ``airy.LARGEST_AIRY_PHASE`` (x >= 60 (v^(3/2) / 6e4)^2: x >= 1e-4 up to
-            v = 18).  Beyond ``distribution.LARGEST_VELOCITY`` (2e5) in |v|, P(x, v) is 0 to
+            v = 18).  Beyond ``distribution.LARGEST_VELOCITY`` (1e6) in |v|, P(x, v) is 0 to
             every double and 0 is returned.
 
         Returns

@@ -34,10 +34,11 @@ EXACT_RESTITUTIONS = (Fraction(1, 2), Fraction(1, 3))
 #: ~ (1 - r)^(-1/2) nodes, outgrows a job.  The bounds are exact decimals: 0.02 is 1/50.
 SOLVER_RESTITUTION_RANGE = (0.02, 0.9999)
 #: The r for which the whole distribution from P(0, v) (bouncing_ball.distribution: w(F), P(x),
-#: P(x, v)) meets the same target, and so every table of rule solve: the r of a run.  Above, int
-#: P(0, v) on the ray of the contour of w(F) needs a dense complex matrix of ~(1 - r)^(-1/2)
-#: nodes (bouncing_ball.distribution, RAY_REACH), which outgrows a job above 0.995.
-DISTRIBUTION_RESTITUTION_RANGE = (0.02, 0.995)
+#: P(x, v)) meets the same target, and so every table of rule solve: the r of a run.  Above,
+#: int P dx and the moments of P(x) miss their Ito values by more than 1e-8: w(F) is taken on the
+#: ray arg v = RAY_ANGLE of bouncing_ball.distribution, along which the integrand of A(F) is
+#: largest at v = 0 only for q >= q(0.999).
+DISTRIBUTION_RESTITUTION_RANGE = (0.02, 0.999)
 
 
 def in_range(exact, bounds) -> bool:

@@ -317,13 +317,13 @@ DISTRIBUTION_HIGH = DISTRIBUTION_RESTITUTION_RANGE[1]
 
 @pytest.fixture(scope="module")
 def near_one():
-    """r = 0.999, above DISTRIBUTION_RESTITUTION_RANGE (where the ray solve of P(0, v) outgrows
-    a job)."""
-    return bb.Equilibrium(0.999)
+    """r = 0.9995, above DISTRIBUTION_RESTITUTION_RANGE (where P(x) misses its Ito moments by
+    more than 1e-8)."""
+    return bb.Equilibrium(0.9995)
 
 
 def test_above_the_distribution_range_the_speed_quantities_are_given(near_one):
-    """P(0, v), the time averages, the flight times and the exponents at r = 0.999: the solution
+    """P(0, v), the time averages, the flight times and the exponents at r = 0.9995: the solution
     balances energy (an identity the solve does not impose) to the solver's target, and the
     exponents are the asymptotic ones."""
     eq = near_one
@@ -338,8 +338,8 @@ def test_above_the_distribution_range_the_speed_quantities_are_given(near_one):
     assert eq.mean_flight_time == pytest.approx(1.0 / eq.collision_rate, rel=1e-10)
     density = eq.flight_time_density([0.1, 1.0, 100.0])
     assert np.all(np.isfinite(density)) and np.all(density > 0.0)
-    assert eq.beta == small_speed_exponent(0.999) and eq.m == large_speed_exponent(0.999)
-    assert eq.q == large_speed_decay_rate(0.999)
+    assert eq.beta == small_speed_exponent(0.9995) and eq.m == large_speed_exponent(0.9995)
+    assert eq.q == large_speed_decay_rate(0.9995)
     assert set(eq.p0v_table(speeds).columns) == {"v", "p0v"}
     assert np.all(np.isfinite(eq.flight_time_table([1.0, 10.0])["density"]))
 
@@ -363,7 +363,7 @@ def test_above_the_distribution_range_the_speed_quantities_are_given(near_one):
 def test_above_the_distribution_range_the_position_quantities_are_refused(near_one, name, call):
     """Above the range of the whole distribution P(x), w(F) and P(x, v) are refused, naming r,
     the range and the method."""
-    with pytest.raises(ValueError, match=rf"^r: r = 0.999 .* {LOW} <= r <= {DISTRIBUTION_HIGH}\b"):
+    with pytest.raises(ValueError, match=rf"^r: r = 0.9995 .* {LOW} <= r <= {DISTRIBUTION_HIGH}\b"):
         call(near_one)
     with pytest.raises(ValueError, match=rf"Equilibrium.{name} needs w\(F\)"):
         call(near_one)

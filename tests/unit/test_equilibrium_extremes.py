@@ -10,6 +10,7 @@ from workflow_support import REPOSITORY
 
 from bouncing_ball import Equilibrium, ExactEquilibrium, distribution, exact, solver
 from bouncing_ball.distribution import LARGEST_POSITION, SMALLEST_POSITION
+from bouncing_ball.restitution import DISTRIBUTION_RESTITUTION_RANGE
 from bouncing_ball.workflow.config import read_yaml
 
 EXACT = ("1/2", "1/3")
@@ -177,9 +178,11 @@ def test_pxv_is_zero_beyond_the_largest_velocity_and_refuses_heights_outside(pai
 
 
 def test_pxv_is_zero_beyond_the_largest_velocity_at_every_r():
-    """P(0, r v) at r = 0.9 (the smallest r q of the range) underflows at v = LARGEST_VELOCITY."""
-    eq = Equilibrium(0.9)
-    assert eq.p0v(0.9 * distribution.LARGEST_VELOCITY) == 0.0
+    """P(0, r v) at the upper end of DISTRIBUTION_RESTITUTION_RANGE (the smallest r q of the
+    range) underflows at v = LARGEST_VELOCITY."""
+    r = DISTRIBUTION_RESTITUTION_RANGE[1]
+    eq = Equilibrium(r)
+    assert eq.p0v(r * distribution.LARGEST_VELOCITY) == 0.0
 
 
 def test_bin_averages_never_depend_on_the_other_bins(pair):
