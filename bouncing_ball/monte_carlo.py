@@ -3,7 +3,7 @@ this process or on several) and returns a ``SimulationResult`` with the observab
 ``Equilibrium`` and their jackknife errors.
 
 It is the workflow's machinery, called directly: shard k of r draws from
-``simulation.shard_seed_sequence(seed, label of r, k)`` (``batches.simulate_batch``), so a
+``simulation.shard_seed_sequence(seed, label of r, k)`` (``workflow.batches.simulate_batch``), so a
 shard of ``simulate`` is the workflow's shard k for the same seed and settings, whatever the
 number of processes; the tables are ``histograms``' (the workflow's merge stage).
 
@@ -658,9 +658,9 @@ class SimulationResult:
     )
 
     def batch_frame(self):
-        """The shards as one table in the workflow's batch format (``batches.batch_to_frame``;
+        """The shards as one table in the workflow's batch format (``tallies.batch_to_frame``;
         ``results/simulation/r{r}/shards{first}-{last}.parquet``)."""
-        from .workflow.batches import batch_to_frame
+        from .tallies import batch_to_frame
 
         return batch_to_frame(dict(zip(self.shard_indices, self.tallies)))
 
