@@ -787,7 +787,7 @@ class SimulationResult:
         >>> from bouncing_ball import simulate
         >>> result = simulate("1/2", shards=4, shard_time=200.0, seed=1, progress=False)
         >>> table = result.observables()
-        >>> table.set_index(["observable", "estimator"]).loc["mean_x", "plain"].dof
+        >>> int(table.set_index(["observable", "estimator"]).loc["mean_x", "plain"].dof)
         3
         """
         import pandas as pd

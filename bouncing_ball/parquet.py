@@ -5,6 +5,19 @@ key ``bouncing_ball`` of the Parquet key-value metadata.  A table is a pandas fr
 pyarrow table.  The library's files (``SimulationResult.save``) and the workflow's
 (``workflow.io``, which adds the workflow's kinds of table and its remedies) are written and
 read here.
+
+Examples
+--------
+A table written with its provenance, read back with it:
+
+>>> import tempfile, pathlib
+>>> import pandas as pd
+>>> import pyarrow.parquet as pq
+>>> from bouncing_ball.parquet import read_parquet, read_provenance, write_table
+>>> path = pathlib.Path(tempfile.mkdtemp()) / "table.parquet"
+>>> write_table(pd.DataFrame({"v": [0.5, 1.0]}), path, {"r": "1/2"})
+>>> read_provenance(path)["r"], read_parquet(pq.read_table, path).num_rows
+('1/2', 2)
 """
 
 import json
@@ -39,9 +52,21 @@ class UnreadableFileError(RuntimeError):
 
 @contextmanager
 def atomic_paths(*paths):
-    """Temporary names next to ``paths`` to write to; all are renamed to ``paths`` only
-    if the block finishes, all removed otherwise: a reader never sees a half-written
-    file, and a rule's outputs appear together or not at all."""
+    """Temporary names next to ``paths`` to write to, renamed to ``paths`` at the end.
+
+    All are renamed to ``paths`` only if the block finishes, all removed otherwise: a reader
+    never sees a half-written file, and a rule's outputs appear together or not at all.
+
+    Parameters
+    ----------
+    *paths : str or os.PathLike
+        The files to write; their folders are made if missing.
+
+    Returns
+    -------
+    contextmanager
+        Yields the list of temporary paths (str), one per path, in order.
+    """
     paths = [Path(path) for path in paths]
     temporaries = []
     try:
@@ -86,8 +111,19 @@ def _umask() -> int:
 
 
 def with_provenance(frame, provenance: dict) -> pa.Table:
-    """``frame`` (a pandas frame or a pyarrow table) as a pyarrow table carrying
-    ``provenance`` and the package version as JSON under ``METADATA_KEY``."""
+    """A table carrying its provenance and the package version under ``METADATA_KEY``.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame or pyarrow.Table
+        The table (a frame's index is dropped).
+    provenance : dict
+        JSON-ready; a value JSON does not know is written as its ``str``.
+
+    Returns
+    -------
+    pyarrow.Table
+    """
     table = (
         frame if isinstance(frame, pa.Table) else pa.Table.from_pandas(frame, preserve_index=False)
     )
@@ -99,8 +135,19 @@ def with_provenance(frame, provenance: dict) -> pa.Table:
 
 
 def write_tables(frames: dict, provenance: dict) -> None:
-    """Write each frame of ``{path: frame}`` with ``provenance``; all or none of them
-    appear (``atomic_paths``), as a rule's outputs should."""
+    """Write each frame of ``{path: frame}`` with ``provenance``; all or none appear.
+
+    Parameters
+    ----------
+    frames : dict
+        ``{path: frame}``, each frame a pandas frame or a pyarrow table.
+    provenance : dict
+        As for ``with_provenance``.
+
+    Returns
+    -------
+    None
+    """
     tables = [with_provenance(frame, provenance) for frame in frames.values()]
     with atomic_paths(*frames) as temporaries:
         for table, temporary in zip(tables, temporaries, strict=True):
@@ -108,14 +155,42 @@ def write_tables(frames: dict, provenance: dict) -> None:
 
 
 def write_table(frame, path, provenance: dict) -> None:
-    """Write ``frame`` (a pandas frame or a pyarrow table) to ``path`` with ``provenance``;
-    atomic (temp file, then rename)."""
+    """Write ``frame`` to ``path`` with ``provenance``, atomically (temp file, then rename).
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame or pyarrow.Table
+    path : str or os.PathLike
+    provenance : dict
+        As for ``with_provenance``.
+
+    Returns
+    -------
+    None
+
+    Examples
+    --------
+    See the module's example.
+    """
     write_tables({path: frame}, provenance)
 
 
 def read_parquet(read, path: Path, remedy: str = ""):
-    """``read(path)`` (pyarrow's ``read_table`` or ``read_schema``), its failures an
-    ``UnreadableFileError`` naming the file, with ``remedy`` (what to do) appended."""
+    """``read(path)``, its failures an ``UnreadableFileError`` naming the file.
+
+    Parameters
+    ----------
+    read : callable
+        ``pyarrow.parquet.read_table`` or ``read_schema``.
+    path : pathlib.Path
+    remedy : str, optional
+        What to do about it, appended to the message.
+
+    Returns
+    -------
+    pyarrow.Table or pyarrow.Schema
+        What ``read`` returns.
+    """
     try:
         return read(path)
     except FileNotFoundError:
@@ -127,8 +202,22 @@ def read_parquet(read, path: Path, remedy: str = ""):
 
 
 def provenance_of(path, schema, remedy: str = "") -> dict:
-    """The provenance in ``schema`` (the schema of the file ``path``); an
-    ``UnreadableFileError`` naming the file, with ``remedy`` appended, when it has none."""
+    """The provenance in ``schema``, the schema of the file ``path``.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file, named in the error.
+    schema : pyarrow.Schema
+    remedy : str, optional
+        Appended to the error's message.
+
+    Returns
+    -------
+    dict
+        The provenance; ``UnreadableFileError`` naming the file when there is none, or it
+        is not a JSON object.
+    """
     raw = (schema.metadata or {}).get(METADATA_KEY)
     if raw is None:
         raise UnreadableFileError(
@@ -145,6 +234,25 @@ def provenance_of(path, schema, remedy: str = "") -> dict:
 
 
 def read_provenance(path) -> dict:
-    """The provenance of a table written by ``write_table``, without reading its data."""
+    """The provenance of a table written by ``write_table``, without reading its data.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    dict
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> import pandas as pd
+    >>> from bouncing_ball.parquet import read_provenance, write_table
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "table.parquet"
+    >>> write_table(pd.DataFrame({"v": [0.5]}), path, {"r": "1/2"})
+    >>> read_provenance(path)["r"]
+    '1/2'
+    """
     path = Path(path)
     return provenance_of(path, read_parquet(pq.read_schema, path))

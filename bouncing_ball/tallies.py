@@ -659,8 +659,14 @@ def _arrow_array(values: np.ndarray, kind):
 
 
 def batch_schema():
-    """The Arrow schema of a batch's table: ``shard`` (int64), then ``COLUMNS`` (``tally`` a
-    large_string, as pandas writes str columns, the rest float64)."""
+    """The Arrow schema of a batch's table.
+
+    Returns
+    -------
+    pyarrow.Schema
+        ``shard`` (int64), then ``COLUMNS`` (``tally`` a large_string, as pandas writes str
+        columns, the rest float64).
+    """
     import pyarrow as pa
 
     return pa.schema(
@@ -673,9 +679,34 @@ def batch_schema():
 
 
 def batch_to_table(batch: dict[int, ShardTallies]):
-    """The table of a batch of shards, ``{shard: tallies}``: their long tables
-    (``tallies_to_columns``) one after the other, in the order of the shards, with a first
-    column ``shard`` (``batch_schema``); a pyarrow.Table, made without pandas."""
+    """The table of a batch of shards, made without pandas.
+
+    Parameters
+    ----------
+    batch : dict
+        ``{shard index: ShardTallies}``, at least one shard.
+
+    Returns
+    -------
+    pyarrow.Table
+        The shards' long tables (``tallies_to_columns``) one after the other, in the order
+        of the shards, with a first column ``shard`` (``batch_schema``).
+
+    Examples
+    --------
+    >>> from bouncing_ball.bins import LinearBins, LogBins
+    >>> from bouncing_ball.settings import ShardSettings
+    >>> from bouncing_ball.tallies import ShardTallies, batch_from_table, batch_to_table
+    >>> settings = ShardSettings(
+    ...     shard_time=1.0, equilibration_time=0.0, criterion_c=5, min_step_divisor=10,
+    ...     max_steps=100, speed_bins=LogBins(0.1, 10.0, 1),
+    ...     position_bins=LogBins(0.1, 10.0, 1), velocity_bins=LinearBins(-1.0, 1.0, 1.0),
+    ...     flight_time_bins=LogBins(0.1, 10.0, 1),
+    ... )
+    >>> shard = ShardTallies.from_loop(settings, ShardTallies.loop_arrays(settings))
+    >>> sorted(batch_from_table(batch_to_table({3: shard, 1: shard}), settings))
+    [1, 3]
+    """
     import pyarrow as pa
 
     if not batch:
@@ -695,13 +726,42 @@ def batch_to_table(batch: dict[int, ShardTallies]):
 
 
 def batch_to_frame(batch: dict[int, ShardTallies]) -> "pd.DataFrame":
-    """The table of a batch (``batch_to_table``) as a pandas frame."""
+    """The table of a batch (``batch_to_table``) as a pandas frame.
+
+    Parameters
+    ----------
+    batch : dict
+        ``{shard index: ShardTallies}``.
+
+    Returns
+    -------
+    pandas.DataFrame
+    """
     return batch_to_table(batch).to_pandas()
 
 
 def batch_from_table(table, settings, source: str = "batch") -> dict[int, ShardTallies]:
-    """Inverse of ``batch_to_table`` (a pyarrow.Table): ``{shard: tallies}``, each checked to be on the bins of
-    ``settings`` (``tallies.tallies_from_columns``); ValueError naming ``source`` otherwise."""
+    """The shards of a batch's table: the inverse of ``batch_to_table``.
+
+    Parameters
+    ----------
+    table : pyarrow.Table
+        A table of ``batch_to_table``.
+    settings : ShardSettings
+        The settings whose bins every shard must be on.
+    source : str, optional
+        The table's name in errors.
+
+    Returns
+    -------
+    dict
+        ``{shard: tallies}``, each checked to be on the bins of ``settings``
+        (``tallies_from_columns``): a ValueError naming ``source`` otherwise.
+
+    Examples
+    --------
+    See ``batch_to_table``.
+    """
     if "shard" not in table.column_names:
         raise ValueError(f"{source}: missing column 'shard'")
     missing = set(COLUMNS) - set(table.column_names)
@@ -727,7 +787,19 @@ def batch_from_table(table, settings, source: str = "batch") -> dict[int, ShardT
 def batch_from_frame(
     frame: "pd.DataFrame", settings, source: str = "batch"
 ) -> dict[int, ShardTallies]:
-    """``batch_from_table`` of a pandas frame (``batch_to_frame``)."""
+    """``batch_from_table`` of a pandas frame (``batch_to_frame``).
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+    settings, source
+        As for ``batch_from_table``.
+
+    Returns
+    -------
+    dict
+        ``{shard: tallies}``.
+    """
     if "shard" not in frame.columns:
         raise ValueError(f"{source}: missing column 'shard'")
     import pyarrow as pa
