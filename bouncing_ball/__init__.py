@@ -6,7 +6,8 @@ The public API:
   time averages, the exponents, P(0, v), P(x), <v^2>_x, P(x, v), w(F), the flight times;
 - ``ExactEquilibrium(r)``: the paper's exact r = 1/2 and 1/3 solutions, the same interface;
 - ``simulate(r, shards=..., shard_time=...)``: the Monte Carlo simulation of the paper's
-  Sec. IV, returning a ``SimulationResult`` with the same observables and their errors.
+  Sec. IV, returning a ``SimulationResult`` with the same observables and their errors;
+  ``SimulationResult.save(path)`` writes it to a Parquet file and ``load(path)`` reads it back.
 
 They are loaded on first use, so that ``import bouncing_ball`` (as the workflow does to plan a
 run) loads neither numba nor scipy.
@@ -25,6 +26,7 @@ __all__ = [
     "simulate",
     "SimulationResult",
     "SimulationInterrupted",
+    "load",
     "PACKAGE",
     "source_digest",
     "__version__",
@@ -37,6 +39,7 @@ _LAZY = {
     "simulate": "monte_carlo",
     "SimulationResult": "monte_carlo",
     "SimulationInterrupted": "monte_carlo",
+    "load": "monte_carlo",
 }
 
 

@@ -792,7 +792,9 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
         One row: ``r``; ``mean_x``, ``delta_x``, ``collision_rate``, ``mean_flight_time``,
         ``flight_time_second_moment``, each with ``_err`` and ``_controlled`` and
         ``_controlled_err``; the totals ``flights``, ``total_time``, ``collisions``,
-        ``steps``, ``shards`` and ``shards_out_of_budget``.
+        ``steps``, ``shards`` and ``shards_out_of_budget``; ``control_variates``, the number
+        of controls fitted to the shards for the ``_controlled`` values (0: none, and those
+        are NaN).
 
     Examples
     --------
@@ -858,6 +860,7 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
             "steps": [int(total.steps)],
             "shards": [len(shards)],
             "shards_out_of_budget": [int(total.budget_exhausted)],
+            "control_variates": [0 if controls is None else int(np.shape(controls)[1])],
         }
     )
 

@@ -3,7 +3,7 @@ this process or on several) and returns a ``SimulationResult`` with the observab
 ``Equilibrium`` and their jackknife errors.
 
 It is the workflow's machinery, called directly: shard k of r draws from
-``simulation.shard_seed_sequence(seed, label of r, k)`` (``batches.simulate_batch``), so a
+``simulation.shard_seed_sequence(seed, label of r, k)`` (``workflow.batches.simulate_batch``), so a
 shard of ``simulate`` is the workflow's shard k for the same seed and settings, whatever the
 number of processes; the tables are ``histograms``' (the workflow's merge stage).
 
@@ -29,7 +29,14 @@ import numpy as np
 from .restitution import parse_restitution, restitution_label
 from .settings import MAX_SHARDS, ShardSettings, real_number
 
-__all__ = ["simulate", "SimulationResult", "SimulationInterrupted", "DEFAULT_SETTINGS"]
+__all__ = [
+    "simulate",
+    "SimulationResult",
+    "SimulationInterrupted",
+    "load",
+    "DEFAULT_SETTINGS",
+    "SCALARS",
+]
 
 # the shard settings ``simulate`` uses where it is not told otherwise (the default config's
 # ``simulation`` section holds the workflow's); every bin set is ``ShardSettings``' default,
@@ -44,15 +51,17 @@ DEFAULT_SETTINGS = {
 
 def _shard_settings(shard_time, settings, restitution):
     """The ``ShardSettings`` of a call at r = ``restitution``: ``settings`` (a ShardSettings,
-    or a mapping of overrides of DEFAULT_SETTINGS and of the default equilibration time) with
-    ``shard_time``."""
+    whose own shard_time must be ``shard_time``, or a mapping of overrides of
+    DEFAULT_SETTINGS and of the default equilibration time) with ``shard_time``."""
+    shard_time = real_number(shard_time, "shard_time")
+    if not 0.0 < shard_time < math.inf:
+        raise ValueError(f"shard_time must be positive and finite, got {shard_time!r}")
     if isinstance(settings, ShardSettings):
-        if shard_time is None:
-            return settings
-        if float(settings.shard_time) != float(shard_time):
+        if float(settings.shard_time) != shard_time:
             raise ValueError(
                 f"shard_time = {shard_time!r} and settings.shard_time = {settings.shard_time!r} "
-                "differ; give one of them"
+                "differ; a ShardSettings' shard_time must be simulate's shard_time "
+                "(settings.replace(shard_time=...) makes one that is)"
             )
         return settings
     if settings is not None and not isinstance(settings, dict):
@@ -68,11 +77,6 @@ def _shard_settings(shard_time, settings, restitution):
         )
     if "shard_time" in overrides:
         raise ValueError("settings: give shard_time as simulate's own argument, not in settings")
-    if shard_time is None:
-        raise TypeError("simulate needs shard_time, the simulated time each shard records")
-    shard_time = real_number(shard_time, "shard_time")
-    if not 0.0 < shard_time < math.inf:
-        raise ValueError(f"shard_time must be positive and finite, got {shard_time!r}")
     if "equilibration_time" not in overrides:
         from .equilibration import default_equilibration_time
 
@@ -83,6 +87,60 @@ def _shard_settings(shard_time, settings, restitution):
         )
     except (KeyError, TypeError) as error:
         raise ValueError(f"settings: {error}") from None
+
+
+def _root_seed(seed):
+    """The root seed of a run, what reproduces it: ``seed`` as given (an int >= 0 or a
+    ``numpy.random.SeedSequence``), or for None a fresh int of the system's entropy."""
+    if seed is None:
+        return int(np.random.SeedSequence().entropy)
+    if isinstance(seed, np.random.SeedSequence):
+        return seed
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+        raise TypeError(
+            f"seed must be an int >= 0, a numpy.random.SeedSequence or None, got {seed!r}"
+        )
+    return _whole_number(seed, "seed", 0)
+
+
+def _seed_record(seed):
+    """``seed`` (an int or a SeedSequence) as JSON-ready data: the int, or the SeedSequence's
+    entropy, spawn key and pool size (``_seed_from_record`` inverts it)."""
+    if not isinstance(seed, np.random.SeedSequence):
+        return int(seed)
+    entropy = seed.entropy
+    entropy = (
+        int(entropy)
+        if isinstance(entropy, (int, np.integer))
+        else [int(value) for value in np.ravel(entropy)]
+    )
+    return {
+        "entropy": entropy,
+        "spawn_key": [int(key) for key in seed.spawn_key],
+        "pool_size": int(seed.pool_size),
+    }
+
+
+def _seed_from_record(record):
+    """The seed of ``_seed_record``'s data."""
+    if isinstance(record, dict):
+        return np.random.SeedSequence(
+            entropy=record["entropy"],
+            spawn_key=tuple(record["spawn_key"]),
+            pool_size=record["pool_size"],
+        )
+    return _whole_number(record, "seed", 0)
+
+
+def _seed_text(seed) -> str:
+    """``seed`` as the repr shows it, on one line."""
+    if not isinstance(seed, np.random.SeedSequence):
+        return str(seed)
+    record = _seed_record(seed)
+    pool = "" if record["pool_size"] == 4 else f", pool_size={record['pool_size']}"
+    return (
+        f"SeedSequence(entropy={record['entropy']}, spawn_key={tuple(record['spawn_key'])}{pool})"
+    )
 
 
 def _whole_number(value, name, least, most=None):
@@ -308,29 +366,37 @@ def _interrupted(exact, seed, settings, finished, requested):
     return SimulationInterrupted(message, result, dict(finished), requested)
 
 
+def _in_notebook() -> bool:
+    """Whether this runs in a Jupyter kernel (IPython's kernel app), whose stderr is no
+    terminal but shows a progress bar."""
+    ipython = sys.modules.get("IPython")
+    shell = ipython.get_ipython() if ipython is not None else None
+    return shell is not None and "IPKernelApp" in getattr(shell, "config", {})
+
+
 class _Progress:
-    """'simulate r=0.6: 3/8 shards, 12 s' on stderr, rewritten in place, on a terminal only."""
+    """The shards done as a progress bar, ``tqdm.auto``'s: a widget in a notebook (a text bar
+    where ipywidgets is not installed), a line rewritten in place on a terminal.  Shown when
+    ``enabled`` and stderr is a terminal or this runs in a notebook; silent otherwise (stderr
+    a log file or a pipe).  ``show`` and ``close`` are what ``simulate`` calls."""
 
     def __init__(self, label, total, enabled):
-        self.label, self.total = label, total
-        self.enabled = bool(enabled) and sys.stderr.isatty()
-        self.started = time.perf_counter()
+        self.bar = None
+        if enabled and (sys.stderr.isatty() or _in_notebook()):
+            from tqdm.auto import tqdm  # loaded only for a bar
+
+            self.bar = tqdm(total=total, desc=f"simulate r={label}", unit="shard")
 
     def show(self, done):
-        if self.enabled:
-            elapsed = time.perf_counter() - self.started
-            sys.stderr.write(
-                f"\rsimulate r={self.label}: {done}/{self.total} shards, {elapsed:.0f} s"
-            )
-            sys.stderr.flush()
+        if self.bar is not None:
+            self.bar.update(done - self.bar.n)
 
     def close(self):
-        if self.enabled:
-            sys.stderr.write("\n")
-            sys.stderr.flush()
+        if self.bar is not None:
+            self.bar.close()
 
 
-def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=1, progress=True):
+def simulate(r, *, shards, shard_time, seed=None, settings=None, processes=1, progress=True):
     """Simulate the bouncing ball at r (the paper's Sec. IV) in independent shards, and
     estimate the equilibrium observables with their jackknife errors.
 
@@ -345,13 +411,15 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
         between them).
     shard_time : float
         Simulated time each shard records, after its equilibration time, positive and finite
-        (a Python or numpy scalar; may be left out when ``settings`` is a ``ShardSettings``,
-        which holds one).  Every shard must record collisions: a run whose shards are too
-        short for that is refused after it ran (ValueError).
-    seed : int, optional
-        Root seed of the random streams; shard k draws from
-        ``simulation.shard_seed_sequence(seed, label of r, k)``, as in the workflow.  None
-        draws fresh entropy (``numpy.random.SeedSequence``), recorded in the result's ``seed``.
+        (a Python or numpy scalar).  When ``settings`` is a ``ShardSettings``, its
+        shard_time must equal this one.  Every shard must record collisions: a run whose
+        shards are too short for that is refused after it ran (ValueError).
+    seed : int or numpy.random.SeedSequence, optional
+        Root seed of the random streams, an int >= 0 or a SeedSequence; shard k draws from
+        ``simulation.shard_seed_sequence(seed, label of r, k)``, as in the workflow: a
+        SeedSequence root's entropy and pool size, with (label of r, k) appended to its spawn
+        key, so ``SeedSequence(n)`` gives the same numbers as ``n``.  None draws fresh
+        entropy (an int).  The result's ``seed`` is what reproduces the run.
     settings : ShardSettings or dict, optional
         The shard settings (``settings.ShardSettings``), or a dict overriding some of
         ``DEFAULT_SETTINGS`` and ``ShardSettings``' defaults (equilibration_time, criterion_c,
@@ -367,7 +435,9 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
         ``if __name__ == "__main__":``.  The workers exit when the process that started them
         dies, however it dies.
     progress : bool, optional
-        Show the shards done on stderr, when stderr is a terminal.
+        Show the shards done as a progress bar (``tqdm.auto``): a widget in a notebook, a
+        line on stderr in a terminal; nothing where stderr is a file or a pipe, or with
+        False.
 
     Returns
     -------
@@ -393,8 +463,12 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
         (a shard's numbers do not depend on an interrupt).  A shard still being compiled
         (the first call in a fresh numba cache) stops when its compile ends.
     ValueError
-        Naming the argument out of its range; or, after the run, a shard_time too short for
-        a collision in every shard.
+        Naming the argument out of its range (a ShardSettings whose shard_time is not
+        ``shard_time`` included); or, after the run, a shard_time too short for a collision
+        in every shard.
+    TypeError
+        A seed that is not an int, a SeedSequence or None; settings not a ShardSettings or
+        a dict.
 
     Examples
     --------
@@ -402,8 +476,16 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
     >>> result = simulate("1/2", shards=4, shard_time=200.0, seed=1, progress=False)
     >>> result.shards, result.total_time, result.partial, result.settings.equilibration_time
     (4, 800.0, False, 1000.0)
-    >>> sorted(result.summary.columns)[:4]
-    ['collision_rate', 'collision_rate_controlled', 'collision_rate_controlled_err', 'collision_rate_err']
+    >>> result.observables().columns.tolist()
+    ['observable', 'symbol', 'estimator', 'value', 'error', 'shards', 'dof']
+
+    A ``numpy.random.SeedSequence`` is a root seed too; ``SeedSequence(1)`` is the seed 1:
+
+    >>> import numpy as np
+    >>> again = simulate("1/2", shards=4, shard_time=200.0, seed=np.random.SeedSequence(1),
+    ...                  progress=False)
+    >>> again.mean_x == result.mean_x
+    True
 
     A Ctrl-C keeps what finished:
 
@@ -425,9 +507,7 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
             "floor (infinitely many collisions in a finite time); give settings="
             '{"min_step_floor": 1e-10} (or another positive floor) to regularise it'
         )
-    if seed is None:
-        seed = int(np.random.SeedSequence().entropy)
-    seed = _whole_number(seed, "seed", 0)
+    seed = _root_seed(seed)
     from .equilibration import warn_equilibration_problems
 
     warn_equilibration_problems(r, run_settings.shard_time, run_settings.equilibration_time)
@@ -455,18 +535,81 @@ def simulate(r, *, shards, shard_time=None, seed=None, settings=None, processes=
     )
 
 
+#: The scalars of a result, name: (symbol, what it is): the plain estimate, its
+#: ``_controlled`` twin and each one's ``_err`` are columns of ``summary_table``.
+SCALARS = {
+    "collision_rate": ("I", "collisions per unit time, eq. (collrate)"),
+    "mean_x": ("<x>", "the mean height, eq. (xandDeltax)"),
+    "delta_x": ("Delta x", "the height's standard deviation, eq. (xandDeltax)"),
+    "mean_flight_time": ("<T>", "the mean time of flight between collisions"),
+    "flight_time_second_moment": ("<T^2>", "the mean squared time of flight"),
+}
+
+#: The names of the tables in other releases' spelling, and the table each is.
+_TABLE_NAMES = {
+    "p0v": "p0v_histogram",
+    "px": "px_histogram",
+    "v2_given_x": "v2_given_x_histogram",
+    "pxv": "pxv_histogram",
+    "position": "position_histogram",
+    "flight_time_density": "flight_time_histogram",
+    "return_speed": "return_speed_histogram",
+    "summary": "summary_table",
+}
+
+#: What ``SimulationResult.save`` writes in its file's provenance under ``kind``.
+RESULT_KIND = "SimulationResult"
+
+
+def _summary_scalar(column):
+    """A read-only attribute: ``column`` of ``summary_table``'s one row, as a float; its
+    docstring says which scalar of ``SCALARS`` it is and which estimate."""
+    name = column.removesuffix("_err").removesuffix("_controlled")
+    symbol, what = SCALARS[name]
+    if column == name:
+        doc = f"{symbol}, {what}: the shards' estimate."
+    elif column == f"{name}_err":
+        doc = f"The delete-one jackknife error of ``{name}`` over the shards."
+    elif column == f"{name}_controlled":
+        doc = (
+            f"{symbol} corrected by the martingale control variates (the same expectation, "
+            "less variance); NaN with too few shards to fit them "
+            "(``tallies.SHARDS_PER_CONTROL`` per control)."
+        )
+    else:
+        doc = f"The delete-one jackknife error of ``{name}_controlled``; NaN where it is."
+
+    def value(self) -> float:
+        return float(self.summary_table[column].iloc[0])
+
+    value.__doc__ = doc
+    return property(value)
+
+
 @dataclass(frozen=True, eq=False)
 class SimulationResult:
     """What ``simulate`` returns: the shards' tallies, their merged tables and the observables
     with their delete-one jackknife errors over the shards (``histograms``).
 
+    The raw data are the shards' tallies with the settings, the seed and r: ``save`` writes
+    them to a Parquet file and ``bouncing_ball.load`` reads them back to an equal result.
+    Every table is a ``pandas.DataFrame`` over bins or lags, named ``*_histogram`` or
+    ``*_table`` (``Equilibrium``'s ``p0v``, ``px``, ... are functions; these are the
+    simulation's bin averages of them).
+
     Attributes
     ----------
     restitution : fractions.Fraction
-        r exactly; ``r`` is it as a float, ``label`` the workflow's label of it.
-    seed : int
-        The root seed (pass it again for the same numbers).
+        r exactly.
+    r : float
+        r as a float.
+    label : str
+        The workflow's label of r (``restitution.restitution_label``).
+    seed : int or numpy.random.SeedSequence
+        The root seed: pass it to ``simulate`` again, with the same r, shard_time and
+        settings, for the same numbers.
     settings : settings.ShardSettings
+        The shard settings of the run.
     tallies : tuple of tallies.ShardTallies
         Each shard's tallies, in the order of the shards (the raw data).
     shard_indices : tuple of int
@@ -475,25 +618,37 @@ class SimulationResult:
     requested_shards : int
         The shards asked for; ``partial`` (shown in the repr and the summary) when fewer
         finished: a run stopped by Ctrl-C (``SimulationInterrupted``).
+    shards : int
+        The shards of ``tallies``.
+    partial : bool
+        True when fewer shards finished than were asked for.
     merged : tallies.ShardTallies
-        Their sum.
+        The shards' tallies summed.
+    total_time : float
+        The simulated time recorded, summed over the shards.
     collision_rate, mean_x, delta_x, mean_flight_time, flight_time_second_moment : float
-        I (eq. (collrate)), <x>, Delta x (eq. (xandDeltax)), and <T>, <T^2> per flight; each
-        with its jackknife error ``*_err``.
-    collision_rate_controlled, mean_x_controlled, delta_x_controlled : float
-        I, <x>, Delta x corrected by the martingale control variates (the same expectation,
-        less variance), each with its ``*_err``; and ``mean_flight_time_controlled``,
-        ``flight_time_second_moment_controlled``.  NaN with fewer than 15 shards.
-    p0v : pandas.DataFrame
+        I (eq. (collrate)), <x>, Delta x (eq. (xandDeltax)), and <T>, <T^2> per flight.
+    collision_rate_err, mean_x_err, delta_x_err, mean_flight_time_err, flight_time_second_moment_err : float
+        Their delete-one jackknife errors over the shards.
+    collision_rate_controlled, mean_x_controlled, delta_x_controlled, mean_flight_time_controlled, flight_time_second_moment_controlled : float
+        The same corrected by the martingale control variates (the same expectation, less
+        variance); NaN with too few shards to fit the controls
+        (``tallies.SHARDS_PER_CONTROL`` per control).
+    collision_rate_controlled_err, mean_x_controlled_err, delta_x_controlled_err, mean_flight_time_controlled_err, flight_time_second_moment_controlled_err : float
+        Their jackknife errors; NaN as they are.
+    relaxation_eigenvalue, relaxation_eigenvalue_err : float
+        lambda of ``bounce_chain_decay`` and its jackknife error (NaN where fewer than 2
+        lags are resolved); against ``Equilibrium.relaxation_eigenvalue``.
+    p0v_histogram : pandas.DataFrame
         P(0, v) on the speed bins (v_lo, v_hi, v, p0v, p0v_err, count).
-    px, v2_given_x : pandas.DataFrame
+    px_histogram, v2_given_x_histogram : pandas.DataFrame
         P(x) and <v^2>_x (eq. (moment2)) on the position bins (x_lo, x_hi, x, and the value
-        with its ``_err``); ``position`` has both.
-    pxv : pandas.DataFrame
+        with its ``_err``); ``position_histogram`` has both.
+    pxv_histogram : pandas.DataFrame
         P(x, v) cell averages (x_lo, x_hi, v_lo, v_hi, pxv, pxv_err).
-    flight_time_density : pandas.DataFrame
+    flight_time_histogram : pandas.DataFrame
         rho(T) per flight on the flight-time bins (t_lo, t_hi, t, density, density_err).
-    return_speed : pandas.DataFrame
+    return_speed_histogram : pandas.DataFrame
         The return speed's bin probabilities given the outgoing speed's bin.
     bounce_autocorrelation : pandas.DataFrame
         The bounce chain's autocorrelation over lags 1 .. ``tallies.BOUNCE_LAGS`` (lag,
@@ -502,23 +657,21 @@ class SimulationResult:
     bounce_chain_decay : dict
         The fitted decay rate -ln lambda of the bounce chain's correlations, lambda
         (``relaxation_eigenvalue``), n_c = 1 / rate (``correlation_bounces``), each with its
-        ``_err``, and the lags of the fit (``histograms.bounce_chain_decay``); against
-        ``Equilibrium.relaxation_eigenvalue``.
-    relaxation_eigenvalue, relaxation_eigenvalue_err : float
-        lambda of ``bounce_chain_decay`` and its jackknife error.
-    summary : pandas.DataFrame
-        One row: the scalars, their errors, the counts (as the workflow's summary table).
+        ``_err``, and the lags of the fit (``histograms.bounce_chain_decay``).
+    summary_table : pandas.DataFrame
+        One row: the scalars, their errors, the counts (as the workflow's summary table);
+        ``observables()`` is the same scalars as a tidy table.
 
     Examples
     --------
     >>> from bouncing_ball import simulate
     >>> result = simulate(0.6, shards=2, shard_time=200.0, seed=3, progress=False)
-    >>> list(result.px.columns)
+    >>> list(result.px_histogram.columns)
     ['x_lo', 'x_hi', 'x', 'px', 'px_err']
     """
 
     restitution: Fraction
-    seed: int
+    seed: object
     settings: object
     tallies: tuple = field(repr=False)
     shard_indices: tuple = field(default=None, repr=False)
@@ -534,6 +687,38 @@ class SimulationResult:
                 f"shard_indices: {len(self.shard_indices)} indices for {len(self.tallies)} shards"
             )
 
+    def __getattr__(self, name):
+        # only for names not found otherwise: a table under another spelling
+        if name in _TABLE_NAMES:
+            raise AttributeError(
+                f"'SimulationResult' object has no attribute {name!r}: the table is "
+                f"{_TABLE_NAMES[name]!r} (Equilibrium.{name} is the function)"
+            )
+        raise AttributeError(f"'SimulationResult' object has no attribute {name!r}")
+
+    collision_rate = _summary_scalar("collision_rate")
+    collision_rate_err = _summary_scalar("collision_rate_err")
+    collision_rate_controlled = _summary_scalar("collision_rate_controlled")
+    collision_rate_controlled_err = _summary_scalar("collision_rate_controlled_err")
+    mean_x = _summary_scalar("mean_x")
+    mean_x_err = _summary_scalar("mean_x_err")
+    mean_x_controlled = _summary_scalar("mean_x_controlled")
+    mean_x_controlled_err = _summary_scalar("mean_x_controlled_err")
+    delta_x = _summary_scalar("delta_x")
+    delta_x_err = _summary_scalar("delta_x_err")
+    delta_x_controlled = _summary_scalar("delta_x_controlled")
+    delta_x_controlled_err = _summary_scalar("delta_x_controlled_err")
+    mean_flight_time = _summary_scalar("mean_flight_time")
+    mean_flight_time_err = _summary_scalar("mean_flight_time_err")
+    mean_flight_time_controlled = _summary_scalar("mean_flight_time_controlled")
+    mean_flight_time_controlled_err = _summary_scalar("mean_flight_time_controlled_err")
+    flight_time_second_moment = _summary_scalar("flight_time_second_moment")
+    flight_time_second_moment_err = _summary_scalar("flight_time_second_moment_err")
+    flight_time_second_moment_controlled = _summary_scalar("flight_time_second_moment_controlled")
+    flight_time_second_moment_controlled_err = _summary_scalar(
+        "flight_time_second_moment_controlled_err"
+    )
+
     @property
     def partial(self) -> bool:
         """True when fewer shards finished than were asked for (an interrupted run)."""
@@ -541,131 +726,238 @@ class SimulationResult:
 
     @property
     def r(self) -> float:
+        """r as a float."""
         return float(self.restitution)
 
     @property
     def label(self) -> str:
+        """The workflow's label of r (``restitution.restitution_label``)."""
         return restitution_label(self.restitution)
 
     @property
     def shards(self) -> int:
+        """The shards of ``tallies``."""
         return len(self.tallies)
 
     @cached_property
     def merged(self):
+        """The shards' tallies summed (``tallies.merge_shards``)."""
         from .tallies import merge_shards
 
         return merge_shards(self.tallies)
 
     @property
     def total_time(self) -> float:
+        """The simulated time recorded, summed over the shards."""
         return float(self.merged.time)
 
     @cached_property
-    def summary(self):
+    def summary_table(self):
+        """One row: the scalars, their errors and the counts
+        (``histograms.position_moments_summary``), with ``requested_shards`` and
+        ``partial``."""
         from .histograms import position_moments_summary
 
         summary = position_moments_summary(list(self.tallies), self.r)
         return summary.assign(requested_shards=self.requested_shards, partial=self.partial)
 
-    def _scalar(self, name) -> float:
-        return float(self.summary[name].iloc[0])
+    def observables(self):
+        """Every scalar with its error, as a tidy table: a row per (observable, estimator).
 
-    collision_rate = property(lambda self: self._scalar("collision_rate"))
-    collision_rate_err = property(lambda self: self._scalar("collision_rate_err"))
-    collision_rate_controlled = property(lambda self: self._scalar("collision_rate_controlled"))
-    collision_rate_controlled_err = property(
-        lambda self: self._scalar("collision_rate_controlled_err")
-    )
-    mean_x_controlled = property(lambda self: self._scalar("mean_x_controlled"))
-    mean_x_controlled_err = property(lambda self: self._scalar("mean_x_controlled_err"))
-    delta_x_controlled = property(lambda self: self._scalar("delta_x_controlled"))
-    delta_x_controlled_err = property(lambda self: self._scalar("delta_x_controlled_err"))
-    mean_flight_time_controlled = property(lambda self: self._scalar("mean_flight_time_controlled"))
-    mean_flight_time_controlled_err = property(
-        lambda self: self._scalar("mean_flight_time_controlled_err")
-    )
-    flight_time_second_moment_controlled = property(
-        lambda self: self._scalar("flight_time_second_moment_controlled")
-    )
-    flight_time_second_moment_controlled_err = property(
-        lambda self: self._scalar("flight_time_second_moment_controlled_err")
-    )
-    mean_x = property(lambda self: self._scalar("mean_x"))
-    mean_x_err = property(lambda self: self._scalar("mean_x_err"))
-    delta_x = property(lambda self: self._scalar("delta_x"))
-    delta_x_err = property(lambda self: self._scalar("delta_x_err"))
-    mean_flight_time = property(lambda self: self._scalar("mean_flight_time"))
-    mean_flight_time_err = property(lambda self: self._scalar("mean_flight_time_err"))
-    flight_time_second_moment = property(lambda self: self._scalar("flight_time_second_moment"))
-    flight_time_second_moment_err = property(
-        lambda self: self._scalar("flight_time_second_moment_err")
-    )
+        The plain estimates and their delete-one jackknife errors over the shards, with
+        ``dof`` = shards - 1; the control-variate estimates (``*_controlled``) with
+        ``dof`` = shards - 1 - the controls fitted (``histograms.moment_controls``); and the
+        bounce chain's relaxation eigenvalue lambda (``bounce_chain_decay``), dof =
+        shards - 1.  Only the estimates that exist are rows: a controlled one needs
+        ``tallies.SHARDS_PER_CONTROL`` shards per control and a finite error, lambda two
+        resolved lags.  A z-score against a prediction is (value - prediction) / error,
+        Student-t with ``dof`` degrees of freedom.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``observable`` (the attribute's name: ``collision_rate``, ``mean_x``,
+            ``delta_x``, ``mean_flight_time``, ``flight_time_second_moment``,
+            ``relaxation_eigenvalue``), ``symbol``, ``estimator`` (``"plain"``,
+            ``"controlled"``, or ``"bounce-chain fit"`` for lambda), ``value``, ``error``
+            (finite and positive), ``shards`` and ``dof``.
+
+        Examples
+        --------
+        >>> from bouncing_ball import simulate
+        >>> result = simulate("1/2", shards=4, shard_time=200.0, seed=1, progress=False)
+        >>> table = result.observables()
+        >>> int(table.set_index(["observable", "estimator"]).loc["mean_x", "plain"].dof)
+        3
+        """
+        import pandas as pd
+
+        row = self.summary_table.iloc[0]
+        shards = self.shards
+        rows = []
+        for name, (symbol, _) in SCALARS.items():
+            rows.append((name, symbol, "plain", row[name], row[f"{name}_err"], shards - 1))
+            rows.append(
+                (
+                    name,
+                    symbol,
+                    "controlled",
+                    row[f"{name}_controlled"],
+                    row[f"{name}_controlled_err"],
+                    shards - 1 - int(row["control_variates"]),
+                )
+            )
+        decay = self.bounce_chain_decay
+        rows.append(
+            (
+                "relaxation_eigenvalue",
+                "lambda",
+                "bounce-chain fit",
+                decay["relaxation_eigenvalue"],
+                decay["relaxation_eigenvalue_err"],
+                shards - 1,
+            )
+        )
+        table = pd.DataFrame(
+            rows, columns=["observable", "symbol", "estimator", "value", "error", "dof"]
+        )
+        table.insert(5, "shards", shards)
+        value, error = table["value"].to_numpy(float), table["error"].to_numpy(float)
+        present = np.isfinite(value) & np.isfinite(error) & (error > 0.0)
+        return table[present].reset_index(drop=True)
 
     @cached_property
-    def p0v(self):
+    def p0v_histogram(self):
+        """P(0, v) averaged over the speed bins (``histograms.outgoing_speed_histogram``):
+        v_lo, v_hi, v, p0v, p0v_err, count."""
         from .histograms import outgoing_speed_histogram
 
         return outgoing_speed_histogram(list(self.tallies), self.restitution)
 
     @cached_property
-    def position(self):
+    def position_histogram(self):
+        """P(x) and <v^2>_x averaged over the position bins (``histograms.position_histogram``)."""
         from .histograms import position_histogram
 
         return position_histogram(list(self.tallies))
 
     @property
-    def px(self):
-        return self.position[["x_lo", "x_hi", "x", "px", "px_err"]]
+    def px_histogram(self):
+        """P(x) averaged over the position bins: x_lo, x_hi, x, px, px_err."""
+        return self.position_histogram[["x_lo", "x_hi", "x", "px", "px_err"]]
 
     @property
-    def v2_given_x(self):
-        return self.position[["x_lo", "x_hi", "x", "v2_given_x", "v2_given_x_err"]]
+    def v2_given_x_histogram(self):
+        """<v^2>_x (eq. (moment2)) over the position bins: x_lo, x_hi, x, v2_given_x,
+        v2_given_x_err."""
+        return self.position_histogram[["x_lo", "x_hi", "x", "v2_given_x", "v2_given_x_err"]]
 
     @cached_property
-    def pxv(self):
+    def pxv_histogram(self):
+        """P(x, v) averaged over the cells (``histograms.distribution_histogram``): x_lo, x_hi,
+        v_lo, v_hi, pxv, pxv_err."""
         from .histograms import distribution_histogram
 
         return distribution_histogram(list(self.tallies))
 
     @cached_property
-    def flight_time_density(self):
+    def flight_time_histogram(self):
+        """rho(T) per flight averaged over the flight-time bins
+        (``histograms.flight_time_histogram``): t_lo, t_hi, t, density, density_err."""
         from .histograms import flight_time_histogram
 
         return flight_time_histogram(list(self.tallies))
 
     @cached_property
-    def return_speed(self):
+    def return_speed_histogram(self):
+        """The return speed's bin probabilities given the outgoing speed's bin
+        (``histograms.return_speed_table``)."""
         from .histograms import return_speed_table
 
         return return_speed_table(list(self.tallies))
 
     @cached_property
     def bounce_autocorrelation(self):
+        """The bounce chain's autocorrelations by lag (``histograms.bounce_autocorrelation``)."""
         from .histograms import bounce_autocorrelation
 
         return bounce_autocorrelation(list(self.tallies))
 
     @cached_property
     def bounce_chain_decay(self):
+        """The fitted decay of the bounce chain's correlations
+        (``histograms.bounce_chain_decay``)."""
         from .histograms import bounce_chain_decay
 
         return bounce_chain_decay(list(self.tallies))
 
-    relaxation_eigenvalue = property(lambda self: self.bounce_chain_decay["relaxation_eigenvalue"])
-    relaxation_eigenvalue_err = property(
-        lambda self: self.bounce_chain_decay["relaxation_eigenvalue_err"]
-    )
+    @property
+    def relaxation_eigenvalue(self) -> float:
+        """lambda, the bounce chain's relaxation eigenvalue fitted to its correlations
+        (``bounce_chain_decay``); NaN where fewer than 2 lags are resolved."""
+        return float(self.bounce_chain_decay["relaxation_eigenvalue"])
+
+    @property
+    def relaxation_eigenvalue_err(self) -> float:
+        """The jackknife error of ``relaxation_eigenvalue``."""
+        return float(self.bounce_chain_decay["relaxation_eigenvalue_err"])
 
     def batch_frame(self):
-        """The shards as one table in the workflow's batch format (``batches.batch_to_frame``;
+        """The shards as one table in the workflow's batch format (``tallies.batch_to_frame``;
         ``results/simulation/r{r}/shards{first}-{last}.parquet``)."""
-        from .workflow.batches import batch_to_frame
+        from .tallies import batch_to_frame
 
         return batch_to_frame(dict(zip(self.shard_indices, self.tallies)))
 
+    def provenance(self) -> dict:
+        """What ``save`` records with the shards: the kind, r, the seed (an int, or a
+        SeedSequence's entropy, spawn key and pool size), the settings, the shard indices and
+        the shards asked for (JSON-ready)."""
+        from .restitution import exact_string
+
+        return {
+            "kind": RESULT_KIND,
+            "r": exact_string(self.restitution),
+            "r_label": self.label,
+            "seed": _seed_record(self.seed),
+            "settings": self.settings.as_mapping(),
+            "shard_indices": [int(index) for index in self.shard_indices],
+            "requested_shards": int(self.requested_shards),
+        }
+
+    def save(self, path):
+        """Write the result to a Parquet file: its shards' tallies in the workflow's batch
+        table (``tallies.batch_to_table``), with ``provenance()`` and the package version in
+        the file's metadata (``parquet.write_table``: atomic, a reader never sees half a
+        file).  ``bouncing_ball.load(path)`` gives it back, every observable bit-identical.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file to write (conventionally ``*.parquet``); its folder is made if missing,
+            an existing file replaced.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> from bouncing_ball import load, simulate
+        >>> result = simulate("1/2", shards=2, shard_time=200.0, seed=1, progress=False)
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "half.parquet"
+        >>> result.save(path)
+        >>> load(path).mean_x == result.mean_x
+        True
+        """
+        from .parquet import write_table
+        from .tallies import batch_to_table
+
+        write_table(
+            batch_to_table(dict(zip(self.shard_indices, self.tallies))),
+            path,
+            self.provenance(),
+        )
+
     def __repr__(self):
-        row = self.summary.iloc[0]
+        row = self.summary_table.iloc[0]
 
         def shown(name, symbol):
             return f"{symbol} = {row[name]:.6g} +- {row[name + '_err']:.2g}"
@@ -677,22 +969,76 @@ class SimulationResult:
                 if self.partial
                 else f"shards={self.shards}, "
             )
-            + f"seed={self.seed}, "
+            + f"seed={_seed_text(self.seed)}, "
             f"total time {row.total_time:.6g}, {int(row.collisions)} collisions, "
             f"{int(row.steps)} steps): "
-            + ", ".join(
-                shown(name, symbol)
-                for name, symbol in (
-                    ("collision_rate", "I"),
-                    ("mean_x", "<x>"),
-                    ("delta_x", "Delta x"),
-                    ("mean_flight_time", "<T>"),
-                    ("flight_time_second_moment", "<T^2>"),
-                )
-            )
+            + ", ".join(shown(name, symbol) for name, (symbol, _) in SCALARS.items())
             + (
                 f"; {int(row.shards_out_of_budget)} shards stopped early (max_steps)"
                 if row.shards_out_of_budget
                 else ""
             )
         )
+
+
+def load(path) -> SimulationResult:
+    """The ``SimulationResult`` a file of ``SimulationResult.save`` holds: its shards'
+    tallies, settings, seed and r, so every table and observable is bit-identical to the
+    saved result's.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A Parquet file written by ``SimulationResult.save``.
+
+    Returns
+    -------
+    SimulationResult
+
+    Raises
+    ------
+    parquet.UnreadableFileError
+        Naming the file: missing, not a readable Parquet file (truncated, corrupt), without
+        bouncing_ball's provenance, of another kind (e.g. a table of the workflow), or whose
+        shards are not on its settings' bins.
+
+    Examples
+    --------
+    See ``SimulationResult.save``.
+    """
+    from pathlib import Path
+
+    import pyarrow.parquet as pq
+
+    from .parquet import UnreadableFileError, provenance_of, read_parquet
+    from .tallies import batch_from_table
+
+    path = Path(path)
+    table = read_parquet(pq.read_table, path)
+    provenance = provenance_of(path, table.schema)
+    if provenance.get("kind") != RESULT_KIND:
+        written_by = provenance.get("rule") or provenance.get("kind") or "unknown"
+        raise UnreadableFileError(
+            f"{path}: not a saved SimulationResult (written by {written_by}); "
+            "bouncing_ball.load reads the files of SimulationResult.save"
+        )
+    try:
+        settings = ShardSettings.from_mapping(provenance["settings"])
+        restitution = parse_restitution(provenance["r"], "r")
+        seed = _seed_from_record(provenance["seed"])
+        shards = batch_from_table(table, settings, source=str(path))
+        indices = tuple(int(index) for index in provenance["shard_indices"])
+        if sorted(shards) != sorted(indices):
+            raise ValueError(
+                f"its shards {sorted(shards)} are not its provenance's {sorted(indices)}"
+            )
+        return SimulationResult(
+            restitution=restitution,
+            seed=seed,
+            settings=settings,
+            tallies=tuple(shards[index] for index in indices),
+            shard_indices=indices,
+            requested_shards=int(provenance["requested_shards"]),
+        )
+    except (KeyError, TypeError, ValueError) as error:
+        raise UnreadableFileError(f"{path}: not a readable SimulationResult ({error})") from None

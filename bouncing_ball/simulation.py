@@ -205,16 +205,20 @@ _POSITION_NOISE_V_SUM = SCALAR_INDEX["position_noise_v_sum"]
 _POSITION_NOISE_X_SUM = SCALAR_INDEX["position_noise_x_sum"]
 
 
-def shard_seed_sequence(seed: int, label: str, shard: int) -> np.random.SeedSequence:
+def shard_seed_sequence(seed, label: str, shard: int) -> np.random.SeedSequence:
     """The random stream of one (r, shard): independent of job order and cores.
 
     The r label (see ``restitution.restitution_label``) enters the spawn key as the integer
-    spelled by its ASCII bytes, so different r never share a stream.
+    spelled by its ASCII bytes, so different r never share a stream.  A root
+    ``numpy.random.SeedSequence`` is the int seed's generalisation: its entropy, its spawn
+    key followed by (the label's integer, ``shard``), and its pool size; so the root
+    ``SeedSequence(seed)`` gives the int ``seed``'s streams, and a root's own children
+    (``SeedSequence.spawn``) are unaffected (it is read, not spawned from).
 
     Parameters
     ----------
-    seed : int
-        The run's seed (the config's ``seed``), >= 0.
+    seed : int or numpy.random.SeedSequence
+        The run's root seed (the config's ``seed``, an int >= 0), or a root SeedSequence.
     label : str
         r as the pipeline names it (``restitution.restitution_label``), ASCII.
     shard : int
@@ -223,7 +227,9 @@ def shard_seed_sequence(seed: int, label: str, shard: int) -> np.random.SeedSequ
     Returns
     -------
     numpy.random.SeedSequence
-        The shard's stream: entropy ``seed``, spawn key (the label's integer, ``shard``).
+        The shard's stream: entropy ``seed``, spawn key (the label's integer, ``shard``); for
+        a root SeedSequence, its entropy, its spawn key + (the label's integer, ``shard``)
+        and its pool size.
 
     Examples
     --------
@@ -238,8 +244,17 @@ def shard_seed_sequence(seed: int, label: str, shard: int) -> np.random.SeedSequ
     >>> other_shard = shard_seed_sequence(1, "0.5", 4).generate_state(4)
     >>> print(np.array_equal(again, other_shard))
     False
+    >>> root = shard_seed_sequence(np.random.SeedSequence(1), "0.5", 3).generate_state(4)
+    >>> print(np.array_equal(root, again))
+    True
     """
     r_key = int.from_bytes(label.encode("ascii"), "big")
+    if isinstance(seed, np.random.SeedSequence):
+        return np.random.SeedSequence(
+            entropy=seed.entropy,
+            spawn_key=(*seed.spawn_key, r_key, shard),
+            pool_size=seed.pool_size,
+        )
     return np.random.SeedSequence(entropy=seed, spawn_key=(r_key, shard))
 
 

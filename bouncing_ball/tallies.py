@@ -92,6 +92,11 @@ __all__ = [
     "tallies_from_columns",
     "tallies_to_frame",
     "tallies_from_frame",
+    "batch_schema",
+    "batch_to_table",
+    "batch_from_table",
+    "batch_to_frame",
+    "batch_from_frame",
 ]
 
 #: The 1-D histograms, name in the table: (the bins' attribute, the values' attribute,
@@ -636,3 +641,167 @@ def tallies_from_frame(frame: "pd.DataFrame", settings, source: str = "shard") -
     See the module's example.
     """
     return tallies_from_columns(frame, settings, source)
+
+
+def _arrow_array(values: np.ndarray, kind):
+    """``values`` as an Arrow array of ``kind`` (int64, float64 or large_string) made from its
+    buffers: ``pyarrow.array`` would import pandas to look at its argument."""
+    import pyarrow as pa
+
+    if kind == pa.large_string():
+        encoded = [str(value).encode() for value in values]
+        offsets = np.zeros(len(encoded) + 1, dtype=np.int64)
+        np.cumsum([len(value) for value in encoded], out=offsets[1:])
+        buffers = [None, pa.py_buffer(offsets), pa.py_buffer(b"".join(encoded))]
+    else:
+        buffers = [None, pa.py_buffer(np.ascontiguousarray(values, dtype=kind.to_pandas_dtype()))]
+    return pa.Array.from_buffers(kind, len(values), buffers)
+
+
+def batch_schema():
+    """The Arrow schema of a batch's table.
+
+    Returns
+    -------
+    pyarrow.Schema
+        ``shard`` (int64), then ``COLUMNS`` (``tally`` a large_string, as pandas writes str
+        columns, the rest float64).
+    """
+    import pyarrow as pa
+
+    return pa.schema(
+        [
+            ("shard", pa.int64()),
+            ("tally", pa.large_string()),
+            *((column, pa.float64()) for column in COLUMNS[1:]),
+        ]
+    )
+
+
+def batch_to_table(batch: dict[int, ShardTallies]):
+    """The table of a batch of shards, made without pandas.
+
+    Parameters
+    ----------
+    batch : dict
+        ``{shard index: ShardTallies}``, at least one shard.
+
+    Returns
+    -------
+    pyarrow.Table
+        The shards' long tables (``tallies_to_columns``) one after the other, in the order
+        of the shards, with a first column ``shard`` (``batch_schema``).
+
+    Examples
+    --------
+    >>> from bouncing_ball.bins import LinearBins, LogBins
+    >>> from bouncing_ball.settings import ShardSettings
+    >>> from bouncing_ball.tallies import ShardTallies, batch_from_table, batch_to_table
+    >>> settings = ShardSettings(
+    ...     shard_time=1.0, equilibration_time=0.0, criterion_c=5, min_step_divisor=10,
+    ...     max_steps=100, speed_bins=LogBins(0.1, 10.0, 1),
+    ...     position_bins=LogBins(0.1, 10.0, 1), velocity_bins=LinearBins(-1.0, 1.0, 1.0),
+    ...     flight_time_bins=LogBins(0.1, 10.0, 1),
+    ... )
+    >>> shard = ShardTallies.from_loop(settings, ShardTallies.loop_arrays(settings))
+    >>> sorted(batch_from_table(batch_to_table({3: shard, 1: shard}), settings))
+    [1, 3]
+    """
+    import pyarrow as pa
+
+    if not batch:
+        raise ValueError("a batch needs at least one shard")
+    schema = batch_schema()
+    parts = {shard: tallies_to_columns(batch[shard]) for shard in sorted(batch)}
+    columns = {
+        "shard": np.concatenate(
+            [np.full(len(part["value"]), shard, dtype=np.int64) for shard, part in parts.items()]
+        ),
+        **{key: np.concatenate([part[key] for part in parts.values()]) for key in COLUMNS},
+    }
+    return pa.Table.from_arrays(
+        [_arrow_array(columns[field.name], field.type) for field in schema],
+        schema=schema,
+    )
+
+
+def batch_to_frame(batch: dict[int, ShardTallies]) -> "pd.DataFrame":
+    """The table of a batch (``batch_to_table``) as a pandas frame.
+
+    Parameters
+    ----------
+    batch : dict
+        ``{shard index: ShardTallies}``.
+
+    Returns
+    -------
+    pandas.DataFrame
+    """
+    return batch_to_table(batch).to_pandas()
+
+
+def batch_from_table(table, settings, source: str = "batch") -> dict[int, ShardTallies]:
+    """The shards of a batch's table: the inverse of ``batch_to_table``.
+
+    Parameters
+    ----------
+    table : pyarrow.Table
+        A table of ``batch_to_table``.
+    settings : ShardSettings
+        The settings whose bins every shard must be on.
+    source : str, optional
+        The table's name in errors.
+
+    Returns
+    -------
+    dict
+        ``{shard: tallies}``, each checked to be on the bins of ``settings``
+        (``tallies_from_columns``): a ValueError naming ``source`` otherwise.
+
+    Examples
+    --------
+    See ``batch_to_table``.
+    """
+    if "shard" not in table.column_names:
+        raise ValueError(f"{source}: missing column 'shard'")
+    missing = set(COLUMNS) - set(table.column_names)
+    if missing:
+        raise ValueError(f"{source}: missing columns {sorted(missing)}")
+    if table.num_rows == 0:
+        return {}
+    shard = table.column("shard").to_numpy()
+    columns = {key: table.column(key).to_numpy() for key in COLUMNS}
+    # each shard's rows in their order (a stable sort: the table's order within a shard)
+    order = np.argsort(shard, kind="stable")
+    shards, starts = np.unique(shard[order], return_index=True)
+    batch = {}
+    for number, rows in zip(shards, np.split(order, starts[1:]), strict=True):
+        batch[int(number)] = tallies_from_columns(
+            {key: column[rows] for key, column in columns.items()},
+            settings,
+            source=f"{source}, shard {int(number)}",
+        )
+    return batch
+
+
+def batch_from_frame(
+    frame: "pd.DataFrame", settings, source: str = "batch"
+) -> dict[int, ShardTallies]:
+    """``batch_from_table`` of a pandas frame (``batch_to_frame``).
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+    settings, source
+        As for ``batch_from_table``.
+
+    Returns
+    -------
+    dict
+        ``{shard: tallies}``.
+    """
+    if "shard" not in frame.columns:
+        raise ValueError(f"{source}: missing column 'shard'")
+    import pyarrow as pa
+
+    return batch_from_table(pa.Table.from_pandas(frame, preserve_index=False), settings, source)

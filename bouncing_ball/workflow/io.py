@@ -1,4 +1,6 @@
-"""Parquet tables with provenance, written atomically, read with clear errors.
+"""The workflow's tables: Parquet with provenance (``bouncing_ball.parquet``), each of a kind
+(``TableKind``: the rule that writes it and its columns), read with errors that name the file
+and say how to make it again.
 
 Provenance (r, the rule's parameters, seed, package version) is stored as
 JSON under the key ``bouncing_ball`` of the Parquet key-value metadata.  A table is a pandas
@@ -6,10 +8,6 @@ frame or a pyarrow table (a simulation job's batch of shards, written and read w
 pandas).
 """
 
-import json
-import os
-import tempfile
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -17,91 +15,35 @@ from typing import TYPE_CHECKING
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from .. import __version__
+from ..parquet import (
+    METADATA_KEY,
+    UnreadableFileError,
+    atomic_paths,
+    provenance_of,
+    read_parquet,
+    write_table,
+    write_tables,
+)
 from ..restitution import parse_restitution
 
 if TYPE_CHECKING:
     import pandas as pd
 
-METADATA_KEY = b"bouncing_ball"
-
-
-class UnreadableFileError(RuntimeError):
-    """An input file is missing, truncated or not what it should be."""
-
-
-@contextmanager
-def atomic_paths(*paths):
-    """Temporary names next to ``paths`` to write to; all are renamed to ``paths`` only
-    if the block finishes, all removed otherwise: a reader never sees a half-written
-    file, and a rule's outputs appear together or not at all."""
-    paths = [Path(path) for path in paths]
-    temporaries = []
-    try:
-        for path in paths:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            for stale in path.parent.glob(f".{path.stem}.*{path.suffix}"):
-                # left by a writer that was killed (SIGKILL skips the cleanup below)
-                stale.unlink(missing_ok=True)
-            handle, temporary = tempfile.mkstemp(
-                prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent
-            )
-            os.close(handle)
-            temporaries.append(temporary)
-            # mkstemp makes the file private (0600); a result gets the mode the user's
-            # umask gives any new file (0644 under umask 022), so colleagues can read it
-            os.chmod(temporary, 0o666 & ~_umask())
-        yield temporaries
-    except BaseException:
-        for temporary in temporaries:
-            Path(temporary).unlink(missing_ok=True)
-        raise
-    renamed = []
-    try:
-        for temporary, path in zip(temporaries, paths, strict=True):
-            os.replace(temporary, path)
-            renamed.append(path)
-    except BaseException:
-        # a rename failed (e.g. a directory where a file should go): take back the new
-        # files already in place, so that none of the set is left without the others
-        for path in renamed:
-            path.unlink(missing_ok=True)
-        for temporary in temporaries:
-            Path(temporary).unlink(missing_ok=True)
-        raise
-
-
-def _umask() -> int:
-    """The process's umask (reading it means setting it; set straight back)."""
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
-def _with_provenance(frame, provenance: dict) -> pa.Table:
-    table = (
-        frame if isinstance(frame, pa.Table) else pa.Table.from_pandas(frame, preserve_index=False)
-    )
-    metadata = dict(table.schema.metadata or {})
-    metadata[METADATA_KEY] = json.dumps(
-        {"package_version": __version__, **provenance}, sort_keys=True, default=str
-    ).encode()
-    return table.replace_schema_metadata(metadata)
-
-
-def write_tables(frames: dict, provenance: dict) -> None:
-    """Write each frame of ``{path: frame}`` with ``provenance``; all or none of them
-    appear (``atomic_paths``), as a rule's outputs should."""
-    tables = [_with_provenance(frame, provenance) for frame in frames.values()]
-    with atomic_paths(*frames) as temporaries:
-        for table, temporary in zip(tables, temporaries, strict=True):
-            pq.write_table(table, temporary)
-
-
-def write_table(frame, path, provenance: dict) -> None:
-    """Write ``frame`` (a pandas frame or a pyarrow table) to ``path`` with ``provenance``;
-    atomic (temp file, then rename)."""
-    write_tables({path: frame}, provenance)
+__all__ = [
+    "METADATA_KEY",
+    "UnreadableFileError",
+    "atomic_paths",
+    "write_tables",
+    "write_table",
+    "TableKind",
+    "read_provenance",
+    "read_arrow_table",
+    "read_table",
+    "require_columns",
+    "read_tables_of_one_restitution",
+    "comparison_panels",
+    "write_csv_and_markdown",
+]
 
 
 @dataclass(frozen=True)
@@ -204,32 +146,25 @@ FITS = TableKind(
 )
 
 
-def _unreadable(path, error) -> UnreadableFileError:
-    return UnreadableFileError(
-        f"{path}: not a readable Parquet file ({error}). It is probably truncated or "
-        f"corrupt: make it again with  snakemake --cores 2 --forcerun {path}  (plus your targets)"
+def _remake(path) -> str:
+    """What to do about a workflow file that cannot be read: make it again."""
+    return f"; make it again with  snakemake --cores 2 --forcerun {path}"
+
+
+def _read_parquet(read, path: Path):
+    """``parquet.read_parquet`` with the workflow's remedy: the file is made again."""
+    return read_parquet(
+        read,
+        path,
+        remedy=(
+            ". It is probably truncated or corrupt: make it again with  snakemake --cores 2 "
+            f"--forcerun {path}  (plus your targets)"
+        ),
     )
 
 
 def _provenance(path, schema) -> dict:
-    raw = (schema.metadata or {}).get(METADATA_KEY)
-    if raw is None:
-        raise UnreadableFileError(
-            f"{path}: no '{METADATA_KEY.decode()}' provenance metadata: not written by this workflow; "
-            f"make it again with  snakemake --cores 2 --forcerun {path}"
-        )
-    return json.loads(raw)
-
-
-def _read_parquet(read, path: Path):
-    """``read(path)`` (pyarrow's ``read_table`` or ``read_schema``), its failures an
-    ``UnreadableFileError`` naming the file."""
-    try:
-        return read(path)
-    except FileNotFoundError:
-        raise UnreadableFileError(f"{path}: file not found") from None
-    except (pa.ArrowException, OSError) as error:
-        raise _unreadable(path, error) from None
+    return provenance_of(path, schema, remedy=_remake(path))
 
 
 def read_provenance(path) -> dict:

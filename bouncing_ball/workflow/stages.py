@@ -37,6 +37,7 @@ READ_SHARDS = (
     "tallies",
     "workflow.audit",
     "workflow.batches",
+    "parquet",
     "workflow.io",
     "workflow.shards",
 )
@@ -56,8 +57,8 @@ SOLVER = (
 EXACT = ("airy", "bins", "exact")
 THEORY = ("asymptotics", "bins")
 FITS = (*READ_SHARDS, "asymptotics", "fits")
-PLOTTING = ("workflow.io", "workflow.plotting", "restitution")
-COMPARISON = ("comparison", "fits", "workflow.io", "restitution")
+PLOTTING = ("parquet", "workflow.io", "workflow.plotting", "restitution")
+COMPARISON = ("comparison", "fits", "parquet", "workflow.io", "restitution")
 # the studies' reports (workflow/rules/studies.smk); their shards are SIMULATION's
 STUDIES = (*READ_SHARDS, "airy", "comparison", "exact", "fits", "workflow.studies")
 # results/tables/validation: the comparison, the exact bin averages, the solver curve's bin

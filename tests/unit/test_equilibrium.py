@@ -20,7 +20,8 @@ from bouncing_ball.asymptotics import (
     small_speed_exponent,
 )
 from bouncing_ball.restitution import DISTRIBUTION_RESTITUTION_RANGE, SOLVER_RESTITUTION_RANGE
-from bouncing_ball.workflow.batches import batch_to_frame, simulate_batch
+from bouncing_ball.tallies import batch_to_frame
+from bouncing_ball.workflow.batches import simulate_batch
 from bouncing_ball.workflow.config import read_config, shard_settings
 
 EXACT = ["1/2", "1/3"]
@@ -146,7 +147,9 @@ def test_simulate_is_reproducible_whatever_the_processes():
     one = bb.simulate(0.6, processes=1, progress=False, **arguments)
     two = bb.simulate(0.6, processes=2, progress=False, **arguments)
     assert one.batch_frame().equals(two.batch_frame())
-    assert one.summary.equals(two.summary) and one.pxv.equals(two.pxv)
+    assert one.summary_table.equals(two.summary_table) and one.pxv_histogram.equals(
+        two.pxv_histogram
+    )
     again = bb.simulate(0.6, processes=1, progress=False, **{**arguments, "seed": 12})
     assert not again.batch_frame().equals(one.batch_frame())
 
@@ -154,7 +157,9 @@ def test_simulate_is_reproducible_whatever_the_processes():
 def test_a_simulated_shard_is_the_workflow_shard():
     """simulate's shards are scripts/simulate_shards.py's for the same seed, r and settings."""
     settings = shard_settings(read_config(TEST_CONFIG), "0.5").replace(shard_time=200.0)
-    result = bb.simulate("1/2", shards=2, seed=5, settings=settings, progress=False)
+    result = bb.simulate(
+        "1/2", shards=2, shard_time=200.0, seed=5, settings=settings, progress=False
+    )
     workflow = batch_to_frame(dict(simulate_batch(0.5, 5, "0.5", [0, 1], settings)))
     assert result.batch_frame().equals(workflow)
 
@@ -188,11 +193,11 @@ def test_simulation_result_has_the_observables():
         "flight_time_second_moment",
     ):
         assert np.isfinite(getattr(result, name)) and np.isfinite(getattr(result, f"{name}_err"))
-    assert {"p0v", "p0v_err"} <= set(result.p0v.columns)
-    assert {"px", "px_err"} <= set(result.px.columns)
-    assert {"v2_given_x", "v2_given_x_err"} <= set(result.v2_given_x.columns)
-    assert {"pxv", "pxv_err"} <= set(result.pxv.columns)
-    assert {"density", "density_err"} <= set(result.flight_time_density.columns)
+    assert {"p0v", "p0v_err"} <= set(result.p0v_histogram.columns)
+    assert {"px", "px_err"} <= set(result.px_histogram.columns)
+    assert {"v2_given_x", "v2_given_x_err"} <= set(result.v2_given_x_histogram.columns)
+    assert {"pxv", "pxv_err"} <= set(result.pxv_histogram.columns)
+    assert {"density", "density_err"} <= set(result.flight_time_histogram.columns)
     assert result.merged.collisions == sum(t.collisions for t in result.tallies)
     assert "<x> =" in repr(result)
 

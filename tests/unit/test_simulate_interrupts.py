@@ -50,7 +50,7 @@ if __name__ == "__main__":
             print(type(error).__name__, f"{{stopped:.3f}}", len(error.finished), error)
             sys.exit()
         print(type(error).__name__, f"{{stopped:.3f}}", result.shards, result.requested_shards,
-              result.partial, "PARTIAL" in repr(result), bool(result.summary.partial.iloc[0]))
+              result.partial, "PARTIAL" in repr(result), bool(result.summary_table.partial.iloc[0]))
 """
 
 
@@ -221,7 +221,9 @@ def test_a_partial_result_says_so_and_keeps_its_shard_indices():
         settings={"equilibration_time": 10.0},
     )
     assert not full.partial and "PARTIAL" not in repr(full)
-    assert not full.summary.partial.iloc[0] and full.summary.requested_shards.iloc[0] == 3
+    assert (
+        not full.summary_table.partial.iloc[0] and full.summary_table.requested_shards.iloc[0] == 3
+    )
     partial = SimulationResult(
         restitution=full.restitution,
         seed=full.seed,
@@ -231,5 +233,5 @@ def test_a_partial_result_says_so_and_keeps_its_shard_indices():
         requested_shards=3,
     )
     assert partial.partial and "PARTIAL: shards=2 of 3 (interrupted)" in repr(partial)
-    assert bool(partial.summary.partial.iloc[0])
+    assert bool(partial.summary_table.partial.iloc[0])
     assert sorted(set(partial.batch_frame().shard)) == [0, 2]
