@@ -299,18 +299,42 @@ class EquilibriumBase(abc.ABC):
     ['accuracy', 'collision_rate', 'delta_x']
     """
 
-    restitution: Fraction
-    r: float
-
     def _set_restitution(self, exact: Fraction) -> None:
         from .asymptotics import large_speed_decay_rate, large_speed_exponent, small_speed_exponent
 
-        self.restitution = exact
-        self.r = float(exact)
+        self._restitution = exact
         self._label = restitution_label(exact)
-        self.beta = float(small_speed_exponent(self.r))
-        self.m = float(large_speed_exponent(self.r))
-        self.q = float(large_speed_decay_rate(self.r))
+        r = float(exact)
+        self._exponents = (
+            float(small_speed_exponent(r)),
+            float(large_speed_exponent(r)),
+            float(large_speed_decay_rate(r)),
+        )
+
+    @property
+    def restitution(self) -> Fraction:
+        """r exactly, as parsed: the key of the solve and of the exact formulas."""
+        return self._restitution
+
+    @property
+    def r(self) -> float:
+        """r as a float, ``float(restitution)``, for arithmetic."""
+        return float(self._restitution)
+
+    @property
+    def beta(self) -> float:
+        """beta of P(0, v) ~ A v^-beta as v -> 0, eq. (asym2)."""
+        return self._exponents[0]
+
+    @property
+    def m(self) -> float:
+        """m of P(0, v) ~ v^-m e^(-q v) as v -> inf, eqs. (asym4)-(asym6)."""
+        return self._exponents[1]
+
+    @property
+    def q(self) -> float:
+        """q of P(0, v) ~ v^-m e^(-q v) as v -> inf, eqs. (asym4), (asym6)."""
+        return self._exponents[2]
 
     # --- what each class supplies
     @property
