@@ -1119,8 +1119,9 @@ def _table_row(quantity, simulated, errors, reference, deviations):
 
 
 def compare(equilibrium, result) -> pd.DataFrame:
-    """A simulation held against an equilibrium object: the z of every scalar and the chi^2
-    per bin and sign-flip p of each table, as the validation table computes them.
+    """A simulation held against an equilibrium object, as the validation table holds it.
+
+    The z of every scalar, and the chi^2 per bin and sign-flip p of each table.
 
     The scalars <x>, Delta x, I, <T>, <T^2> (eqs. (xandDeltax), (collrate), (meanT),
     (meanT2)), plain and controlled where the result has a finite controlled estimate:
@@ -1162,7 +1163,7 @@ def compare(equilibrium, result) -> pd.DataFrame:
     >>> table = bb.compare(bb.ExactEquilibrium("1/2"), sim)
     >>> table.loc[table.estimator == "plain", "quantity"].tolist()
     ['mean_x', 'delta_x', 'collision_rate', 'mean_flight_time', 'flight_time_second_moment', 'p0v', 'px', 'v2_given_x']
-    >>> int(table.dof.max())
+    >>> table.dof.max()
     3
     """
     if Fraction(equilibrium.restitution) != Fraction(result.restitution):
@@ -1222,4 +1223,6 @@ def compare(equilibrium, result) -> pd.DataFrame:
                     deviations,
                 )
             )
-    return pd.DataFrame(rows, columns=list(COMPARE_COLUMNS))
+    return pd.DataFrame(rows, columns=list(COMPARE_COLUMNS)).astype(
+        {"dof": "Int64", "bins": "Int64"}
+    )

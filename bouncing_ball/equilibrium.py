@@ -295,7 +295,7 @@ class EquilibriumBase(abc.ABC):
     >>> import bouncing_ball as bb
     >>> isinstance(bb.ExactEquilibrium("1/2"), bb.EquilibriumBase)
     True
-    >>> sorted(bb.EquilibriumBase.__abstractmethods__)[:3]
+    >>> sorted(name for name in bb.EquilibriumBase.__abstractmethods__ if name[0] != "_")[:3]
     ['accuracy', 'collision_rate', 'delta_x']
     """
 
@@ -875,7 +875,7 @@ class EquilibriumBase(abc.ABC):
         --------
         >>> from bouncing_ball import ExactEquilibrium
         >>> print(ExactEquilibrium("1/2").p0v_bin_average([0.5, 1.0], [1.0, 2.0]).round(6))
-        [0.234637 0.051676]
+        [0.212134 0.051676]
         """
         lo, hi = self._speed_bins(lo, hi)
         return _out(np.asarray(self._outgoing_bin_average(lo, hi), dtype=float).reshape(lo.shape))
