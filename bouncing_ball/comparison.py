@@ -1163,7 +1163,7 @@ def compare(equilibrium, result) -> pd.DataFrame:
     >>> table = bb.compare(bb.ExactEquilibrium("1/2"), sim)
     >>> table.loc[table.estimator == "plain", "quantity"].tolist()
     ['mean_x', 'delta_x', 'collision_rate', 'mean_flight_time', 'flight_time_second_moment', 'p0v', 'px', 'v2_given_x']
-    >>> table.dof.max()
+    >>> print(table.dof.max())
     3
     """
     if Fraction(equilibrium.restitution) != Fraction(result.restitution):

@@ -174,6 +174,18 @@ def test_simulate_agrees_with_the_exact_solution_at_one_half():
         value, error = getattr(result, name), getattr(result, f"{name}_err")
         assert 0.0 < error < 0.1 * abs(value)
         assert abs(value - getattr(exact, name)) < 4.0 * error, name
+    table = bb.compare(exact, result).set_index(["quantity", "estimator"])
+    assert set(table.dof.dropna()) == {15}
+    for name in ("mean_x", "delta_x", "collision_rate", "mean_flight_time"):
+        row = table.loc[(name, "plain")]
+        z = (getattr(result, name) - getattr(exact, name)) / getattr(result, f"{name}_err")
+        assert row.z == pytest.approx(z, rel=1e-12) and abs(row.z) < 4.0
+    # each table's sign-flip p: below 1e-3 with probability 1e-3 under the null
+    for name in ("p0v", "px", "v2_given_x"):
+        assert table.loc[(name, "plain"), "bins"] > 5
+        assert table.loc[(name, "plain"), "p_sign_flip"] > 1e-3, name
+    with pytest.raises(ValueError, match="r = 1/3"):
+        bb.compare(bb.ExactEquilibrium("1/3"), result)
 
 
 def test_simulation_result_has_the_observables():
