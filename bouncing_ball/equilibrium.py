@@ -280,11 +280,6 @@ class EquilibriumBase(abc.ABC):
         A bound on the relative error of P(x) and its moments.
     distribution_available : bool
         Whether P(x), <v^2>_x, P(x, v) and w(F) are computed at this r.
-    solution : solver.OutgoingSpeedSolution
-        P(0, v) at the solver's nodes (the quadratures of the flight-time and return-speed
-        tables run on them).
-    weight_function : distribution.WeightFunction or distribution.ClosedFormWeight
-        w(F) of eq. (weightfunc) as an object (``__call__`` and ``log``).
     smallest_speed, smallest_force : float
         The lower bounds of ``p0v`` and ``weight``.
     relaxation_eigenvalue, correlation_bounces, relaxation_time, relaxation_accuracy : float
