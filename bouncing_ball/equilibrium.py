@@ -1243,8 +1243,6 @@ class Equilibrium(EquilibriumBase):
     r : float
     restitution : fractions.Fraction
         r exactly, as parsed.
-    label : str
-        The label the workflow files r's outputs under.
     collision_rate : float
         I = M_1, eq. (collrate); inf below r_c.
     mean_x, delta_x : float
