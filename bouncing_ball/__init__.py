@@ -4,10 +4,13 @@ The public API:
 
 - ``Equilibrium(r)``: the equilibrium state at any r the solver answers (eq. (inteq)): the
   time averages, the exponents, P(0, v), P(x), <v^2>_x, P(x, v), w(F), the flight times;
-- ``ExactEquilibrium(r)``: the paper's exact r = 1/2 and 1/3 solutions, the same interface;
+- ``ExactEquilibrium(r)``: the paper's exact r = 1/2 and 1/3 solutions; both are
+  ``EquilibriumBase``, with the same methods and signatures;
 - ``simulate(r, shards=..., shard_time=...)``: the Monte Carlo simulation of the paper's
   Sec. IV, returning a ``SimulationResult`` with the same observables and their errors;
   ``SimulationResult.save(path)`` writes it to a Parquet file and ``load(path)`` reads it back.
+- ``compare(equilibrium, result)``: the simulation against the equilibrium, z-scores and
+  chi^2 per bin with their sign-flip p-values.
 
 They are loaded on first use, so that ``import bouncing_ball`` (as the workflow does to plan a
 run) loads neither numba nor scipy.
@@ -21,12 +24,14 @@ __version__ = "0.3.0"
 PACKAGE = Path(__file__).parent
 
 __all__ = [
+    "EquilibriumBase",
     "Equilibrium",
     "ExactEquilibrium",
     "simulate",
     "SimulationResult",
     "SimulationInterrupted",
     "load",
+    "compare",
     "PACKAGE",
     "source_digest",
     "__version__",
@@ -34,12 +39,14 @@ __all__ = [
 
 # public name -> the module that defines it (imported on first access, PEP 562)
 _LAZY = {
+    "EquilibriumBase": "equilibrium",
     "Equilibrium": "equilibrium",
     "ExactEquilibrium": "equilibrium",
     "simulate": "monte_carlo",
     "SimulationResult": "monte_carlo",
     "SimulationInterrupted": "monte_carlo",
     "load": "monte_carlo",
+    "compare": "comparison",
 }
 
 

@@ -34,8 +34,10 @@ Importing this module loads neither scipy nor numba (the config check of every w
 uses ``check_solver_settings``); the solver loads them on first use.
 """
 
+import abc
 import collections
 import functools
+import inspect
 import math
 import numbers
 import weakref
@@ -54,8 +56,11 @@ from .restitution import (
 )
 
 __all__ = [
+    "EquilibriumBase",
     "Equilibrium",
     "ExactEquilibrium",
+    "EXACT_ACCURACY",
+    "SPEED_PANEL",
     "QUADRATURE_STEP_RANGE",
     "WEIGHT_PANEL_NODES_RANGE",
     "KEPT_SOLVES",
@@ -76,6 +81,13 @@ QUADRATURE_STEP_RANGE = (0.1, 0.3)
 #: 0.02, and 0.99, where the step 0.3 and 10 nodes hold ``position_accuracy`` at ~3e-11); at 9 the margin is 2.5, at 8 P(x) misses it (3e-8 at r = 0.15).  Above 40 the cost
 #: grows with nothing to gain.
 WEIGHT_PANEL_NODES_RANGE = (10, 40)
+#: The widest panel in ln v of ``Equilibrium.p0v_bin_average``'s Gauss-Legendre rule
+#: (``bins.outgoing_speed_bin_average`` on each panel): a bin wider than this is split.
+SPEED_PANEL = 0.5
+#: ``ExactEquilibrium.accuracy``: the relative tolerance its quadratures are asked for and
+#: meet (the time averages and flight times against the solver at its finest settings,
+#: tests/unit/test_equilibrium.py); P(0, v) and, at r = 1/2, P(x) are closed forms.
+EXACT_ACCURACY = 1e-11
 
 
 # ---------------------------------------------------------------------------------------------
@@ -237,51 +249,187 @@ def _out(array):
 # what both classes share
 
 
-class _EquilibriumState:
-    """The interface of ``Equilibrium`` and ``ExactEquilibrium``: the checks and the parts that
-    do not depend on how P(0, v) is known."""
+class EquilibriumBase(abc.ABC):
+    """The equilibrium state of the bouncing ball at one r: what ``Equilibrium`` and
+    ``ExactEquilibrium`` both answer, with the same methods and signatures.
 
-    restitution: Fraction
-    r: float
-    label: str
+    An abstract class: ``Equilibrium(r)`` computes it from the solver of eq. (inteq) at any r of
+    ``restitution.SOLVER_RESTITUTION_RANGE``; ``ExactEquilibrium(r)`` from the paper's exact
+    solutions at r = 1/2 and 1/3.  Code written against this class takes either, so the exact
+    solutions stand in for the solver (and check it) wherever they exist.
+
+    Every method takes arrays and broadcasts like numpy (a scalar in, a numpy scalar out), and
+    refuses input that has no answer with a ValueError naming the argument.
+
+    Attributes
+    ----------
+    restitution : fractions.Fraction
+        r exactly, as parsed (the key of the solve and of the exact formulas).
+    r : float
+        ``float(restitution)``, for arithmetic.
+    beta, m, q : float
+        The exponents of P(0, v) ~ v^-beta (v -> 0, eq. (asym2)) and v^-m e^(-q v) (v -> inf,
+        eqs. (asym4)-(asym6)).
+    collision_rate, mean_x, delta_x : float
+        I = M_1 (eq. (collrate); inf below r_c), <x> and Delta x (eq. (xandDeltax)).
+    mean_flight_time, flight_time_second_moment : float
+        <T> and <T^2> per collision (0 below r_c), eqs. (meanT), (meanT2).
+    accuracy : float
+        A bound on the relative error of P(0, v) and the time averages.
+    position_accuracy : float
+        A bound on the relative error of P(x) and its moments.
+    distribution_available : bool
+        Whether P(x), <v^2>_x, P(x, v) and w(F) are computed at this r.
+    smallest_speed, smallest_force : float
+        The lower bounds of ``p0v`` and ``weight``.
+    relaxation_eigenvalue, correlation_bounces, relaxation_time, relaxation_accuracy : float
+        The relaxation of the bounce-speed chain (``relaxation``).
+
+    Examples
+    --------
+    >>> import bouncing_ball as bb
+    >>> isinstance(bb.ExactEquilibrium("1/2"), bb.EquilibriumBase)
+    True
+    >>> sorted(name for name in bb.EquilibriumBase.__abstractmethods__ if name[0] != "_")[:3]
+    ['accuracy', 'collision_rate', 'delta_x']
+    """
 
     def _set_restitution(self, exact: Fraction) -> None:
         from .asymptotics import large_speed_decay_rate, large_speed_exponent, small_speed_exponent
 
-        self.restitution = exact
-        self.r = float(exact)
-        self.label = restitution_label(exact)
-        self.beta = float(small_speed_exponent(self.r))
-        self.m = float(large_speed_exponent(self.r))
-        self.q = float(large_speed_decay_rate(self.r))
+        self._restitution = exact
+        self._label = restitution_label(exact)
+        r = float(exact)
+        self._exponents = (
+            float(small_speed_exponent(r)),
+            float(large_speed_exponent(r)),
+            float(large_speed_decay_rate(r)),
+        )
+
+    @property
+    def restitution(self) -> Fraction:
+        """r exactly, as parsed: the key of the solve and of the exact formulas."""
+        return self._restitution
+
+    @property
+    def r(self) -> float:
+        """r as a float, ``float(restitution)``, for arithmetic."""
+        return float(self._restitution)
+
+    @property
+    def beta(self) -> float:
+        """beta of P(0, v) ~ A v^-beta as v -> 0, eq. (asym2)."""
+        return self._exponents[0]
+
+    @property
+    def m(self) -> float:
+        """m of P(0, v) ~ v^-m e^(-q v) as v -> inf, eqs. (asym4)-(asym6)."""
+        return self._exponents[1]
+
+    @property
+    def q(self) -> float:
+        """q of P(0, v) ~ v^-m e^(-q v) as v -> inf, eqs. (asym4), (asym6)."""
+        return self._exponents[2]
 
     # --- what each class supplies
+    @property
+    @abc.abstractmethod
+    def collision_rate(self) -> float:
+        """I = M_1 = int v P(0, v) dv, eq. (collrate): collisions per unit time (inf below
+        r_c)."""
+
+    @property
+    @abc.abstractmethod
+    def mean_x(self) -> float:
+        """<x>, the time average of the height, eq. (xandDeltax)."""
+
+    @property
+    @abc.abstractmethod
+    def delta_x(self) -> float:
+        """Delta x = (<x^2> - <x>^2)^(1/2), eq. (xandDeltax)."""
+
+    @property
+    @abc.abstractmethod
+    def mean_flight_time(self) -> float:
+        """<T>, the mean time between two collisions, eq. (meanT) (0 below r_c)."""
+
+    @property
+    @abc.abstractmethod
+    def flight_time_second_moment(self) -> float:
+        """<T^2> per collision, eq. (meanT2) (0 below r_c)."""
+
+    @property
+    @abc.abstractmethod
+    def accuracy(self) -> float:
+        """A bound on the relative error of P(0, v), the time averages and the flight times."""
+
+    @property
+    @abc.abstractmethod
+    def position_accuracy(self) -> float:
+        """A bound on the relative error of P(x) of eq. (P(x)1) and its moments."""
+
+    @property
+    @abc.abstractmethod
+    def distribution_available(self) -> bool:
+        """Whether P(x), <v^2>_x, P(x, v) and w(F) are computed at this r."""
+
+    @property
+    @abc.abstractmethod
+    def solution(self):
+        """P(0, v) at the solver's nodes, a ``solver.OutgoingSpeedSolution``."""
+
+    @property
+    @abc.abstractmethod
+    def weight_function(self):
+        """w(F) of eq. (weightfunc) as an object with ``__call__(F)`` and ``log(F)``."""
+
+    @abc.abstractmethod
     def _outgoing(self, v):  # P(0, v), v > 0
-        raise NotImplementedError
+        """P(0, v) at v > 0."""
 
+    @abc.abstractmethod
     def _floor_density(self) -> float:  # P(x = 0) = int dv P(0, v), both sides
-        raise NotImplementedError
+        """P(x = 0)."""
 
-    def _position(self, x):  # P(x), x > 0
-        raise NotImplementedError
+    @abc.abstractmethod
+    def _position(self, x):
+        """P(x) at x > 0."""
 
-    def _speed_squared(self, x):  # <v^2>_x, x > 0
-        raise NotImplementedError
+    @abc.abstractmethod
+    def _speed_squared(self, x):
+        """<v^2>_x at x > 0."""
 
-    def _joint(self, x, v):  # P(x, v), x >= 0 (NaN at x = v = 0)
-        raise NotImplementedError
+    @abc.abstractmethod
+    def _joint(self, x, v):
+        """P(x, v) at x >= 0 (NaN at x = v = 0)."""
 
-    def _weight(self, force):  # w(F), F > 0
-        raise NotImplementedError
+    @abc.abstractmethod
+    def _weight(self, force):
+        """w(F) at F > 0."""
 
-    def _flight_rate(self, times):  # nu(T), T > 0 (flight_time.flight_rate_in_regimes)
-        raise NotImplementedError
+    @abc.abstractmethod
+    def _flight_rate(self, times):
+        """nu(T) at T > 0 (``flight_time.flight_rate_in_regimes``)."""
 
-    def _short_flight_amplitude(self) -> float:  # A C_beta of nu ~ A C_beta T^(-beta/2)
-        raise NotImplementedError
+    @abc.abstractmethod
+    def _short_flight_amplitude(self) -> float:
+        """A C_beta of nu ~ A C_beta T^(-beta/2), eq. (short)."""
 
-    def _check_distribution(self, what: str) -> None:  # ValueError where P(x) is not computed
-        pass
+    @abc.abstractmethod
+    def _outgoing_bin_average(self, lo, hi):
+        """int v P(0, v) dv / int v dv over each bin, 0 < lo < hi < inf."""
+
+    @abc.abstractmethod
+    def _position_bin_average(self, lo, hi):
+        """int P(x) dx / (hi - lo) over each bin, checked bins."""
+
+    @abc.abstractmethod
+    def _speed_squared_bin_average(self, lo, hi):
+        """int_bin dx int_x^inf P / int_bin P dx over each bin, checked bins."""
+
+    def _check_distribution(self, what: str) -> None:
+        """ValueError naming ``what`` where P(x) is not computed (nothing by default)."""
+        return None
 
     # --- the public methods
     @functools.cached_property
@@ -331,7 +479,7 @@ class _EquilibriumState:
         if tiny.any():
             raise ValueError(
                 f"v = {v[tiny].flat[0]:g} is below smallest_speed = {self.smallest_speed:.3g} at "
-                f"r = {self.label}, where P(0, v) ~ A v^-beta (eq. (asym1)) exceeds the largest "
+                f"r = {self._label}, where P(0, v) ~ A v^-beta (eq. (asym1)) exceeds the largest "
                 "double; give v = 0 (P = inf) or v >= smallest_speed"
             )
         result = np.full(v.shape, np.inf)
@@ -527,7 +675,7 @@ class _EquilibriumState:
         if small.any():
             raise ValueError(
                 f"F = {force[small].flat[0]:g} is below smallest_force = {self.smallest_force:.3g}"
-                f" at r = {self.label}, where w(F) ~ F^gamma e^(-S/F) with S < 0 exceeds the "
+                f" at r = {self._label}, where w(F) ~ F^gamma e^(-S/F) with S < 0 exceeds the "
                 "largest double (distribution.small_force_decay)"
             )
         with np.errstate(over="ignore", divide="ignore"):  # e^(-S/F) underflows at tiny F
@@ -547,7 +695,7 @@ class _EquilibriumState:
         bad = (times > 0.0) & (times < shortest)
         if bad.any():
             raise ValueError(
-                f"{name} must be 0 or >= {shortest:.3g} at r = {self.label}: below, "
+                f"{name} must be 0 or >= {shortest:.3g} at r = {self._label}: below, "
                 f"{'rho' if per_collision else 'nu'}(T) ~ T^(-beta/2) (eq. (short)) exceeds "
                 f"the largest double; got {times[bad].flat[0]:g}"
             )
@@ -666,6 +814,180 @@ class _EquilibriumState:
         v, u = _broadcast(v, u, ("v", "u"))
         return _out(return_speed_density(v, u))
 
+    # --- averages over the bins and cells of a simulation's tables (``SimulationResult``)
+    def _speed_bins(self, lo, hi):
+        """Speed bins checked: smallest_speed <= lo < hi, finite, lo > 0 (ValueError naming
+        lo or hi and the bound)."""
+        lo, hi = _broadcast(
+            _checked(lo, "lo", low=0.0, strictly=True), _checked(hi, "hi"), ("lo", "hi")
+        )
+        if np.any(lo < self.smallest_speed):
+            raise ValueError(
+                f"lo = {lo[lo < self.smallest_speed].flat[0]:g} is below smallest_speed = "
+                f"{self.smallest_speed:.3g} at r = {self._label}"
+            )
+        if np.any(hi <= lo):
+            raise ValueError(f"hi must be > lo, got hi = {hi[hi <= lo].flat[0]:g}")
+        return lo, hi
+
+    def _height_bins(self, lo, hi, what: str):
+        """Height bins checked: lo = 0 or ``distribution.SMALLEST_POSITION`` <= lo < hi <=
+        ``distribution.LARGEST_POSITION`` (ValueError naming lo or hi and the bound)."""
+        self._check_distribution(what)
+        lo, hi = _broadcast(_heights(lo, "lo"), _heights(hi, "hi"), ("lo", "hi"))
+        if np.any(hi <= lo):
+            raise ValueError(f"hi must be > lo, got hi = {hi[hi <= lo].flat[0]:g}")
+        return lo, hi
+
+    def p0v_bin_average(self, lo, hi):
+        """P(0, v) averaged over speed bins as a simulation's P(0, v) table measures it, with
+        the weight v of the flux through the floor (eq. (collrate)):
+        int_lo^hi v P(0, v) dv / int_lo^hi v dv.
+
+        ``ExactEquilibrium``: in closed form (``exact.outgoing_speed_bin_average``);
+        ``Equilibrium``: ``bins.outgoing_speed_bin_average`` (8-point Gauss-Legendre in ln v)
+        on panels of at most ``SPEED_PANEL`` in ln v, so a wide bin is as accurate as a
+        narrow one.
+
+        Parameters
+        ----------
+        lo, hi : array_like
+            The bins' edges, ``smallest_speed`` <= lo < hi, lo > 0, finite; they broadcast
+            (the v_lo, v_hi columns of ``SimulationResult.p0v`` without its under- and
+            overflow bins).
+
+        Returns
+        -------
+        numpy.ndarray or numpy.float64
+            The bin averages, the broadcast shape.
+
+        Raises
+        ------
+        ValueError
+            Naming lo or hi and the bound.
+
+        Examples
+        --------
+        >>> from bouncing_ball import ExactEquilibrium
+        >>> print(ExactEquilibrium("1/2").p0v_bin_average([0.5, 1.0], [1.0, 2.0]).round(6))
+        [0.212134 0.051676]
+        """
+        lo, hi = self._speed_bins(lo, hi)
+        return _out(np.asarray(self._outgoing_bin_average(lo, hi), dtype=float).reshape(lo.shape))
+
+    def px_bin_average(self, lo, hi):
+        """P(x) averaged over height bins as a simulation's P(x) table measures it (the time
+        spent in the bin over the time and the bin's width): int_lo^hi P(x) dx / (hi - lo).
+
+        The x integral is done under the F integral of eq. (P(x)1) in closed form
+        (``distribution.position_bin_average``; ``exact.position_bin_average`` for the exact
+        solutions), so a narrow bin loses nothing to cancellation.
+
+        Parameters
+        ----------
+        lo, hi : array_like
+            The bins' edges: lo = 0 or ``distribution.SMALLEST_POSITION`` (1e-300) <= lo < hi
+            <= ``distribution.LARGEST_POSITION`` (1e12); they broadcast.
+
+        Returns
+        -------
+        numpy.ndarray or numpy.float64
+            The bin averages, the broadcast shape (finite also where P(0) is infinite).
+
+        Raises
+        ------
+        ValueError
+            Naming lo or hi and the bound; r above ``DISTRIBUTION_RESTITUTION_RANGE``.
+
+        Examples
+        --------
+        >>> from bouncing_ball import ExactEquilibrium
+        >>> print(ExactEquilibrium("1/2").px_bin_average([0.0, 1.0], [1.0, 2.0]).round(8))
+        [0.31801854 0.1429493 ]
+        """
+        lo, hi = self._height_bins(lo, hi, "px_bin_average")
+        return _out(np.asarray(self._position_bin_average(lo, hi), dtype=float).reshape(lo.shape))
+
+    def v2_given_x_bin_average(self, lo, hi):
+        """<v^2>_x of eq. (moment2) averaged over height bins with the weight P(x), as a
+        simulation's <v^2>_x table measures it (the integral of v^2 dt over the time spent in
+        the bin): int_lo^hi dx int_x^inf P(x') dx' / int_lo^hi P(x) dx, the ratio of the bin
+        integrals of P(x) <v^2>_x and of P(x).
+
+        Parameters
+        ----------
+        lo, hi : array_like
+            The bins' edges, as ``px_bin_average``'s.
+
+        Returns
+        -------
+        numpy.ndarray or numpy.float64
+            The bin averages, the broadcast shape.
+
+        Raises
+        ------
+        ValueError
+            Naming lo or hi and the bound; r above ``DISTRIBUTION_RESTITUTION_RANGE``.
+
+        Examples
+        --------
+        >>> from bouncing_ball import ExactEquilibrium
+        >>> print(ExactEquilibrium("1/2").v2_given_x_bin_average([0.0, 1.0], [1.0, 2.0]).round(8))
+        [2.53258574 4.23045873]
+        """
+        lo, hi = self._height_bins(lo, hi, "v2_given_x_bin_average")
+        return _out(
+            np.asarray(self._speed_squared_bin_average(lo, hi), dtype=float).reshape(lo.shape)
+        )
+
+    def pxv_cell_average(self, x_lo, x_hi, v_lo, v_hi):
+        """P(x, v) of eq. (fpsol) averaged over cells of (x, v), as a simulation's P(x, v)
+        table measures it: int dx int dv P(x, v) / ((x_hi - x_lo) (v_hi - v_lo)).
+
+        ``distribution.distribution_cell_average`` of ``weight_function``: the x average in
+        closed form under the F integral, the v average by Gauss-Legendre on panels no wider
+        than x_lo^(1/3); good to 1e-9 for x_lo >= 0.01.
+
+        Parameters
+        ----------
+        x_lo, x_hi, v_lo, v_hi : array_like
+            The cells' edges, 0 < x_lo < x_hi <= ``distribution.LARGEST_POSITION`` and finite
+            v_lo < v_hi; they broadcast.  A cell must not reach an x and v > 0 at which the F
+            integral's Airy factor oscillates too fast (as ``pxv``).
+
+        Returns
+        -------
+        numpy.ndarray or numpy.float64
+            The cell averages, the broadcast shape.
+
+        Raises
+        ------
+        ValueError
+            Naming the edge and the bound; r above ``DISTRIBUTION_RESTITUTION_RANGE``.
+
+        Examples
+        --------
+        >>> from bouncing_ball import ExactEquilibrium
+        >>> eq = ExactEquilibrium("1/2")
+        >>> print(eq.pxv_cell_average([0.5, 1.0], [1.0, 2.0], 0.0, 1.0).round(8))
+        [0.06005725 0.03294018]
+        """
+        from . import distribution
+
+        self._check_distribution("pxv_cell_average")
+        x_lo, x_hi = _broadcast(
+            _checked(x_lo, "x_lo", low=0.0, strictly=True), _heights(x_hi, "x_hi"), ("x_lo", "x_hi")
+        )
+        v_lo, v_hi = _broadcast(_checked(v_lo, "v_lo"), _checked(v_hi, "v_hi"), ("v_lo", "v_hi"))
+        if np.any(x_hi <= x_lo):
+            raise ValueError(f"x_hi must be > x_lo, got x_hi = {x_hi[x_hi <= x_lo].flat[0]:g}")
+        if np.any(v_hi <= v_lo):
+            raise ValueError(f"v_hi must be > v_lo, got v_hi = {v_hi[v_hi <= v_lo].flat[0]:g}")
+        x_lo, x_hi, v_lo, v_hi = np.broadcast_arrays(x_lo, x_hi, v_lo, v_hi)
+        return _out(
+            distribution.distribution_cell_average(x_lo, x_hi, v_lo, v_hi, self.weight_function)
+        )
+
     # --- the relaxation of the bounce-speed chain (``relaxation``), computed on first use
     _relaxation_step = None  # the solver's step of the matrix (``Equilibrium``: its own)
 
@@ -775,22 +1097,6 @@ class _EquilibriumState:
             f"<T> = {self.mean_flight_time:.10g}, <T^2> = {self.flight_time_second_moment:.10g}; "
             f"beta = {self.beta:.6g}, m = {self.m:.6g}, q = {self.q:.6g}"
         )
-
-
-def _relaxation_columns(equilibrium) -> dict:
-    """The summary's ``relaxation.RELAXATION_COLUMNS`` of an ``Equilibrium``: NaN at r <= r_c."""
-    from .asymptotics import CRITICAL_RESTITUTION
-    from .relaxation import RELAXATION_COLUMNS
-
-    if equilibrium.r <= CRITICAL_RESTITUTION:
-        return dict.fromkeys(RELAXATION_COLUMNS, math.nan)
-    return {
-        "relaxation_eigenvalue": equilibrium.relaxation_eigenvalue,
-        "relaxation_eigenvalue_accuracy": equilibrium.relaxation_accuracy,
-        "continuum_edge": equilibrium._relaxation.continuum_edge,
-        "correlation_bounces": equilibrium.correlation_bounces,
-        "relaxation_time": equilibrium.relaxation_time,
-    }
 
 
 @functools.lru_cache(maxsize=16)
@@ -908,7 +1214,7 @@ def _solver_restitution(r) -> Fraction:
     return exact
 
 
-class Equilibrium(_EquilibriumState):
+class Equilibrium(EquilibriumBase):
     """The equilibrium state of the bouncing ball at one coefficient of restitution r,
     from the numerical solution of eq. (inteq).
 
@@ -923,8 +1229,6 @@ class Equilibrium(_EquilibriumState):
         <v^2>_x, P(x, v), w(F)) are computed in ``restitution.DISTRIBUTION_RESTITUTION_RANGE``;
         above it they raise ValueError, and P(0, v), the time averages, the flight times and the
         exponents remain.
-    exact : bool, optional
-        If True, return the paper's exact solution, ``ExactEquilibrium(r)`` (r = 1/2 or 1/3).
     quadrature_step : float, optional
         The trapezoidal step of the solver in s = ln v + v^(1/2) (``solver.DEFAULT_STEP``; the
         config's ``solver.quadrature_step``), 0.1 <= step <= 0.3 (``QUADRATURE_STEP_RANGE``,
@@ -939,8 +1243,6 @@ class Equilibrium(_EquilibriumState):
     r : float
     restitution : fractions.Fraction
         r exactly, as parsed.
-    label : str
-        The label the workflow files r's outputs under.
     collision_rate : float
         I = M_1, eq. (collrate); inf below r_c.
     mean_x, delta_x : float
@@ -991,45 +1293,73 @@ class Equilibrium(_EquilibriumState):
     True
     >>> print(eq.px([0.1, 1.0]).round(6))  # builds w(F) first
     [0.503776 0.183784]
-    >>> Equilibrium("1/2", exact=True)
-    ExactEquilibrium(r=1/2): I = 0.3333333333, ...
+
+    The exact solutions are their own class, ``ExactEquilibrium("1/2")``, not a flag of this
+    one: each class is built one way, with one signature, and both are ``EquilibriumBase``.
+    Passing ``exact=`` raises a TypeError that names ``ExactEquilibrium``.
     """
 
-    def __new__(cls, r, *, exact=False, **settings):
-        if exact:
-            if settings:
-                raise TypeError(
-                    f"exact=True takes no solver settings, got {', '.join(sorted(settings))}"
-                )
-            return ExactEquilibrium(r)
+    def __new__(cls, *args, **kwargs):
+        if "exact" in kwargs:
+            raise TypeError(
+                "Equilibrium takes no exact argument: the paper's exact solutions are "
+                "ExactEquilibrium(r), r = 1/2 or 1/3 (the same interface, EquilibriumBase)"
+            )
         return super().__new__(cls)
 
-    def __init__(
-        self, r, *, exact=False, quadrature_step=None, weight_panel_nodes=None
-    ):  # exact=True is handled by __new__
+    def __init__(self, r, *, quadrature_step=None, weight_panel_nodes=None):
         from . import flight_time, solver
 
         self._set_restitution(_solver_restitution(r))
         self.quadrature_step, self.weight_panel_nodes = check_solver_settings(
             quadrature_step, weight_panel_nodes
         )
-        self.distribution_available = in_range(self.restitution, DISTRIBUTION_RESTITUTION_RANGE)
         self._solve = _shared_solve(self.restitution, self.quadrature_step)
-        self.solution = self._solve.solution
         averages = solver.time_averages(self.solution)
-        self.collision_rate = float(averages["collision_rate"])
-        self.mean_x = float(averages["mean_x"])
-        self.delta_x = float(averages["delta_x"])
-        self.mean_flight_time = float(flight_time.mean_flight_time(self.solution))
-        self.flight_time_second_moment = float(flight_time.flight_time_second_moment(self.solution))
+        self._averages = {
+            "collision_rate": float(averages["collision_rate"]),
+            "mean_x": float(averages["mean_x"]),
+            "delta_x": float(averages["delta_x"]),
+            "mean_flight_time": float(flight_time.mean_flight_time(self.solution)),
+            "flight_time_second_moment": float(
+                flight_time.flight_time_second_moment(self.solution)
+            ),
+        }
         self._relaxation_step = self.quadrature_step
 
     def __reduce__(self):
         """Pickled and copied as its state: r, the settings, the solve and what has been
         computed from it (kilobytes; rebuilding them would cost a solve and w(F), and could
-        differ in the last bits on another machine).  ``__new__`` needs r, so the state is
-        restored on an object made without it (``_restored``)."""
+        differ in the last bits on another machine), restored on an object made without
+        calling ``__init__`` (``_restored``)."""
         return (_restored, (type(self), dict(self.__dict__)))
+
+    collision_rate = property(
+        lambda self: self._averages["collision_rate"], doc=EquilibriumBase.collision_rate.__doc__
+    )
+    mean_x = property(lambda self: self._averages["mean_x"], doc=EquilibriumBase.mean_x.__doc__)
+    delta_x = property(lambda self: self._averages["delta_x"], doc=EquilibriumBase.delta_x.__doc__)
+    mean_flight_time = property(
+        lambda self: self._averages["mean_flight_time"],
+        doc=EquilibriumBase.mean_flight_time.__doc__,
+    )
+    flight_time_second_moment = property(
+        lambda self: self._averages["flight_time_second_moment"],
+        doc=EquilibriumBase.flight_time_second_moment.__doc__,
+    )
+
+    @property
+    def distribution_available(self) -> bool:
+        """Whether r lies in ``restitution.DISTRIBUTION_RESTITUTION_RANGE``, where P(x),
+        <v^2>_x, P(x, v) and w(F) are computed."""
+        return in_range(self.restitution, DISTRIBUTION_RESTITUTION_RANGE)
+
+    @property
+    def solution(self):
+        """P(0, v) of eq. (inteq) at the solver's nodes (``solver.OutgoingSpeedSolution``): the
+        one solve everything here is computed from, shared by the ``Equilibrium`` objects of
+        this r and step in the process."""
+        return self._solve.solution
 
     def _check_distribution(self, what: str) -> None:
         if not self.distribution_available:
@@ -1038,7 +1368,7 @@ class Equilibrium(_EquilibriumState):
             except ValueError as error:
                 raise ValueError(
                     f"{error}: Equilibrium.{what} needs w(F) of eq. (weightfunc), computed "
-                    f"only there; at r = {self.label} Equilibrium gives P(0, v), the time "
+                    f"only there; at r = {self._label} Equilibrium gives P(0, v), the time "
                     "averages, the flight times and the exponents"
                 ) from None
 
@@ -1118,284 +1448,36 @@ class Equilibrium(_EquilibriumState):
         amplitude = flight_time.small_speed_amplitude(self.solution)
         return amplitude * flight_time.short_time_constant(self.beta)
 
-    # --- the workflow's tables (results/solver/r{r}/)
-    @functools.cached_property
-    def _summary(self) -> dict:
-        from . import distribution, flight_time, solver
+    def _outgoing_bin_average(self, lo, hi):
+        """``bins.outgoing_speed_bin_average`` on panels of at most ``SPEED_PANEL`` in ln v,
+        recombined with their weights int v dv."""
+        from .bins import outgoing_speed_bin_average
 
-        self._check_distribution("summary")
-        row = solver.solution_summary(self.solution, with_accuracy_estimate=False)
-        row["accuracy_estimate"] = self.accuracy
-        collisions = flight_time.flight_time_summary(self.solution)
-        row.update({key: value for key, value in collisions.items() if key not in row})
-        weight = self.weight_function
-        averages = self._position_averages
-        row["position_normalization"] = averages["normalization"]
-        row["mean_x_from_position"] = averages["mean_x"]
-        row["delta_x_from_position"] = averages["delta_x"]
-        row["weight_interpolation_error"] = weight.interpolation_error
-        measured = distribution.measured_exponents(weight)
-        for key, value in distribution.predicted_exponents(self.restitution).items():
-            row[f"{key}_measured"], row[f"{key}_predicted"] = measured[key], value
-        row["large_x_window_lo"], row["large_x_window_hi"] = measured["large_x_window"]
-        row.update(_relaxation_columns(self))
-        return row
+        lo, hi = lo.ravel(), hi.ravel()
+        panels = np.maximum(np.ceil(np.log(hi / lo) / SPEED_PANEL), 1).astype(int)
+        owner = np.repeat(np.arange(lo.size), panels)
+        step = np.concatenate([np.arange(n) for n in panels])
+        ratio = (hi / lo) ** (1.0 / panels)
+        lower = lo[owner] * ratio[owner] ** step
+        upper = np.where(step + 1 == panels[owner], hi[owner], lower * ratio[owner])
+        flux = outgoing_speed_bin_average(self._outgoing, lower, upper) * (upper**2 - lower**2)
+        return np.bincount(owner, flux, minlength=lo.size) / (hi**2 - lo**2)
 
-    def summary(self) -> dict:
-        """The solve rule's summary row: ``solver.solution_summary`` (with the accuracy
-        estimate), the collision statistics (``flight_time.flight_time_summary``), <x>, Delta x
-        and the normalisation from P(x) (eqs. (P(x)1), (xandDeltax)), the interpolation error
-        of w(F) (``WeightFunction.interpolation_error``), the measured and predicted
-        exponents of P(x) with the large-x fit window (``distribution.measured_exponents``),
-        and the relaxation of the bounce-speed chain (``relaxation.RELAXATION_COLUMNS``; NaN
-        below r_c, where it is not defined).
-
-        Returns
-        -------
-        dict
-            One row of ``results/solver/r{r}/summary.parquet`` (a copy: computed once).
-
-        Examples
-        --------
-        >>> from bouncing_ball import Equilibrium
-        >>> row = Equilibrium("1/2").summary()
-        >>> print(f"{row['mean_x']:.8f} {row['mean_x_from_position']:.8f}")
-        6.00000000 6.00000000
-        """
-        return dict(self._summary)
-
-    def check(self, tables) -> None:
-        """The solve rule's checks of its tables and of ``summary()``, held to the accuracy
-        target ``solver.ACCURACY_TARGET`` (1e-8): ``accuracy`` (P(0, v) against a finer solve)
-        and ``position_accuracy`` (int P dx = 1, and <x>, Delta x from P(x) of eq. (P(x)1)
-        against the Ito identities) within it; then ``distribution.check_solve_tables``: no
-        NaN where a value is defined and no infinity anywhere, the moments from P(x) equal the
-        Ito ones, the measured exponents within their tolerance of the predicted ones.
-
-        Parameters
-        ----------
-        tables : dict of str to pandas.DataFrame
-            Any of p0v, flight_time, return_speed, position, distribution, weight, as the table
-            methods give them.
-
-        Raises
-        ------
-        ValueError
-            Naming r and every check that fails: first ``accuracy`` and ``position_accuracy``
-            beyond the target (with the settings), then the tables' (naming the table and
-            column).
-
-        Examples
-        --------
-        >>> import numpy as np
-        >>> from bouncing_ball import Equilibrium
-        >>> eq = Equilibrium("1/2")
-        >>> eq.check({"position": eq.position_table([0.1, 1.0])})
-        >>> table = eq.flight_time_table([1.0, 2.0])
-        >>> table.loc[1, "rate_density"] = np.inf
-        >>> eq.check({"flight_time": table})
-        Traceback (most recent call last):
-        ...
-        ValueError: r = 0.5: the solver's tables fail their checks: flight_time: 1 of 2 rate_density are infinite ...
-        """
-        from . import distribution, solver
-
-        target = solver.ACCURACY_TARGET
-        misses = [
-            f"{name} = {value:.1e}"
-            for name, value in (
-                ("accuracy", self.accuracy),
-                ("position_accuracy", self.position_accuracy),
-            )
-            if not value <= target
-        ]
-        if misses:
-            raise ValueError(
-                f"r = {self.label}: the solve misses the {target:.0e} accuracy target: "
-                + ", ".join(misses)
-                + f" (quadrature_step = {self.quadrature_step:g}, weight_panel_nodes = "
-                f"{self.weight_panel_nodes}; docs/distribution.md#where-it-degrades)"
-            )
-        distribution.check_solve_tables(self.label, self.summary(), tables, target)
-
-    def p0v_table(self, speeds):
-        """P(0, v) of eq. (inteq) as a table (``results/solver/r{r}/p0v``).
-
-        Parameters
-        ----------
-        speeds : array_like
-            Outgoing speeds, v > 0.
-
-        Returns
-        -------
-        pandas.DataFrame
-            Columns v, p0v.
-
-        Examples
-        --------
-        >>> from bouncing_ball import Equilibrium
-        >>> Equilibrium("1/2").p0v_table([1.0, 2.0]).round(6)
-             v       p0v
-        0  1.0  0.122626
-        1  2.0  0.022556
-        """
-        import pandas as pd
-
-        speeds = _checked(speeds, "speeds", low=0.0, strictly=True)
-        return pd.DataFrame({"v": speeds, "p0v": self.p0v(speeds)})
-
-    def position_table(self, positions):
-        """P(x) and <v^2>_x, eqs. (P(x)1), (moment2), as a table
-        (``results/solver/r{r}/position``).
-
-        Parameters
-        ----------
-        positions : array_like
-            Heights, x > 0.
-
-        Returns
-        -------
-        pandas.DataFrame
-            Columns x, px, v2_given_x.
-
-        Examples
-        --------
-        >>> from bouncing_ball import Equilibrium
-        >>> Equilibrium("1/2").position_table([0.1, 1.0]).round(6)
-             x        px  v2_given_x
-        0  0.1  0.503776    1.853157
-        1  1.0  0.183784    3.710784
-        """
+    def _position_bin_average(self, lo, hi):
         from . import distribution
 
-        self._check_distribution("position_table")
-        positions = _heights(positions, "positions")
-        if np.any(positions == 0.0):
-            raise ValueError("positions must be > 0 (P(0) is px(0))")
-        return distribution.position_table(self.weight_function, positions)
+        return distribution.position_bin_average(lo, hi, self.weight_function)
 
-    def distribution_table(self, positions, speeds):
-        """P(x, v), eq. (fpsol), on the grid of ``positions`` and ``speeds``, with the largest
-        relative error quad estimates for it (``results/solver/r{r}/distribution``).
-
-        Parameters
-        ----------
-        positions : array_like
-            Heights, x >= 0.
-        speeds : array_like
-            Velocities (either sign).
-
-        Returns
-        -------
-        table : pandas.DataFrame
-            Columns x, v, pxv, one row per (x, v), v fastest (NaN at x = v = 0).
-        worst : float
-            The largest relative error estimate of the F integrals.
-
-        Examples
-        --------
-        >>> from bouncing_ball import Equilibrium
-        >>> table, worst = Equilibrium("1/2").distribution_table([0.1], [-1.0, 1.0])
-        >>> print(table["pxv"].to_numpy().round(6), worst < 1e-8)
-        [0.074292 0.146809] True
-        """
+    def _speed_squared_bin_average(self, lo, hi):
         from . import distribution
 
-        self._check_distribution("distribution_table")
-        positions = _checked(positions, "positions", low=0.0)
-        speeds = _checked(speeds, "speeds")
-        return distribution.distribution_table(
-            self.weight_function, self.solution, positions, speeds
-        )
+        return distribution.speed_squared_given_position_bin_average(lo, hi, self.weight_function)
 
-    def weight_table(self, forces):
-        """w(F) of eq. (weightfunc) as a table (``results/solver/r{r}/weight``).
 
-        Parameters
-        ----------
-        forces : array_like
-            F > 0.
-
-        Returns
-        -------
-        pandas.DataFrame
-            Columns F, w, log_w (log_w stays finite where w over- or underflows).
-
-        Examples
-        --------
-        >>> from bouncing_ball import Equilibrium
-        >>> Equilibrium("1/2").weight_table([1.0]).round(6)
-             F         w     log_w
-        0  1.0  0.153341 -1.875093
-        """
-        from . import distribution
-
-        self._check_distribution("weight_table")
-        forces = _checked(forces, "forces", low=0.0, strictly=True)
-        return distribution.weight_table(self.weight_function, forces)
-
-    def flight_time_table(self, times):
-        """The flight-time densities of eq. (rate) and their short- and long-time forms,
-        eqs. (short), (long1), (long2) (``flight_time.flight_time_table``;
-        ``results/solver/r{r}/flight_time``).
-
-        Parameters
-        ----------
-        times : array_like
-            Flight times, T > 0 and at least the bounds of ``flight_rate_density`` and
-            ``flight_time_density`` (every value of the table is finite).  The pipeline writes
-            ``flight_time.FLIGHT_TIME_TABLE_RANGE`` (config ``solver.flight_times``).
-
-        Returns
-        -------
-        pandas.DataFrame
-            Columns t, density, rate_density, time_weighted_density, short_time_form,
-            long_time_form.
-
-        Raises
-        ------
-        ValueError
-            If a T is not positive, or below a bound.
-
-        Examples
-        --------
-        >>> from bouncing_ball import Equilibrium
-        >>> Equilibrium("1/2").flight_time_table([1.0])["density"].round(6).tolist()
-        [0.196832]
-        """
-        from . import flight_time
-
-        times = _checked(times, "times", low=0.0, strictly=True)
-        for per_collision in (False, True):  # nu(T) and rho(T) finite
-            self._flight_times(times, "times", per_collision=per_collision)
-        return flight_time.flight_time_table(self.solution, times)
-
-    def return_speed_table(self, speed_bins):
-        """The return-speed law v G_g(v, u) of eq. (kernel3) averaged over a simulation's speed
-        bins, with u weighted by the collision rate u P(0, u) in its bin
-        (``flight_time.return_speed_table``; ``results/solver/r{r}/return_speed``).
-
-        Parameters
-        ----------
-        speed_bins : bins.LogBins
-            The bins of the outgoing and return speeds (``settings.ShardSettings.speed_bins``).
-
-        Returns
-        -------
-        pandas.DataFrame
-            Columns u_lo, u_hi, v_lo, v_hi, probability.
-
-        Examples
-        --------
-        >>> from bouncing_ball import Equilibrium
-        >>> from bouncing_ball.bins import LogBins
-        >>> table = Equilibrium("1/2").return_speed_table(LogBins(0.1, 10.0, 1))
-        >>> table.groupby("u_lo")["probability"].sum().round(12).tolist()
-        [1.0, 1.0]
-        """
-        from . import flight_time
-
-        return flight_time.return_speed_table(self.solution, speed_bins)
+# the class's signature is its __init__'s (``__new__`` only refuses ``exact``)
+Equilibrium.__signature__ = inspect.Signature(
+    list(inspect.signature(Equilibrium.__init__).parameters.values())[1:]
+)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1413,7 +1495,7 @@ def _exact_restitution(r) -> Fraction:
     return exact
 
 
-class ExactEquilibrium(_EquilibriumState):
+class ExactEquilibrium(EquilibriumBase):
     """The paper's exact equilibrium at r = 1/2 or r = 1/3: eqs. (P(0,v)), (constants),
     (P(x)2), (weightfunc2), (fpsol), with the interface of ``Equilibrium``.
 
@@ -1428,7 +1510,12 @@ class ExactEquilibrium(_EquilibriumState):
 
     Attributes
     ----------
-    The same as ``Equilibrium``'s (``accuracy`` is 0: closed forms and quadratures to ~1e-11).
+    The same as ``EquilibriumBase``'s.  ``accuracy`` and ``position_accuracy`` are
+    ``EXACT_ACCURACY``, the relative tolerance of its quadratures, held against the solver at
+    its finest settings in tests/unit/test_equilibrium.py.  ``solution`` is the exact P(0, v)
+    at the solver's nodes (step ``solver.DEFAULT_STEP``), on which the tables of
+    ``workflow.solver_tables`` run their quadratures; ``weight_function`` is w(F) of
+    eq. (weightfunc2) in closed form (``distribution.ClosedFormWeight``).
 
     Examples
     --------
@@ -1440,12 +1527,57 @@ class ExactEquilibrium(_EquilibriumState):
     [0.815666 0.199051]
     """
 
-    distribution_available = True
-
     def __init__(self, r):
         self._set_restitution(_exact_restitution(r))
-        self.accuracy = 0.0
-        self.position_accuracy = 0.0
+
+    @property
+    def distribution_available(self) -> bool:
+        """True: P(x), <v^2>_x, P(x, v) and w(F) are known in closed form or by quadrature."""
+        return True
+
+    @property
+    def accuracy(self) -> float:
+        """``EXACT_ACCURACY``: the relative tolerance of the quadratures of the time averages
+        and flight times (P(0, v) is in closed form, to rounding)."""
+        return EXACT_ACCURACY
+
+    @property
+    def position_accuracy(self) -> float:
+        """``EXACT_ACCURACY``: the relative tolerance of the F integrals of P(x), <v^2>_x,
+        P(x, v) (closed forms at r = 1/2)."""
+        return EXACT_ACCURACY
+
+    @functools.cached_property
+    def solution(self):
+        """The exact P(0, v) of eq. (P(0,v)) at the solver's nodes (``solver.DEFAULT_STEP`` in
+        s = ln v + v^(1/2), from 1e-12 to where P(0, v) has fallen by e^-700), as a
+        ``solver.OutgoingSpeedSolution`` (eigenvalue 1): the nodes the quadratures of the
+        flight-time and return-speed tables run on."""
+        from . import exact, solver
+
+        s = np.arange(
+            solver.coordinate_of_speed(1e-12),
+            solver.coordinate_of_speed(700.0 / self.q),
+            solver.DEFAULT_STEP,
+        )
+        nodes = solver.speed_of_coordinate(s)
+        density = exact.outgoing_speed_density(nodes, self.restitution)
+        return solver.OutgoingSpeedSolution(
+            self.r, self.beta, solver.DEFAULT_STEP, nodes, density, 1.0
+        )
+
+    @functools.cached_property
+    def weight_function(self):
+        """w(F) of eq. (weightfunc2) in closed form (``distribution.closed_form_weight_function``)."""
+        from . import distribution
+
+        return distribution.closed_form_weight_function(self.r, self._log_weight)
+
+    def _log_weight(self, force):
+        from . import exact
+
+        with np.errstate(divide="ignore"):
+            return np.log(exact.weight_function(force, self.restitution))
 
     # the time averages: computed on first use (a second at r = 1/3, nested quadratures)
     @functools.cached_property
@@ -1518,6 +1650,21 @@ class ExactEquilibrium(_EquilibriumState):
         from . import exact
 
         return exact.weight_function(force, self.restitution)
+
+    def _outgoing_bin_average(self, lo, hi):
+        from . import exact
+
+        return exact.outgoing_speed_bin_average(lo, hi, self.restitution)
+
+    def _position_bin_average(self, lo, hi):
+        from . import exact
+
+        return exact.position_bin_average(lo, hi, self.restitution)
+
+    def _speed_squared_bin_average(self, lo, hi):
+        from . import exact
+
+        return exact.speed_squared_given_position_bin_average(lo, hi, self.restitution)
 
     def _short_flight_amplitude(self) -> float:
         from . import exact, flight_time

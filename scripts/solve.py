@@ -14,6 +14,7 @@ from bouncing_ball import solver
 from bouncing_ball.bins import linear_grid, log_bins, log_grid
 from bouncing_ball.equilibrium import Equilibrium
 from bouncing_ball.restitution import exact_string, parse_restitution
+from bouncing_ball.workflow import solver_tables
 from bouncing_ball.workflow.io import write_tables
 from bouncing_ball.workflow.jobs import job_log
 
@@ -30,20 +31,26 @@ with job_log(snakemake.log[0], exit_when_done=True):
     )
     accuracy = equilibrium.accuracy
     elapsed = time.perf_counter() - started
-    label = equilibrium.label
+    label = solver_tables.label(equilibrium)
     tables = {
-        "p0v": equilibrium.p0v_table(log_grid(settings["output_speeds"])),
-        "flight_time": equilibrium.flight_time_table(log_grid(settings["flight_times"])),
-        "return_speed": equilibrium.return_speed_table(log_bins(snakemake.params.speed_bins)),
+        "p0v": solver_tables.p0v_table(equilibrium, log_grid(settings["output_speeds"])),
+        "flight_time": solver_tables.flight_time_table(
+            equilibrium, log_grid(settings["flight_times"])
+        ),
+        "return_speed": solver_tables.return_speed_table(
+            equilibrium, log_bins(snakemake.params.speed_bins)
+        ),
     }
     # the whole distribution from the same P(0, v): w(F), then P(x), P(x, v)
     started_distribution = time.perf_counter()
-    tables["position"] = equilibrium.position_table(log_grid(settings["position_grid"]))
-    tables["distribution"], worst = equilibrium.distribution_table(
-        settings["positions"], linear_grid(settings["speeds"])
+    tables["position"] = solver_tables.position_table(
+        equilibrium, log_grid(settings["position_grid"])
     )
-    tables["weight"] = equilibrium.weight_table(log_grid(settings["forces"]))
-    row = equilibrium.summary()
+    tables["distribution"], worst = solver_tables.distribution_table(
+        equilibrium, settings["positions"], linear_grid(settings["speeds"])
+    )
+    tables["weight"] = solver_tables.weight_table(equilibrium, log_grid(settings["forces"]))
+    row = solver_tables.summary(equilibrium)
     logging.info(
         "r=%s: %d nodes, solved with its time averages and accuracy estimate in %.1f ms (first "
         "call: includes loading the compiled kernel); <x> = %.10g, Delta x = %.10g, I = %.10g; "
@@ -96,7 +103,7 @@ with job_log(snakemake.log[0], exit_when_done=True):
         row["large_x_power_predicted"],
     )
     # nothing is written unless every table passes (an error naming r and the failed checks)
-    equilibrium.check(tables)
+    solver_tables.check(equilibrium, tables, row)
     provenance = {
         "rule": "solve",
         "r": exact_string(exact),

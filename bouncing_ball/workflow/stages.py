@@ -51,8 +51,10 @@ SOLVER = (
     "flight_time",
     "jit",
     "kernel",
+    "relaxation",
     "restitution",
     "solver",
+    "workflow.solver_tables",
 )
 EXACT = ("airy", "bins", "exact")
 THEORY = ("asymptotics", "bins")

@@ -25,6 +25,7 @@ from bouncing_ball.equilibrium import (
     WEIGHT_PANEL_NODES_RANGE,
     check_solver_settings,
 )
+from bouncing_ball.workflow import solver_tables
 
 X = np.array([1e-3, 0.1, 1.0, 10.0])
 V = np.array([-2.0, 0.5, 3.0])
@@ -217,7 +218,7 @@ def test_check_refuses_a_position_accuracy_beyond_its_target():
     with pytest.raises(
         ValueError, match=r"r = 0.333333: .*position_accuracy = .*weight_panel_nodes = 4"
     ):
-        eq.check({})
+        solver_tables.check(eq, {})
 
 
 # --- r as a numpy scalar

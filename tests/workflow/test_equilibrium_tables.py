@@ -1,7 +1,7 @@
 """The solve rule is Equilibrium: a fresh Equilibrium(r) in the test process, with the settings
 the rule's files record, against the tables the rule writes (results/solver/r{r}/) at the
 first r of the small config, in a temporary copy of the repository (one solve job).  The rule
-builds its tables with the same methods, so this checks that they are reproduced in another
+builds its tables with the same functions (``workflow.solver_tables``), so this checks that they are reproduced in another
 process (the solve, w(F) and the quadratures are deterministic), and that the pointwise methods
 (px, pxv, weight, ...) give the tables' rows."""
 
@@ -13,6 +13,7 @@ from workflow_support import SMALL, copy_repository, snakemake
 import bouncing_ball as bb
 from bouncing_ball.bins import linear_grid, log_bins, log_grid
 from bouncing_ball.restitution import parse_restitution, restitution_label
+from bouncing_ball.workflow import solver_tables
 from bouncing_ball.workflow.io import read_table
 
 R = SMALL["restitution"][0]
@@ -83,7 +84,7 @@ def test_scalars_are_the_workflow_summary(solved):
         _same(getattr(eq, name), row[name])
     _same(eq.flight_time_second_moment, row["flight_time_second_moment"])
     _same(eq.accuracy, row["accuracy_estimate"], atol=RESIDUAL)
-    summary = eq.summary()
+    summary = solver_tables.summary(eq)
     assert set(summary) == set(tables["summary"].columns)
     for name, value in summary.items():
         rounding = any(part in name for part in ROUNDING_COLUMNS)
@@ -91,21 +92,23 @@ def test_scalars_are_the_workflow_summary(solved):
 
 
 def test_the_rule_tables_are_the_table_methods_with_its_settings(solved):
-    """Every frame the rule writes is the table method's for the grids its provenance records,
+    """Every frame the rule writes is the table function's (``workflow.solver_tables``) for the grids its provenance records,
     column by column to rtol 1e-12 (the summary's residual and accuracy columns, above, and the
     return-speed law to their rounding), and the solution reaches the highest speed it
     records."""
     tables, eq = solved
     settings, provenance = tables["provenance"]["settings"], tables["provenance"]
     assert float(eq.solution.speeds[-1]) == provenance["highest_speed"]
-    joint, _ = eq.distribution_table(settings["positions"], linear_grid(settings["speeds"]))
+    joint, _ = solver_tables.distribution_table(
+        eq, settings["positions"], linear_grid(settings["speeds"])
+    )
     ours = {
-        "p0v": eq.p0v_table(log_grid(settings["output_speeds"])),
-        "flight_time": eq.flight_time_table(log_grid(settings["flight_times"])),
-        "return_speed": eq.return_speed_table(log_bins(provenance["speed_bins"])),
-        "position": eq.position_table(log_grid(settings["position_grid"])),
+        "p0v": solver_tables.p0v_table(eq, log_grid(settings["output_speeds"])),
+        "flight_time": solver_tables.flight_time_table(eq, log_grid(settings["flight_times"])),
+        "return_speed": solver_tables.return_speed_table(eq, log_bins(provenance["speed_bins"])),
+        "position": solver_tables.position_table(eq, log_grid(settings["position_grid"])),
         "distribution": joint,
-        "weight": eq.weight_table(log_grid(settings["forces"])),
+        "weight": solver_tables.weight_table(eq, log_grid(settings["forces"])),
     }
     for name, table in ours.items():
         # the return-speed probabilities are differences of the cumulative law, of order 1: the
@@ -114,4 +117,4 @@ def test_the_rule_tables_are_the_table_methods_with_its_settings(solved):
         pd.testing.assert_frame_equal(
             table, tables[name], check_exact=False, rtol=1e-12, atol=atol, obj=name
         )
-    assert list(eq.summary()) == list(tables["summary"].columns)
+    assert list(solver_tables.summary(eq)) == list(tables["summary"].columns)
