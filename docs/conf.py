@@ -109,7 +109,7 @@ def _on_source_read(app, docname, source):
 # run's config) as the gallery shows them: rendered with the config that made docs/gallery/*.png.
 CAPTIONS = REPOSITORY / "workflow" / "report"
 GALLERY_CONFIGS = [
-    REPOSITORY / ".test" / "config" / "config.yaml",
+    REPOSITORY / "config" / "config.yaml",
     DOCS / "gallery" / "gallery.yaml",
 ]
 
