@@ -15,11 +15,14 @@ from bouncing_ball.equilibration import (
     EQUILIBRATION_RELAXATION_TIMES,
     MIN_EQUILIBRATION_TIME,
     QUANTITIES,
+    REFUSE_P,
     SHARD_RELAXATION_TIMES,
+    WARN_P,
     EquilibrationWarning,
     default_equilibration_time,
     early_check,
     early_check_message,
+    early_check_power,
     early_check_record,
     equilibration_problems,
     relaxation_record,
@@ -216,3 +219,73 @@ def test_simulate_warns_of_shards_too_short_for_the_relaxation_time():
     with pytest.warns(EquilibrationWarning, match="r = 0.95: shard_time = 2000 is shorter"):
         result = simulate(0.95, shards=2, shard_time=2e3, seed=1, progress=False)
     assert result.settings.equilibration_time == default_equilibration_time(0.95)
+
+
+def _normal_shards(rng, n, early_shift, time=1.0):
+    """``n`` shards whose windows' <x> scatter normally with variance 1 over the whole
+    recording (1 / f over its early part f, 1 / (1 - f) over the rest), the early part's
+    mean shifted by ``early_shift``; <x^2> and I without a transient."""
+    f = EARLY_FRACTION
+    early = early_shift + rng.normal(scale=np.sqrt(1.0 / f), size=n)
+    rest = rng.normal(scale=np.sqrt(1.0 / (1.0 - f)), size=n)
+    return [
+        SimpleNamespace(
+            time=time,
+            collisions=1.0,
+            int_x=f * time * e + (1.0 - f) * time * r,
+            int_x2=1.0,
+            early_time=f * time,
+            early_collisions=f,
+            early_int_x=f * time * e,
+            early_int_x2=f,
+        )
+        for e, r in zip(early, rest)
+    ]
+
+
+def test_the_power_of_the_check_is_that_of_early_check_on_normal_shards():
+    # at the early part's shift that early_check_power says is caught half the time,
+    # early_check warns of 240 sets of 64 normal shards half the time (binomial error
+    # 0.032), and at half that shift (caught with probability 0.05) rarely
+    power = early_check_power(64)
+    standard_error = 1.0 / np.sqrt(64)  # of the mean over 64 shards of variance 1
+    rng = np.random.default_rng(11)
+
+    def caught(shift, sets):
+        shards = [_normal_shards(rng, 64, shift * standard_error) for _ in range(sets)]
+        return np.mean([early_check(s).verdict[0] != "ok" for s in shards])
+
+    assert abs(caught(power["early_shift"], 240) - 0.5) < 4 * np.sqrt(0.25 / 240)
+    assert caught(0.5 * power["early_shift"], 80) < 0.15
+
+
+def test_the_power_is_a_bias_of_a_fraction_of_the_early_shift():
+    # the difference's error is 1 / sqrt(f (1 - f)) = 3.02 standard errors of the full run;
+    # a transient within the early part biases the whole recording by f of its shift there
+    warn = early_check_power(64)
+    assert warn["difference_error"] == pytest.approx(np.sqrt(64.0 / 7.0), rel=1e-12)
+    assert warn["bias"] == pytest.approx(EARLY_FRACTION * warn["early_shift"], rel=1e-12)
+    # a transient decaying over tau = T spreads over the rest: the same difference, a
+    # larger bias (contrast (early - rest) / whole from the exponential's window averages)
+    slow = early_check_power(64, decay=1.0)
+    f = EARLY_FRACTION
+    contrast = ((1 - np.exp(-f)) / f - (np.exp(-f) - np.exp(-1)) / (1 - f)) / (1 - np.exp(-1))
+    assert slow["bias"] == pytest.approx(slow["early_shift"] / contrast, rel=1e-12)
+    # refusing needs more than warning; more shards need less
+    assert early_check_power(64, p=REFUSE_P)["bias"] > warn["bias"] > early_check_power(256)["bias"]
+
+
+@pytest.mark.parametrize(
+    "argument, message",
+    [
+        ({"shards": 1}, "shards = 1"),
+        ({"detection": WARN_P}, "detection"),
+        ({"detection": 1.0}, "detection"),
+        ({"p": 0.0}, "p = 0.0"),
+        ({"decay": -1.0}, "decay"),
+        ({"decay": np.inf}, "decay"),
+    ],
+)
+def test_the_power_refuses_arguments_outside_its_domain(argument, message):
+    with pytest.raises(ValueError, match=message):
+        early_check_power(**argument)

@@ -114,9 +114,7 @@ def test_r075_report_compares_every_run_and_all_with_the_solver(studies_run):
 
 
 def test_coverage_report_scatters_every_moment_and_estimator_against_students_t(studies_run):
-    table = pd.read_csv(
-        studies_run / "results/studies/coverage.csv", keep_default_na=False, na_values=[""]
-    )
+    table = pd.read_csv(studies_run / "results/studies/coverage.csv", dtype={"r_label": str})
     moments = [
         "mean_x",
         "delta_x",
