@@ -447,7 +447,9 @@ def coverage_rows(z_scores: pd.DataFrame, shards: int) -> pd.DataFrame:
         ``COVERAGE_ESTIMATORS``: ``runs`` (finite z), ``mean_z`` and ``mean_z_err`` (its
         standard error), ``mean_z2`` and ``mean_z2_err`` (the standard error of z^2 over the
         runs), ``miss`` (the fraction of |z| > ``COVERAGE_Z_LIMIT``) and ``miss_err`` (its
-        binomial error sqrt(p (1 - p) / runs)), ``expected_mean_z2``, ``expected_miss``.
+        binomial error if the errors are right, sqrt(P (1 - P) / runs) with P =
+        ``expected_miss``: never 0, and the scale on which a departure from P is judged),
+        ``expected_mean_z2``, ``expected_miss``.
         NaN where there are too few runs (an error needs two).
     """
     expected_z2, expected_miss = student_t_coverage(shards)
@@ -476,7 +478,11 @@ def coverage_rows(z_scores: pd.DataFrame, shards: int) -> pd.DataFrame:
                         "mean_z2": float(np.mean(z**2)) if runs else np.nan,
                         "mean_z2_err": _standard_error(z**2),
                         "miss": miss,
-                        "miss_err": float(np.sqrt(miss * (1 - miss) / runs)) if runs else np.nan,
+                        "miss_err": (
+                            float(np.sqrt(expected_miss * (1 - expected_miss) / runs))
+                            if runs
+                            else np.nan
+                        ),
                         "expected_mean_z2": expected_z2,
                         "expected_miss": expected_miss,
                     }
@@ -514,9 +520,10 @@ def coverage_markdown(table: pd.DataFrame, runs: dict) -> str:
         "z = (estimate - exact) / jackknife error. If the errors are right, z follows "
         f"Student's t with n - 1 = {shards - 1} degrees of freedom (columns t: ...; the controlled "
         "estimators fit their slopes to the same shards, which leaves fewer), so mean z is 0, "
-        "mean z^2 is (n - 1)/(n - 3) and abs z exceeds {COVERAGE_Z_LIMIT:g} with "
-        "the probability given. Errors: the standard errors of mean z and mean z^2 over the "
-        "runs, and the binomial error of the fraction. Controlled: blank with too few shards "
+        f"mean z^2 is (n - 1)/(n - 3) and abs z exceeds {COVERAGE_Z_LIMIT:g} with "
+        "the probability P given. Errors: the standard errors of mean z and mean z^2 over the "
+        "runs, and the binomial error of the fraction under t, sqrt(P (1 - P) / runs). "
+        "Controlled: blank with too few shards "
         "to fit the control slopes.\n\n"
         + shown.to_markdown(index=False, disable_numparse=True)
         + "\n"

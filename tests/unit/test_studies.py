@@ -168,8 +168,11 @@ def test_coverage_rows_are_the_moments_of_z_over_the_runs():
     assert row.mean_z == pytest.approx(0.125)
     assert row.mean_z2 == pytest.approx((1.0 + 9.0 + 6.25) / 4)
     assert row.mean_z2_err == pytest.approx(np.std([1.0, 9.0, 6.25, 0.0], ddof=1) / 2.0)
-    assert row.miss == 0.5 and row.miss_err == pytest.approx(0.25)
     assert row.expected_mean_z2 == pytest.approx(7.0 / 5.0)
+    # the binomial error of the fraction at t_7's P(|t| > 2) = 0.0856
+    assert row.miss == 0.5
+    assert row.miss_err == pytest.approx(np.sqrt(row.expected_miss * (1 - row.expected_miss) / 4))
+    assert row.expected_miss == pytest.approx(2.0 * stats.t.sf(2.0, 7), rel=1e-12)
     # every moment and estimator has a row; those without a z have none of the statistics
     table = studies.coverage_rows(frame, 8)
     assert len(table) == len(studies.COVERAGE_MOMENTS) * len(studies.COVERAGE_ESTIMATORS)
@@ -186,11 +189,10 @@ def test_coverage_of_normal_shards_is_students_t():
     )
     row = studies.coverage_rows(frame, 8).iloc[0]
     assert abs(row.mean_z2 - row.expected_mean_z2) < 4 * row.mean_z2_err
-    expected_err = np.sqrt(row.expected_miss * (1 - row.expected_miss) / len(z))
-    assert abs(row.miss - row.expected_miss) < 4 * expected_err
+    assert abs(row.miss - row.expected_miss) < 4 * row.miss_err
     # the normal law's 1 and 0.0455 are rejected by the same test: t_7 is heavier
     assert abs(row.mean_z2 - 1.0) > 4 * row.mean_z2_err
-    assert abs(row.miss - 0.0455) > 4 * expected_err
+    assert abs(row.miss - 0.0455) > 4 * row.miss_err
 
 
 def test_run_z_scores_of_both_estimators_and_none_without_an_estimate():
