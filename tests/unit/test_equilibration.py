@@ -133,11 +133,17 @@ def test_the_equilibration_time_can_be_set_per_r():
         check_config(config, schema)
 
 
+# 8 relaxation times at r = 0.99 and a little more: the transient of a 1e3 equilibration is a
+# large part of such a shard's recording; in the default run's far longer shards it leaves a
+# bias below the check's power (docs/validation.md, "What the equilibration check can see")
+SHORT_SHARD_TIME = 2.4e5
+
+
 @pytest.mark.parametrize(
     "equilibration_time, verdict", [(1.0e3, "refuse"), (1.0e5, "ok"), ("auto", "ok")]
 )
 def test_a_short_equilibration_near_r_1_is_refused(equilibration_time, verdict):
-    """r = 0.99 with the default config's shard time: the ball starts at rest and its
+    """r = 0.99 with shards of SHORT_SHARD_TIME: the ball starts at rest and its
     energy relaxes over ~1e4-1e5 time units, so with 1e3 time units of equilibration every
     shard records the same transient and the merged <x> and Delta x are biased (z of about -3
     and -5 against the solver) with errors that do not show it.  The check refuses those
@@ -149,7 +155,9 @@ def test_a_short_equilibration_near_r_1_is_refused(equilibration_time, verdict):
     if equilibration_time == "auto":
         equilibration_time = shard_settings(config, "0.99").equilibration_time
         assert equilibration_time == default_equilibration_time(0.99)
-    settings = shard_settings(config, "0.99").replace(equilibration_time=equilibration_time)
+    settings = shard_settings(config, "0.99").replace(
+        equilibration_time=equilibration_time, shard_time=SHORT_SHARD_TIME
+    )
     shards = [
         simulate_shard(0.99, shard_seed_sequence(config["seed"], "0.99", k), settings)
         for k in range(64)
