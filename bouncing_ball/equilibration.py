@@ -1,4 +1,5 @@
-"""A run's own evidence of equilibrium: the early part of each shard against the rest.
+"""Equilibration: how long a shard discards, and a coarse check of the early part of each
+shard's recording against the rest.
 
 Every shard starts at rest one unit above the floor and discards ``equilibration_time``
 before it records.  Where the process relaxes more slowly than that (near r -> 1 the ball
@@ -6,7 +7,7 @@ loses a fraction 1 - r^2 of its energy per bounce, and the collisions grow rare)
 shard records part of the same transient: <x>, Delta x and I are biased alike in every
 shard, and the errors from their scatter (``histograms.jackknife``) do not see it.  Comparing
 the shards with each other, or batches of shards with the jackknife, cannot catch it either,
-since the shards are independent and share the bias.  What does see it is time within each
+since the shards are independent and share the bias.  What can see it is time within each
 shard: in equilibrium the early part of a recording (its first ``tallies.EARLY_FRACTION``,
 ``tallies.EARLY_SUMS``) has the expectation of the rest, while a transient sits in it.
 
@@ -18,6 +19,19 @@ quantity and each shard it takes the difference d_k of the early part's estimate
 rest's, and Student's t-test of mean d = 0 over the independent shards.  Its p-value says
 how likely a difference this large is in equilibrium: below ``WARN_P`` the merge warns,
 below ``REFUSE_P`` it refuses, since the errors cannot be trusted.
+
+The check is weak, and a pass is no proof of equilibrium (``early_check_power``,
+docs/validation.md, "What the equilibration check can see").  The early part holds f = 1/8
+of the recording, so the mean difference has a standard error 1 / sqrt(f (1 - f)) = 3.02
+times that of the full run's estimate.  At 64 shards a transient over within the early
+part is caught half the time only once it biases the final estimate by 1.3 of its standard
+errors (warn) or 2.0 (refuse).  One that decays as e^(-t/tau) over a good part of the
+recording T shifts both parts and must be larger: 2.2 standard errors at tau = T/8, 4.1 at
+T/4 (warn); one as slow as the recording (18.7 at tau = T: the difference falls as
+T / (2 tau)) it hardly sees, and a bias constant in time (of the step rule, of the model)
+not at all (``early_check_power_table``).  What keeps the transient out is the discarded
+time, ``default_equilibration_time``; the check catches gross shortfalls of it, such as an
+``equilibration_time`` set far below the relaxation time.
 
 How long to discard, and how long a shard must be, follow from the relaxation time of the
 process (``equilibration_relaxation_time``: ``Equilibrium(r).relaxation_time``, the bounce
@@ -65,6 +79,8 @@ __all__ = [
     "equilibration_problems",
     "warn_equilibration_problems",
     "relaxation_record",
+    "early_check_power",
+    "early_check_power_table",
 ]
 
 #: The p-value of ``early_check`` below which the merge warns.
@@ -523,3 +539,173 @@ def early_check_message(check: pd.DataFrame, label: str) -> str:
         f"r={label}: the first {EARLY_FRACTION:g} of each shard's recording against the rest: "
         + "; ".join(parts)
     )
+
+
+def _transient_contrast(decay: float) -> float:
+    """(early part's shift - rest's shift) / the whole recording's shift of a transient
+    a e^(-t / tau) from the start of the recording, tau = ``decay`` x the recording time
+    (0: a transient over before the early part ends, whatever its shape)."""
+    f = EARLY_FRACTION
+    if decay == 0.0:
+        return 1.0 / f
+    # in units of a tau / T: the early part's shift (1 - e^(-f/s)) / f, the rest's
+    # (e^(-f/s) - e^(-1/s)) / (1 - f), the whole recording's 1 - e^(-1/s)
+    early = -np.expm1(-f / decay) / f
+    rest = np.exp(-f / decay) * -np.expm1(-(1.0 - f) / decay) / (1.0 - f)
+    return float((early - rest) / -np.expm1(-1.0 / decay))
+
+
+def _noncentral_t_two_sided_tail(dof: float, noncentrality: float, critical: float) -> float:
+    """P(|t| > critical) of a noncentral Student's t, t = (Z + lambda) / (V / dof)^(1/2)
+    with Z standard normal and V chi^2 with ``dof`` degrees of freedom: the normal tails
+    given V averaged over V's density by quadrature in ln V (``scipy.special.nctdtr``
+    gives NaN in parts of the lower tail)."""
+    from scipy import integrate
+
+    half = 0.5 * dof
+
+    def integrand(log_v):
+        v = np.exp(log_v)
+        scale = critical * np.sqrt(v / dof)
+        # V's density times v (d ln V), from its logarithm
+        weight = np.exp(half * log_v - 0.5 * v - half * np.log(2.0) - special.gammaln(half))
+        return weight * (special.ndtr(noncentrality - scale) + special.ndtr(-noncentrality - scale))
+
+    # ln V from -80 (below, V's mass is under e^(-40)) to 20 standard deviations and 60 above
+    # its mean; breaks at the peak and where the tails given V turn over
+    lower, upper = -80.0, np.log(dof + 20.0 * np.sqrt(2.0 * dof) + 60.0)
+    breaks = {np.log(dof)}
+    if noncentrality > 0.0:
+        breaks.add(np.log(dof) + 2.0 * np.log(noncentrality / critical))
+    edges = [lower, *sorted(b for b in breaks if lower < b < upper), upper]
+    return float(
+        sum(
+            integrate.quad(integrand, a, b, epsabs=1e-14, epsrel=1e-11, limit=200)[0]
+            for a, b in zip(edges[:-1], edges[1:])
+        )
+    )
+
+
+def early_check_power(
+    shards: int = 64, detection: float = 0.5, p: float = WARN_P, decay: float = 0.0
+) -> dict:
+    """The smallest transient ``early_check`` catches with probability ``detection``.
+
+    The model: each of n independent shards records time T; the estimate of a quantity over a
+    window of length w scatters normally with variance sigma^2 T / w about its expectation
+    (windows much longer than the correlation time, so the early part, ``EARLY_FRACTION``
+    f of T, and the rest are independent), and a transient a e^(-t / tau) from the start
+    of the recording shifts each window's expectation by its average there.  The full
+    run's mean over n shards has the standard error SE = sigma / sqrt(n); the mean
+    difference early - rest has SE / sqrt(f (1 - f)), 3.02 SE at f = 1/8.  The check's
+    statistic is then a noncentral Student's t with n - 1 degrees of freedom, and the transient is caught (p below ``p``) with
+    probability ``detection`` at one noncentrality, solved for (``scipy.optimize.brentq``).
+
+    Parameters
+    ----------
+    shards : int, optional
+        n, at least 2.
+    detection : float, optional
+        The probability of catching the transient, strictly between ``p`` (the false-alarm
+        rate, what the check gives without a transient) and 1.
+    p : float, optional
+        The check's threshold: ``WARN_P`` (warn) or ``REFUSE_P`` (refuse); 0 < p < 1.
+    decay : float, optional
+        tau / T, at least 0 and finite: 0 for a transient over within the early part,
+        whatever its shape (only its integral counts); a slower one straddles both parts.
+
+    Returns
+    -------
+    dict
+        ``difference_error``: the mean difference's standard error in units of SE,
+        1 / sqrt(f (1 - f)); ``noncentrality``: the t statistic's, at the probability asked;
+        ``early_shift``: the early part's shift minus the rest's (the early part's alone
+        where ``decay`` is 0), and ``bias``: the shift the transient leaves in the estimate
+        from the whole recording, both in units of SE.
+
+    Examples
+    --------
+    At 64 shards the check warns half the time of a transient within the early part once
+    it shifts that part by 10.4 standard errors, which biases the final estimate by 1.3,
+    and refuses at 2.04:
+
+    >>> from bouncing_ball.equilibration import REFUSE_P, early_check_power
+    >>> warn, refuse = early_check_power(64), early_check_power(64, p=REFUSE_P)
+    >>> print(round(warn["difference_error"], 3), round(warn["early_shift"], 1))
+    3.024 10.4
+    >>> print(round(warn["bias"], 2), round(refuse["bias"], 2))
+    1.3 2.04
+    """
+    from scipy import optimize
+
+    if isinstance(shards, bool) or not isinstance(shards, (int, np.integer)) or shards < 2:
+        raise ValueError(f"shards = {shards!r}: a whole number of at least 2")
+    if not 0.0 < p < 1.0:
+        raise ValueError(f"p = {p!r}: must lie strictly between 0 and 1")
+    if not p < detection < 1.0:
+        raise ValueError(
+            f"detection = {detection!r}: must lie strictly between p = {p:g} (the false-alarm "
+            "rate) and 1"
+        )
+    if not (np.isfinite(decay) and decay >= 0.0):
+        raise ValueError(f"decay = {decay!r}: tau / T must be at least 0 and finite")
+    dof = float(shards - 1)
+    critical = float(special.stdtrit(dof, 1.0 - p / 2.0))  # two-sided: |t| > critical
+
+    def caught(noncentrality):
+        return _noncentral_t_two_sided_tail(dof, noncentrality, critical)
+
+    # caught(0) = p < detection; caught grows to 1 with lambda: double until past detection
+    upper = critical + 10.0
+    while caught(upper) <= detection:
+        upper *= 2.0
+    noncentrality = optimize.brentq(
+        lambda lam: caught(lam) - detection, 0.0, upper, xtol=1e-10 * upper
+    )
+    difference_error = 1.0 / np.sqrt(EARLY_FRACTION * (1.0 - EARLY_FRACTION))
+    early_shift = noncentrality * difference_error
+    return {
+        "difference_error": float(difference_error),
+        "noncentrality": float(noncentrality),
+        "early_shift": float(early_shift),
+        "bias": float(early_shift / _transient_contrast(float(decay))),
+    }
+
+
+def early_check_power_table(
+    shards: int = 64, detection: float = 0.5, decays=(0.0, 1 / 64, 1 / 16, 1 / 8, 1 / 4, 1.0)
+) -> pd.DataFrame:
+    """``early_check_power`` at ``WARN_P`` and ``REFUSE_P`` for each tau / T of ``decays``.
+
+    Parameters
+    ----------
+    shards : int, optional
+        n, at least 2.
+    detection : float, optional
+        The probability of catching the transient, strictly between ``WARN_P`` and 1.
+    decays : sequence of float, optional
+        tau / T of the transients (``early_check_power``'s ``decay``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per decay: ``decay`` (tau / T), ``warn_bias`` and ``refuse_bias``: the bias
+        of the final estimate, in its standard errors, of the transient the check warns of,
+        or refuses, with probability ``detection``.
+
+    Examples
+    --------
+    >>> from bouncing_ball.equilibration import early_check_power_table
+    >>> print(early_check_power_table(decays=(0.0, 1.0)).round(2).to_string(index=False))
+     decay  warn_bias  refuse_bias
+       0.0       1.30         2.04
+       1.0      18.67        29.32
+    """
+    rows = []
+    for decay in decays:
+        warn = early_check_power(shards, detection, WARN_P, decay)
+        refuse = early_check_power(shards, detection, REFUSE_P, decay)
+        rows.append(
+            {"decay": float(decay), "warn_bias": warn["bias"], "refuse_bias": refuse["bias"]}
+        )
+    return pd.DataFrame(rows)

@@ -604,28 +604,14 @@ def study_runs(studies: dict, config: dict) -> dict[str, dict[str, StudyRun]]:
     solution and a shard_time.  The seed is shared, so the runs at one r with different c
     draw the same streams (shard k of r: ``(seed, r label, k)``).
     r075: the runs as named in the file; their seeds must differ (the report pools them).
+    coverage: ``runs`` runs per r, named r{label}_run{k}, run k with seed ``seed + k``
+    (independent streams; the runs of different r differ by the r label of the streams).
     Settings not in the study come from the main config's ``simulation`` section.
     """
     runs: dict[str, dict[str, StudyRun]] = {}
     where = "criterion_bias"
     study = studies["criterion_bias"]
-    grid = restitution_grid(study["restitution"], f"{where}.restitution")
-    for value in grid.values():
-        if value not in EXACT_RESTITUTIONS:
-            raise ValueError(
-                f"{where}.restitution: r = {value} has no exact solution (only 1/2 and 1/3)"
-            )
-    times = {}
-    for key, shard_time in study["shard_time"].items():
-        label = restitution_label(parse_restitution(key, f"{where}.shard_time.{key}"))
-        if label not in grid:
-            raise ValueError(f"{where}.shard_time.{key}: r = {key} is not in {where}.restitution")
-        if label in times:
-            raise ValueError(f"{where}.shard_time.{key}: the same r as another key")
-        times[label] = shard_time
-    missing = [str(value) for label, value in grid.items() if label not in times]
-    if missing:
-        raise ValueError(f"{where}.shard_time: no shard_time for r = {', '.join(missing)}")
+    grid, times = _exact_grid_and_shard_times(study, where)
     runs[where] = {}
     for label, value in grid.items():
         for c in study["criterion_c"]:
@@ -660,13 +646,47 @@ def study_runs(studies: dict, config: dict) -> dict[str, dict[str, StudyRun]]:
             criterion_c=run["criterion_c"],
         )
         runs[where][name] = StudyRun(where, name, value, run["seed"], run["shards"], settings)
+    where = "coverage"
+    study = studies["coverage"]
+    grid, times = _exact_grid_and_shard_times(study, where)
+    runs[where] = {}
+    width = len(str(study["runs"] - 1))
+    for label, value in grid.items():
+        settings = _study_settings(config, label, study, where, shard_time=times[label])
+        for k in range(study["runs"]):
+            name = f"r{label}_run{k:0{width}d}"
+            runs[where][name] = StudyRun(
+                where, name, value, study["seed"] + k, study["shards"], settings
+            )
     for study, named in runs.items():
         for name, run in named.items():
-            # a study shard is a file of its own; its report reads every shard of its study
+            # a study shard is a file of its own; its report reads every shard of its study,
+            # the coverage report one run at a time
+            merged = run.shards if study == "coverage" else sum(o.shards for o in named.values())
             check_merge_memory(
-                run.settings.as_mapping(),
-                sum(other.shards for other in named.values()),
-                1,
-                f"the shards of {study} (run {name})",
+                run.settings.as_mapping(), merged, 1, f"the shards of {study} (run {name})"
             )
     return runs
+
+
+def _exact_grid_and_shard_times(study: dict, where: str) -> tuple[dict, dict]:
+    """A study's r values ({label: r}), each with an exact solution, and its ``shard_time``
+    per r label ({label: time}, one for every r); ValueError naming the key otherwise."""
+    grid = restitution_grid(study["restitution"], f"{where}.restitution")
+    for value in grid.values():
+        if value not in EXACT_RESTITUTIONS:
+            raise ValueError(
+                f"{where}.restitution: r = {value} has no exact solution (only 1/2 and 1/3)"
+            )
+    times = {}
+    for key, shard_time in study["shard_time"].items():
+        label = restitution_label(parse_restitution(key, f"{where}.shard_time.{key}"))
+        if label not in grid:
+            raise ValueError(f"{where}.shard_time.{key}: r = {key} is not in {where}.restitution")
+        if label in times:
+            raise ValueError(f"{where}.shard_time.{key}: the same r as another key")
+        times[label] = shard_time
+    missing = [str(value) for label, value in grid.items() if label not in times]
+    if missing:
+        raise ValueError(f"{where}.shard_time: no shard_time for r = {', '.join(missing)}")
+    return grid, times

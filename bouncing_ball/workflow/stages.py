@@ -61,8 +61,17 @@ THEORY = ("asymptotics", "bins")
 FITS = (*READ_SHARDS, "asymptotics", "fits")
 PLOTTING = ("parquet", "workflow.io", "workflow.plotting", "restitution")
 COMPARISON = ("comparison", "fits", "parquet", "workflow.io", "restitution")
-# the studies' reports (workflow/rules/studies.smk); their shards are SIMULATION's
-STUDIES = (*READ_SHARDS, "airy", "comparison", "exact", "fits", "workflow.studies")
+# the studies' reports (workflow/rules/studies.smk); their shards are SIMULATION's; the
+# exact moments of the coverage report are ExactEquilibrium's (equilibrium)
+STUDIES = (
+    *READ_SHARDS,
+    "airy",
+    "comparison",
+    "equilibrium",
+    "exact",
+    "fits",
+    "workflow.studies",
+)
 # results/tables/validation: the comparison, the exact bin averages, the solver curve's bin
 # averages, and the shards read back for the sign-flip p-values
 VALIDATION = (*READ_SHARDS, "airy", "comparison", "exact", "fits")

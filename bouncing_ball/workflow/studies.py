@@ -9,13 +9,17 @@ batches of shards, groups of shards, and the shape of the per-shard distribution
 Every estimate is the one of the merge stage (``histograms.position_moments_summary`` and
 ``histograms.outgoing_speed_histogram``, jackknife errors), applied to all the shards of a
 run, to a batch or group of them, or to one shard.
+
+coverage: many independent runs of n shards at r = 1/2 and 1/3 against the exact results;
+per moment and estimator (plain, controlled) the scatter of the runs' z against Student's t
+with n - 1 degrees of freedom: whether the jackknife errors are honest.
 """
 
 from itertools import islice
 
 import numpy as np
 import pandas as pd
-from scipy import stats
+from scipy import special, stats
 
 from .. import exact
 from ..comparison import QUANTITIES, SYMBOLS, exact_outgoing_speed_residuals, value_with_error
@@ -28,15 +32,20 @@ def read_runs(paths, runs) -> dict:
     """{run name: (shards, provenances)} of a report's input: ``paths`` in the order of
     ``runs`` (the rule's ``params.runs``: dicts with ``run``, ``r_label`` and ``shards``, the
     number of files of that run).  Each run's shards are checked by ``shards.read_shards``."""
+    return {run["run"]: read for run, read in iter_runs(paths, runs)}
+
+
+def iter_runs(paths, runs):
+    """``read_runs`` one run at a time: (run, (shards, provenances)) in the order of
+    ``runs``, each run read when asked for (a report of many runs holds one in memory)."""
     paths = list(paths)
     if len(paths) != sum(run["shards"] for run in runs):
         raise ValueError(
             f"{len(paths)} shard files for {sum(run['shards'] for run in runs)} shards of the runs"
         )
     files = iter(paths)
-    return {
-        run["run"]: read_shards(list(islice(files, run["shards"])), run["r_label"]) for run in runs
-    }
+    for run in runs:
+        yield run, read_shards(list(islice(files, run["shards"])), run["r_label"])
 
 
 def cpu_seconds(provenances) -> float:
@@ -345,3 +354,185 @@ def r075_markdown(table: pd.DataFrame, label: str) -> str:
         + shown.to_markdown(index=False, disable_numparse=True)
         + "\n"
     )
+
+
+#: The moments of the coverage study: <x>, Delta x (eq. (xandDeltax)), I (eq. (collrate)),
+#: <T> and <T^2> per flight (eqs. (meanT), (meanT2)), each as ``position_moments_summary``
+#: gives it, plain and ``*_controlled``.
+COVERAGE_MOMENTS = (
+    "mean_x",
+    "delta_x",
+    "collision_rate",
+    "mean_flight_time",
+    "flight_time_second_moment",
+)
+COVERAGE_SYMBOLS = {**SYMBOLS, "mean_flight_time": "<T>", "flight_time_second_moment": "<T^2>"}
+#: The estimators of each moment: the plain tallies and the control-variate ones.
+COVERAGE_ESTIMATORS = ("plain", "controlled")
+#: |z| beyond this counts as a miss in the coverage report.
+COVERAGE_Z_LIMIT = 2.0
+
+
+def exact_moments(restitution) -> dict:
+    """{moment of ``COVERAGE_MOMENTS``: exact value} at r = 1/2 or 1/3 (``ExactEquilibrium``:
+    ``exact.position_moments`` and the flight-time moments of the exact P(0, u))."""
+    from ..equilibrium import ExactEquilibrium
+
+    equilibrium = ExactEquilibrium(restitution)
+    return {moment: float(getattr(equilibrium, moment)) for moment in COVERAGE_MOMENTS}
+
+
+def run_z_scores(summary: pd.Series, reference: dict) -> dict:
+    """{(moment, estimator): z} of one run's summary row (``position_moments_summary``)
+    against ``reference`` (``exact_moments``): (estimate - exact) / jackknife error, NaN
+    where the estimator has no value (the controlled ones with too few shards)."""
+    out = {}
+    for moment in COVERAGE_MOMENTS:
+        for estimator in COVERAGE_ESTIMATORS:
+            column = moment if estimator == "plain" else f"{moment}_controlled"
+            value, error = float(summary[column]), float(summary[f"{column}_err"])
+            finite = np.isfinite(value) and np.isfinite(error) and error > 0.0
+            out[moment, estimator] = (value - reference[moment]) / error if finite else np.nan
+    return out
+
+
+def student_t_coverage(shards: int, limit: float = COVERAGE_Z_LIMIT) -> tuple[float, float]:
+    """What z = (estimate - exact) / error gives if it follows Student's t with n - 1 degrees
+    of freedom (a mean of n independent, normal shard values over its standard error).
+
+    Parameters
+    ----------
+    shards : int
+        n, at least 2.
+    limit : float, optional
+        The |z| counted as a miss, positive.
+
+    Returns
+    -------
+    tuple of float
+        E[z^2] = (n - 1) / (n - 3), NaN for n <= 3 (where it is infinite), and
+        P(|z| > ``limit``) = 2 P(t_{n-1} < -limit) (``scipy.special.stdtr``).
+
+    Examples
+    --------
+    >>> from bouncing_ball.workflow.studies import student_t_coverage
+    >>> print([round(value, 4) for value in student_t_coverage(64)])
+    [1.0328, 0.0498]
+    """
+    if isinstance(shards, bool) or not isinstance(shards, (int, np.integer)) or shards < 2:
+        raise ValueError(f"shards = {shards!r}: a whole number of at least 2")
+    if not limit > 0:
+        raise ValueError(f"limit = {limit!r}: must be positive")
+    dof = shards - 1
+    mean_square = dof / (dof - 2) if dof > 2 else np.nan
+    return float(mean_square), float(2.0 * special.stdtr(dof, -limit))
+
+
+def coverage_rows(z_scores: pd.DataFrame, shards: int) -> pd.DataFrame:
+    """The coverage of the errors: per r, moment and estimator, how the runs' z scatter.
+
+    Parameters
+    ----------
+    z_scores : pandas.DataFrame
+        One row per (run, moment, estimator): columns ``r_label``, ``run``, ``moment``,
+        ``estimator``, ``z`` (``run_z_scores``; NaN rows are left out of the statistics).
+    shards : int
+        The shards n of every run, at least 2: the expectations are Student's t with n - 1
+        degrees of freedom (``student_t_coverage``; the controls' fitted slopes take more).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per (r_label, moment, estimator), in the order of ``COVERAGE_MOMENTS`` and
+        ``COVERAGE_ESTIMATORS``: ``runs`` (finite z), ``mean_z`` and ``mean_z_err`` (its
+        standard error), ``mean_z2`` and ``mean_z2_err`` (the standard error of z^2 over the
+        runs), ``miss`` (the fraction of |z| > ``COVERAGE_Z_LIMIT``) and ``miss_err`` (its
+        binomial error if the errors are right, sqrt(P (1 - P) / runs) with P =
+        ``expected_miss``: never 0, and the scale on which a departure from P is judged),
+        ``expected_mean_z2``, ``expected_miss``.
+        NaN where there are too few runs (an error needs two).
+    """
+    expected_z2, expected_miss = student_t_coverage(shards)
+    rows = []
+    for label in dict.fromkeys(z_scores["r_label"]):
+        for moment in COVERAGE_MOMENTS:
+            for estimator in COVERAGE_ESTIMATORS:
+                chosen = z_scores[
+                    (z_scores["r_label"] == label)
+                    & (z_scores["moment"] == moment)
+                    & (z_scores["estimator"] == estimator)
+                ]
+                z = chosen["z"].to_numpy(dtype=float)
+                z = z[np.isfinite(z)]
+                runs = len(z)
+                miss = float(np.mean(np.abs(z) > COVERAGE_Z_LIMIT)) if runs else np.nan
+                rows.append(
+                    {
+                        "r_label": label,
+                        "moment": moment,
+                        "estimator": estimator,
+                        "shards": shards,
+                        "runs": runs,
+                        "mean_z": float(z.mean()) if runs else np.nan,
+                        "mean_z_err": _standard_error(z),
+                        "mean_z2": float(np.mean(z**2)) if runs else np.nan,
+                        "mean_z2_err": _standard_error(z**2),
+                        "miss": miss,
+                        "miss_err": (
+                            float(np.sqrt(expected_miss * (1 - expected_miss) / runs))
+                            if runs
+                            else np.nan
+                        ),
+                        "expected_mean_z2": expected_z2,
+                        "expected_miss": expected_miss,
+                    }
+                )
+    return pd.DataFrame(rows)
+
+
+def _standard_error(values) -> float:
+    """The standard error of the mean of ``values``; NaN with fewer than two."""
+    return float(values.std(ddof=1) / np.sqrt(len(values))) if len(values) >= 2 else np.nan
+
+
+def coverage_markdown(table: pd.DataFrame, runs: dict) -> str:
+    """The coverage report for a reader; ``runs`` is {r label: number of runs}."""
+    shown = pd.DataFrame(
+        {
+            "r": table.r_label,
+            "moment": table.moment.map(COVERAGE_SYMBOLS),
+            "estimator": table.estimator,
+            "runs": table.runs.astype(str),
+            "mean z": [_pm(v, e, "{:+.2f}") for v, e in zip(table.mean_z, table.mean_z_err)],
+            "mean z^2": [_pm(v, e, "{:.2f}") for v, e in zip(table.mean_z2, table.mean_z2_err)],
+            "t: mean z^2": table.expected_mean_z2.map(_shown("{:.3f}")),
+            f"abs z > {COVERAGE_Z_LIMIT:g}": [
+                _pm(v, e, "{:.3f}") for v, e in zip(table.miss, table.miss_err)
+            ],
+            f"t: P(abs t > {COVERAGE_Z_LIMIT:g})": table.expected_miss.map(_shown("{:.3f}")),
+        }
+    )
+    shards = table.shards.iloc[0]
+    described = ", ".join(f"r = {label}: {count} runs" for label, count in runs.items())
+    return (
+        "# Coverage of the jackknife errors against the exact r = 1/2 and 1/3 results\n\n"
+        f"Independent runs ({described}) of {shards} shards each; per run and estimator "
+        "z = (estimate - exact) / jackknife error. If the errors are right, z follows "
+        f"Student's t with n - 1 = {shards - 1} degrees of freedom (columns t: ...; the controlled "
+        "estimators fit their slopes to the same shards, which leaves fewer), so mean z is 0, "
+        f"mean z^2 is (n - 1)/(n - 3) and abs z exceeds {COVERAGE_Z_LIMIT:g} with "
+        "the probability P given. Errors: the standard errors of mean z and mean z^2 over the "
+        "runs, and the binomial error of the fraction under t, sqrt(P (1 - P) / runs). "
+        "Controlled: blank with too few shards "
+        "to fit the control slopes.\n\n"
+        + shown.to_markdown(index=False, disable_numparse=True)
+        + "\n"
+    )
+
+
+def _pm(value, error, form: str) -> str:
+    """``value ± error`` in ``form``; blank for NaN, the value alone without an error."""
+    if not np.isfinite(value):
+        return ""
+    shown = form.format(value)
+    return f"{shown} ± {form.format(error).lstrip('+')}" if np.isfinite(error) else shown

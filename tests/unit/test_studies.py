@@ -7,8 +7,10 @@ from fractions import Fraction
 from types import SimpleNamespace
 
 import numpy as np
+import pandas as pd
 import pytest
 import yaml
+from scipy import stats
 from workflow_support import REPOSITORY, SMALL
 
 from bouncing_ball.bins import LinearBins, LogBins
@@ -106,6 +108,13 @@ def test_the_studies_file_plans_the_readme_runs():
     # what the study does not set comes from the main config (here the small one)
     expected = shard_settings(SMALL, "0.75").replace(shard_time=3.1e7, criterion_c=3.0)
     assert r075["c3"].settings == expected
+    coverage = runs["coverage"]
+    assert len(coverage) == 2 * 48
+    assert coverage["r0.5_run00"].seed == 271828 and coverage["r0.333333_run47"].seed == 271875
+    assert {run.shards for run in coverage.values()} == {64}
+    assert coverage["r0.333333_run05"].settings == shard_settings(SMALL, "1/3").replace(
+        shard_time=2.4e5
+    )
 
 
 @pytest.mark.parametrize(
@@ -125,6 +134,8 @@ def test_the_studies_file_plans_the_readme_runs():
             "r075.runs.b: seed 1",
         ),
         ({"r075": {"simulation": {"equilibration_time": -1.0}}}, "r075.runs.c3: shard settings"),
+        ({"coverage": {"restitution": ["1/3", 0.75]}}, "coverage.restitution: r = 3/4"),
+        ({"coverage": {"shard_time": {"1/3": 1.0e3}}}, "coverage.shard_time: no shard_time"),
     ],
 )
 def test_inconsistent_studies_are_refused_naming_the_key(change, message):
@@ -133,3 +144,75 @@ def test_inconsistent_studies_are_refused_naming_the_key(change, message):
         bad[study].update(values)
     with pytest.raises(ValueError, match=message):
         study_runs(bad, SMALL)
+
+
+def test_student_t_coverage_is_scipys_t_distribution():
+    for shards in (4, 8, 64):
+        mean_square, miss = studies.student_t_coverage(shards)
+        assert mean_square == pytest.approx(stats.t.var(shards - 1), rel=1e-12)
+        assert miss == pytest.approx(2.0 * stats.t.sf(2.0, shards - 1), rel=1e-12)
+    assert np.isnan(studies.student_t_coverage(3)[0])  # E[t_2^2] is infinite
+    with pytest.raises(ValueError, match="shards"):
+        studies.student_t_coverage(1)
+    with pytest.raises(ValueError, match="limit"):
+        studies.student_t_coverage(8, limit=0.0)
+
+
+def test_coverage_rows_are_the_moments_of_z_over_the_runs():
+    z = [1.0, -3.0, 2.5, 0.0, np.nan]  # the NaN (no estimate) is left out
+    frame = pd.DataFrame(
+        {"r_label": "0.5", "run": range(5), "moment": "mean_x", "estimator": "plain", "z": z}
+    )
+    row = studies.coverage_rows(frame, 8).set_index(["moment", "estimator"]).loc["mean_x", "plain"]
+    assert row.runs == 4
+    assert row.mean_z == pytest.approx(0.125)
+    assert row.mean_z2 == pytest.approx((1.0 + 9.0 + 6.25) / 4)
+    assert row.mean_z2_err == pytest.approx(np.std([1.0, 9.0, 6.25, 0.0], ddof=1) / 2.0)
+    assert row.expected_mean_z2 == pytest.approx(7.0 / 5.0)
+    # the binomial error of the fraction at t_7's P(|t| > 2) = 0.0856
+    assert row.miss == 0.5
+    assert row.miss_err == pytest.approx(np.sqrt(row.expected_miss * (1 - row.expected_miss) / 4))
+    assert row.expected_miss == pytest.approx(2.0 * stats.t.sf(2.0, 7), rel=1e-12)
+    # every moment and estimator has a row; those without a z have none of the statistics
+    table = studies.coverage_rows(frame, 8)
+    assert len(table) == len(studies.COVERAGE_MOMENTS) * len(studies.COVERAGE_ESTIMATORS)
+    assert (table.runs[1:] == 0).all() and table.mean_z2[1:].isna().all()
+
+
+def test_coverage_of_normal_shards_is_students_t():
+    # 4000 runs of 8 normal shards, z = mean / standard error: mean z^2 and the fraction of
+    # |z| > 2 match t_7 within 4 of their standard errors
+    values = np.random.default_rng(5).normal(size=(4000, 8))
+    z = values.mean(axis=1) / (values.std(axis=1, ddof=1) / np.sqrt(8))
+    frame = pd.DataFrame(
+        {"r_label": "0.5", "run": range(len(z)), "moment": "mean_x", "estimator": "plain", "z": z}
+    )
+    row = studies.coverage_rows(frame, 8).iloc[0]
+    assert abs(row.mean_z2 - row.expected_mean_z2) < 4 * row.mean_z2_err
+    assert abs(row.miss - row.expected_miss) < 4 * row.miss_err
+    # the normal law's 1 and 0.0455 are rejected by the same test: t_7 is heavier
+    assert abs(row.mean_z2 - 1.0) > 4 * row.mean_z2_err
+    assert abs(row.miss - 0.0455) > 4 * row.miss_err
+
+
+def test_run_z_scores_of_both_estimators_and_none_without_an_estimate():
+    summary = pd.Series(
+        {
+            **dict.fromkeys(studies.COVERAGE_MOMENTS, 2.0),
+            **{f"{moment}_err": 0.5 for moment in studies.COVERAGE_MOMENTS},
+            **{f"{moment}_controlled": 1.0 for moment in studies.COVERAGE_MOMENTS},
+            **{f"{moment}_controlled_err": np.nan for moment in studies.COVERAGE_MOMENTS},
+        }
+    )
+    reference = dict.fromkeys(studies.COVERAGE_MOMENTS, 1.5)
+    z = studies.run_z_scores(summary, reference)
+    assert z["flight_time_second_moment", "plain"] == pytest.approx(1.0)
+    assert np.isnan(z["mean_x", "controlled"])
+
+
+def test_exact_moments_are_the_closed_forms_at_one_half():
+    # <x> = 6, Delta x = 6 sqrt(3), I = 1/3 (exact.position_moments), <T> = 1 / I
+    moments = studies.exact_moments("1/2")
+    assert moments["mean_x"] == pytest.approx(6.0, rel=1e-10)
+    assert moments["delta_x"] == pytest.approx(6.0 * np.sqrt(3.0), rel=1e-10)
+    assert moments["mean_flight_time"] == pytest.approx(3.0, rel=1e-10)

@@ -12,7 +12,8 @@ from bouncing_ball.equilibration import default_equilibration_time
 from bouncing_ball.workflow.io import read_table
 
 # 2-4 shards per run of 1e3-2e3 time units; batches and groups of 2 shards so that every
-# column of the r075 report has a number for run c3 and the pooled runs
+# column of the r075 report has a number for run c3 and the pooled runs; coverage: 2 runs of
+# 4 shards per r, too few shards for the control variates
 TINY = {
     "criterion_bias": {
         "restitution": ["1/2", "1/3"],
@@ -31,6 +32,13 @@ TINY = {
             "c3": {"criterion_c": 3.0, "seed": 1, "shards": 4},
             "c5": {"criterion_c": 5.0, "seed": 2, "shards": 2},
         },
+    },
+    "coverage": {
+        "restitution": ["1/2", "1/3"],
+        "seed": 3,
+        "runs": 2,
+        "shards": 4,
+        "shard_time": {"1/2": 1.0e3, "1/3": 1.0e3},
     },
 }
 
@@ -105,11 +113,43 @@ def test_r075_report_compares_every_run_and_all_with_the_solver(studies_run):
     assert "r = 0.75" in (studies_run / "results/studies/r075.md").read_text()
 
 
+def test_coverage_report_scatters_every_moment_and_estimator_against_students_t(studies_run):
+    table = pd.read_csv(studies_run / "results/studies/coverage.csv", dtype={"r_label": str})
+    moments = [
+        "mean_x",
+        "delta_x",
+        "collision_rate",
+        "mean_flight_time",
+        "flight_time_second_moment",
+    ]
+    assert list(zip(table.r_label, table.moment, table.estimator)) == [
+        (label, moment, estimator)
+        for label in ("0.5", "0.333333")
+        for moment in moments
+        for estimator in ("plain", "controlled")
+    ]
+    # t with 3 degrees of freedom: E[t^2] = 3, P(|t| > 2) = 0.1393
+    assert table.expected_mean_z2.tolist() == pytest.approx([3.0] * 20)
+    assert table.expected_miss.tolist() == pytest.approx([0.139326] * 20, abs=1e-6)
+    plain, controlled = table[table.estimator == "plain"], table[table.estimator == "controlled"]
+    assert (plain.runs == 2).all() and (plain.shards == 4).all()
+    assert finite(plain, ["mean_z", "mean_z_err", "mean_z2", "mean_z2_err", "miss", "miss_err"])
+    # 4 shards are too few to fit the control slopes: no controlled z
+    assert (controlled.runs == 0).all() and controlled.mean_z2.isna().all()
+    markdown = (studies_run / "results/studies/coverage.md").read_text()
+    assert "r = 0.5: 2 runs" in markdown and markdown.count("\n| 0.") == 20
+    _, provenance = read_table(
+        studies_run / "results/studies/coverage/r0.333333_run1/shard3.parquet"
+    )
+    assert provenance["seed"] == 4 and provenance["r_label"] == "0.333333"
+
+
 def test_the_studies_are_not_part_of_the_default_target(tmp_path):
     directory = copy_with_studies(tmp_path, TINY)
     jobs = planned_jobs(directory)
     assert "simulate_shards" in jobs
-    assert not {"study_shard", "criterion_bias_report", "r075_report", "studies"} & set(jobs)
+    reports = {"criterion_bias_report", "r075_report", "coverage_report"}
+    assert not {"study_shard", "studies", *reports} & set(jobs)
 
 
 @pytest.mark.parametrize(

@@ -118,3 +118,26 @@ rule r075_report:
         code=code(stages.STUDIES, "studies/r075_report.py"),
     script:
         "../../scripts/studies/r075_report.py"
+
+
+rule coverage_report:
+    input:
+        shards=STUDY_SHARDS["coverage"],
+    output:
+        md="results/studies/coverage.md",
+        csv="results/studies/coverage.csv",
+    log:
+        "logs/studies/coverage.log",
+    localrule: True
+    conda:
+        "../envs/bouncing-ball.yaml"
+    # minutes: one position_moments_summary per run (the control fits' jackknife)
+    resources:
+        runtime=30,
+        mem_mb=1000,
+        cpus_per_task=1,
+    params:
+        runs=STUDY_RUN_TABLES["coverage"],
+        code=code(stages.STUDIES, "studies/coverage_report.py"),
+    script:
+        "../../scripts/studies/coverage_report.py"
