@@ -176,7 +176,7 @@ def shard_controls(shards, names):
     the slopes of the fit without each shard k as they are; it does not refit them without
     each left-out shard, and needs no correction for that: each adjusted tally already holds
     its own out-of-sample slope's noise, so its squared error is unbiased for the estimate's
-    variance (within 4 % at p / n from 1/11 to 1/3, Gaussian and Student-t controls,
+    variance (Gaussian and Student-t controls at three shards per control,
     tests/unit/test_control_variates.py), while refitting in each leave-one-out sample
     counts the slopes' noise twice and overstates the variance.  The error itself is
     noisy: z = (estimate - truth) / error follows Student's t, with n - 1 degrees of freedom
