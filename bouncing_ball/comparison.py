@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from .restitution import EXACT_RESTITUTIONS
+from .tallies import RATE_CONTROLS, SHARDS_PER_CONTROL
 
 # exact, fits and histograms (scipy, numba) are imported by the functions that use them: the
 # moments and position tables need none of them
@@ -22,6 +23,9 @@ __all__ = [
     "moments_table",
     "moments_markdown",
     "value_with_error",
+    "independent_estimate",
+    "kernel3_estimate",
+    "INDEPENDENT_ESTIMATOR",
     "outgoing_speed_residuals",
     "exact_outgoing_speed_residuals",
     "sign_flip_test",
@@ -61,28 +65,78 @@ MOMENT_COLUMNS = (
     "estimator",
     "reference",
     "z",
+    "kernel3_controlled",
+    "kernel3_controlled_err",
+    "kernel3_z",
 )
 
+#: The estimator of each quantity in the moments table's ``simulation`` column, fixed in
+#: advance and the same at every r: the summary's ``{quantity}_martingale``, corrected by the
+#: martingale control variates only (their mean is 0 for the simulated process whatever it
+#: is, ``histograms.position_moments_summary``), and where the shards are too few for them
+#: (NaN) the plain ``{quantity}``.  Never chosen by the smaller error: a choice by a noisy
+#: error picks the estimates whose errors came out low.
+INDEPENDENT_ESTIMATOR = "martingale"
 
-def smaller_error_estimate(summary, quantity):
-    """(value, error, estimator) of ``quantity`` in a simulation summary: the plain estimate
-    or the one corrected by control variates (``{quantity}_controlled``, the same
-    expectation), whichever has the smaller error; estimator is "plain" or "controlled"."""
-    value, error = float(summary[quantity]), float(summary[f"{quantity}_err"])
-    controlled = f"{quantity}_controlled"
-    if controlled in summary:
-        other, other_error = float(summary[controlled]), float(summary[f"{controlled}_err"])
-        if np.isfinite(other) and other_error > 0 and not other_error >= error:
-            return other, other_error, "controlled"
-    return value, error, "plain"
+
+def independent_estimate(summary, quantity):
+    """(value, error, estimator) of ``quantity`` in a simulation summary by the fixed rule of
+    ``INDEPENDENT_ESTIMATOR``: ``{quantity}_martingale`` where the summary has it (finite),
+    else the plain ``{quantity}``; estimator is "martingale" or "plain".
+
+    Parameters
+    ----------
+    summary : mapping
+        The merge stage's summary row.
+    quantity : str
+        One of ``QUANTITIES``.
+
+    Returns
+    -------
+    tuple
+        (value, error, estimator).
+
+    Examples
+    --------
+    >>> from bouncing_ball.comparison import independent_estimate
+    >>> summary = {"mean_x": 6.0, "mean_x_err": 0.2, "mean_x_martingale": 6.1,
+    ...            "mean_x_martingale_err": 0.3}
+    >>> independent_estimate(summary, "mean_x")
+    (6.1, 0.3, 'martingale')
+    """
+    column = f"{quantity}_{INDEPENDENT_ESTIMATOR}"
+    if column in summary and np.isfinite(float(summary[column])):
+        return float(summary[column]), float(summary[f"{column}_err"]), INDEPENDENT_ESTIMATOR
+    return float(summary[quantity]), float(summary[f"{quantity}_err"]), "plain"
+
+
+def kernel3_estimate(summary, quantity):
+    """(value, error) of ``quantity`` corrected with the flight-law controls of eq. (kernel3)
+    (the summary's ``{quantity}_controlled`` where its ``kernel3_controls`` is true), else
+    (NaN, NaN): an estimate that leans on the theory it is held against, shown beside the
+    independent one, never instead of it."""
+    column = f"{quantity}_controlled"
+    if column in summary and bool(summary.get("kernel3_controls", False)):
+        return float(summary[column]), float(summary[f"{column}_err"])
+    return np.nan, np.nan
+
+
+def _z(value, error, reference):
+    if np.isfinite(value) and np.isfinite(reference) and error > 0:
+        return (value - reference) / error
+    return np.nan
 
 
 def moment_rows(label, restitution, simulation, solver, exact=None):
     """The time averages <x>, Delta x and I of eq. (xandDeltax) of one r, with their z.
 
-    The simulation's value is that of ``smaller_error_estimate``, plain or controlled
-    (``estimator`` says which). z = (simulation - reference) / simulation_err, the reference
-    being the exact value where there is one and the solver's otherwise.
+    The simulation's value is the independent estimate (``independent_estimate``: the
+    martingale-controlled one, or the plain one with too few shards; ``estimator`` says
+    which), z = (simulation - reference) / simulation_err, the reference being the exact
+    value where there is one and the solver's otherwise.  Beside it, ``kernel3_controlled``
+    with its error and ``kernel3_z`` against the same reference: the estimate corrected with
+    the flight-law controls of eq. (kernel3) (``kernel3_estimate``; NaN where the summary
+    has none).  It leans on the theory under test, so agreement is judged on ``z``.
 
     Parameters
     ----------
@@ -91,7 +145,9 @@ def moment_rows(label, restitution, simulation, solver, exact=None):
     restitution : float or fractions.Fraction
         r.
     simulation : mapping
-        The merge stage's summary: each quantity and its ``<quantity>_err``.
+        The merge stage's summary: each quantity and its ``<quantity>_err``, and where the
+        shards allowed them ``<quantity>_martingale``, ``<quantity>_controlled`` (with
+        ``_err``) and ``kernel3_controls``.
     solver : mapping
         The solve stage's summary.
     exact : mapping, optional
@@ -110,16 +166,16 @@ def moment_rows(label, restitution, simulation, solver, exact=None):
     ...               "delta_x_err": 0.1, "collision_rate": 0.333, "collision_rate_err": 0.001}
     >>> exact = {"mean_x": 6.0, "delta_x": 10.39, "collision_rate": 1 / 3}
     >>> row = moment_rows("0.5", 0.5, simulation, exact, exact)[0]
-    >>> print(row["quantity"], row["paper"], row["reference"], round(row["z"], 6))
-    mean_x 6.0 exact 1.0
+    >>> print(row["quantity"], row["paper"], row["reference"], row["estimator"], round(row["z"], 6))
+    mean_x 6.0 exact plain 1.0
     """
     paper = PAPER_VALUES.get(Fraction(restitution))
     rows = []
     for quantity in QUANTITIES:
         reference_name = "exact" if exact is not None else "solver"
         reference = float((exact if exact is not None else solver)[quantity])
-        value, error, estimator = smaller_error_estimate(simulation, quantity)
-        z = (value - reference) / error if np.isfinite(reference) and error > 0 else np.nan
+        value, error, estimator = independent_estimate(simulation, quantity)
+        kernel3, kernel3_err = kernel3_estimate(simulation, quantity)
         rows.append(
             {
                 "r_label": label,
@@ -132,7 +188,10 @@ def moment_rows(label, restitution, simulation, solver, exact=None):
                 "simulation_err": error,
                 "estimator": estimator,
                 "reference": reference_name,
-                "z": z,
+                "z": _z(value, error, reference),
+                "kernel3_controlled": kernel3,
+                "kernel3_controlled_err": kernel3_err,
+                "kernel3_z": _z(kernel3, kernel3_err, reference),
             }
         )
     return rows
@@ -197,8 +256,9 @@ def moments_markdown(table: pd.DataFrame) -> str:
     Returns
     -------
     str
-        A Markdown table: value ± error, the paper's rounded numbers, the exact and the
-        solver's values, z.
+        A Markdown table: the paper's rounded numbers, the exact and the solver's values,
+        the simulation's independent estimate (value ± error, its estimator, z), and the
+        estimate controlled with eq. (kernel3) with its z.
     """
     shown = pd.DataFrame(
         {
@@ -216,6 +276,11 @@ def moments_markdown(table: pd.DataFrame) -> str:
                 f"{z:+.2f} (vs {reference})" if np.isfinite(z) else ""
                 for z, reference in zip(table.z, table.reference)
             ],
+            "controlled with eq. (kernel3)": [
+                value_with_error(value, error)
+                for value, error in zip(table.kernel3_controlled, table.kernel3_controlled_err)
+            ],
+            "z, eq. (kernel3)": [f"{z:+.2f}" if np.isfinite(z) else "" for z in table.kernel3_z],
         }
     )
     return shown.to_markdown(index=False, disable_numparse=True) + "\n"
@@ -324,10 +389,15 @@ VALIDATION_CHECKS = {
     "p0v_chi2_per_bin": "P(0,v): chi^2/n",
     "p0v_worst_bin": "P(0,v): worst bin, z",
     "p0v_largest_relative_error": "P(0,v): largest relative error, 0.01 <= v <= 5",
-    "p0v_controlled_chi2_per_bin": "P(0,v) controlled: chi^2/n",
-    "p0v_controlled_worst_bin": "P(0,v) controlled: worst bin, z",
+    "p0v_martingale_chi2_per_bin": "P(0,v) martingale-controlled: chi^2/n",
+    "p0v_martingale_worst_bin": "P(0,v) martingale-controlled: worst bin, z",
+    "p0v_martingale_largest_relative_error": (
+        "P(0,v) martingale-controlled: largest relative error, 0.01 <= v <= 5"
+    ),
+    "p0v_controlled_chi2_per_bin": "P(0,v) controlled with eq. (kernel3): chi^2/n",
+    "p0v_controlled_worst_bin": "P(0,v) controlled with eq. (kernel3): worst bin, z",
     "p0v_controlled_largest_relative_error": (
-        "P(0,v) controlled: largest relative error, 0.01 <= v <= 5"
+        "P(0,v) controlled with eq. (kernel3): largest relative error, 0.01 <= v <= 5"
     ),
     "px_chi2_per_bin": "P(x): chi^2/n",
     "px_worst_bin": "P(x): worst bin, z",
@@ -689,8 +759,12 @@ def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None, per
         z = (simulation - reference) / p0v_err over the bins with an error (not the under-
         and overflow bins, nor bins beyond the solver's grid), and the largest relative error
         p0v_err / p0v over the bins with 0.01 <= v <= 5 (an empty bin there counts as an
-        infinite relative error); the same of ``p0v_controlled`` (``p0v_controlled_*`` rows,
-        with no p_sign_flip) where the table has it, else those rows empty (NaN).
+        infinite relative error): these ``p0v_*`` rows of the plain counts, with the
+        p_sign_flip of chi^2/n, judge agreement.  The same three of ``p0v_martingale``
+        (``p0v_martingale_*``, the martingale controls: still independent of the theory)
+        and of ``p0v_controlled`` (``p0v_controlled_*``, the return-law control of
+        eq. (kernel3): leans on the theory under test, shown beside the independent rows),
+        with no p_sign_flip, where the table has them, else those rows empty (NaN).
 
     Raises
     ------
@@ -699,28 +773,31 @@ def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None, per
         another number of shards.
     """
     rows = _outgoing_speed_rows("p0v", simulated, restitution, shards, solver_curve, per_shard)
-    if "p0v_controlled" in simulated and np.isfinite(simulated.p0v_controlled).any():
-        controlled = simulated.assign(
-            p0v=simulated.p0v_controlled, p0v_err=simulated.p0v_controlled_err
-        )
-        rows += _outgoing_speed_rows(
-            "p0v_controlled", controlled, restitution, shards, solver_curve, None
-        )
-    else:  # every check in every r's rows: these empty
-        rows += [
-            {
-                "check": check,
-                "reference": "none",
-                "bins": 0,
-                "value": np.nan,
-                "bin_centre": np.nan,
-                "p_sign_flip": np.nan,
-                "detail": "no controlled P(0,v): fewer than 4 shards, or r outside the "
-                "solver's range",
-            }
-            for check in VALIDATION_CHECKS
-            if check.startswith("p0v_controlled")
-        ]
+    for estimate, absent in (
+        ("p0v_martingale", f"fewer than {SHARDS_PER_CONTROL * len(RATE_CONTROLS)} shards"),
+        ("p0v_controlled", "fewer than 4 shards, or r outside the solver's range"),
+    ):
+        if estimate in simulated and np.isfinite(simulated[estimate]).any():
+            corrected = simulated.assign(
+                p0v=simulated[estimate], p0v_err=simulated[f"{estimate}_err"]
+            )
+            rows += _outgoing_speed_rows(
+                estimate, corrected, restitution, shards, solver_curve, None
+            )
+        else:  # every check in every r's rows: these empty
+            rows += [
+                {
+                    "check": check,
+                    "reference": "none",
+                    "bins": 0,
+                    "value": np.nan,
+                    "bin_centre": np.nan,
+                    "p_sign_flip": np.nan,
+                    "detail": f"no {estimate}: {absent}",
+                }
+                for check in VALIDATION_CHECKS
+                if check.startswith(f"{estimate}_")
+            ]
     return rows
 
 

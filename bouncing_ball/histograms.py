@@ -172,10 +172,16 @@ def deviations_from_mean(values):
 def shard_controls(shards, names):
     """The control sums ``names`` of each shard, if the shards are enough to fit their slopes.
 
-    With p controls fitted to n shards the jackknife error of the corrected estimate is too
-    small by a factor that grows with p / n (about 1.05 at p / n = 1/3, 1.3 at 3/4, on shards
-    with Student-t controls), so at least ``tallies.SHARDS_PER_CONTROL`` shards per control
-    are asked for.
+    The jackknife of the cross-fitted adjusted tallies (``control_variate_adjusted``) keeps
+    the slopes of the fit without each shard k as they are; it does not refit them without
+    each left-out shard, and needs no correction for that: each adjusted tally already holds
+    its own out-of-sample slope's noise, so its squared error is unbiased for the estimate's
+    variance (Gaussian and Student-t controls at three shards per control,
+    tests/unit/test_control_variates.py), while refitting in each leave-one-out sample
+    counts the slopes' noise twice and overstates the variance.  The error itself is
+    noisy: z = (estimate - truth) / error follows Student's t, with n - 1 degrees of freedom
+    at most and fewer as p grows, so its tails are heavy with few shards per control; at
+    least ``tallies.SHARDS_PER_CONTROL`` shards per control are asked for.
 
     Parameters
     ----------
@@ -487,13 +493,18 @@ def outgoing_speed_histogram(
     pandas.DataFrame
         One row per speed bin, under- and overflow included, columns ``v_lo``, ``v_hi``,
         ``v`` (the geometric centre; the arithmetic one for the underflow bin), ``p0v``,
-        ``p0v_err``, ``count``, ``p0v_controlled``, ``p0v_controlled_err``.  The overflow bin
+        ``p0v_err``, ``count``, ``p0v_martingale``, ``p0v_martingale_err``,
+        ``p0v_controlled``, ``p0v_controlled_err``.  The overflow bin
         has p0v = NaN; an empty bin has p0v = 0 and p0v_err = NaN (no scatter to measure).
-        ``p0v_controlled`` is the same with each bin's counts corrected by the control
-        variates of ``tallies.RATE_CONTROLS`` and, given ``restitution``, the bin's
-        return-law control (``control_variate_adjusted``: the same expectation, less
-        variance; NaN with fewer than ``SHARDS_PER_CONTROL`` x the controls' number of
-        shards).
+        ``p0v_martingale`` (with ``p0v_martingale_err``) is the same with each bin's counts
+        corrected by the martingale control variates of ``tallies.RATE_CONTROLS``
+        (``control_variate_adjusted``: the same expectation for the simulated process, less
+        variance; NaN with fewer than ``SHARDS_PER_CONTROL`` x ``len(RATE_CONTROLS)``
+        shards).  ``p0v_controlled`` is corrected by the bin's return-law control, built
+        from eq. (kernel3), the theory under test, and with enough shards the martingale
+        ones too: unbiased only if the simulated process follows eq. (kernel3) (NaN
+        without ``restitution`` or ``return_law``, outside the solver's range, or with
+        fewer than 4 shards).
 
     Examples
     --------
@@ -513,15 +524,16 @@ def outgoing_speed_histogram(
         solver_density = _solver_outgoing_density(exact)
         if solver_density is not None:
             return_law = return_law_prediction(shards, float(exact), solver_density)
+    controls = shard_controls(shards, RATE_CONTROLS)
+    martingale, martingale_err = _controlled(density, controls, times[:, 0], [counts], [times])
     if return_law is None:
-        controls = shard_controls(shards, RATE_CONTROLS)
-        controlled, controlled_err = _controlled(density, controls, times[:, 0], [counts], [times])
+        controlled, controlled_err = _controlled(density, None, times[:, 0], [counts], [times])
     else:
         controlled, controlled_err = _return_law_controlled(
             shards, counts, times, return_law, density
         )
     total = counts.sum(axis=0)
-    for value, error in ((p0v, err), (controlled, controlled_err)):
+    for value, error in ((p0v, err), (martingale, martingale_err), (controlled, controlled_err)):
         value[~np.isfinite(upper)] = np.nan
         error[~np.isfinite(upper) | (total == 0)] = np.nan
     return pd.DataFrame(
@@ -532,6 +544,8 @@ def outgoing_speed_histogram(
             "p0v": p0v,
             "p0v_err": err,
             "count": total.astype(np.int64),
+            "p0v_martingale": martingale,
+            "p0v_martingale_err": martingale_err,
             "p0v_controlled": controlled,
             "p0v_controlled_err": controlled_err,
         }
@@ -764,19 +778,49 @@ def _delta_x(int_x, int_x2, time):
 CONTROLLED_MOMENTS = ("mean_x", "delta_x", "mean_flight_time", "flight_time_second_moment")
 
 
+# each moment as a function of the sums of the collisions, int x dt, int x^2 dt, the
+# flights, sum T and sum T^2, and of the times
+_MOMENT_ESTIMATORS = {
+    "collision_rate": lambda c, ix, ix2, n, f, f2, t: c / t,
+    "mean_x": lambda c, ix, ix2, n, f, f2, t: _mean_x(ix, t),
+    "delta_x": lambda c, ix, ix2, n, f, f2, t: _delta_x(ix, ix2, t),
+    "mean_flight_time": lambda c, ix, ix2, n, f, f2, t: f / n,
+    "flight_time_second_moment": lambda c, ix, ix2, n, f, f2, t: f2 / n,
+}
+
+
+def _controlled_moments(controls, time, sums, suffix):
+    """The columns ``{moment}_{suffix}`` and ``{moment}_{suffix}_err`` of every moment of
+    ``_MOMENT_ESTIMATORS``, its sums ``sums`` adjusted by ``controls`` (NaN where None)."""
+    columns = {}
+    for name, estimator in _MOMENT_ESTIMATORS.items():
+        value, error = _controlled(estimator, controls, time, sums, [time])
+        columns[f"{name}_{suffix}"] = [float(value)]
+        columns[f"{name}_{suffix}_err"] = [float(error)]
+    return columns
+
+
 def position_moments_summary(shards: list[ShardTallies], restitution: float) -> pd.DataFrame:
     """One row of moments: <x>, Delta x, the collision rate I and the flight time's moments.
 
     <x> and Delta x are eq. (xandDeltax), I eq. (collrate); the flight time T has its mean and
-    second moment per flight.  Each is given twice: plain (the time averages, collisions per
-    time, the flights' averages) and ``*_controlled`` (the moments of
-    ``CONTROLLED_MOMENTS`` and I), the same with each sum (the collisions, int x dt,
-    int x^2 dt, the flights, sum T, sum T^2) corrected by control variates of mean 0 before
-    the ratio (``control_variate_adjusted``: the same expectation, less variance), those of
-    ``moment_controls``: the martingale sums ``tallies.MOMENT_CONTROLS`` or the fewer
-    ``tallies.RATE_CONTROLS``, and where r is in the solver's range the flight-law controls
-    (``flight_law_prediction``), as many as the shards can fit (``shard_controls``), none
-    (NaN) with too few shards.
+    second moment per flight.  Each is given three times:
+
+    - plain: the time averages, collisions per time, the flights' averages;
+    - ``*_martingale``: the same with each sum (the collisions, int x dt, int x^2 dt, the
+      flights, sum T, sum T^2) corrected before the ratio by the martingale control
+      variates of ``moment_controls`` without a flight law (``tallies.MOMENT_CONTROLS`` or
+      the fewer ``tallies.RATE_CONTROLS``, as many as the shards can fit,
+      ``shard_controls``; NaN with too few shards).  Their mean is 0 for the simulated
+      process whatever it is, so the estimate has the plain one's expectation
+      (``control_variate_adjusted``) with less variance: with the plain one, it is
+      independent of the theory it is held against;
+    - ``*_controlled``: corrected by the same controls and, where r is in the solver's
+      range and the shards suffice, the flight-law controls of ``flight_law_prediction``
+      (``kernel3_controls`` True).  Those are built from E[T | u] and E[T^2 | u] of
+      eq. (kernel3), the theory under test: their mean is 0 only if the simulated process
+      follows it, so a simulation that departs from eq. (kernel3) shifts this estimate by
+      more or less than its own departure.
 
     Parameters
     ----------
@@ -790,11 +834,12 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
     -------
     pandas.DataFrame
         One row: ``r``; ``mean_x``, ``delta_x``, ``collision_rate``, ``mean_flight_time``,
-        ``flight_time_second_moment``, each with ``_err`` and ``_controlled`` and
-        ``_controlled_err``; the totals ``flights``, ``total_time``, ``collisions``,
-        ``steps``, ``shards`` and ``shards_out_of_budget``; ``control_variates``, the number
-        of controls fitted to the shards for the ``_controlled`` values (0: none, and those
-        are NaN).
+        ``flight_time_second_moment``, each with ``_err``, ``_martingale``,
+        ``_martingale_err``, ``_controlled`` and ``_controlled_err``; ``kernel3_controls``
+        (whether ``_controlled`` uses the flight-law controls of eq. (kernel3)); the totals
+        ``flights``, ``total_time``, ``collisions``, ``steps``, ``shards`` and
+        ``shards_out_of_budget``; ``control_variates``, the number of controls fitted to the
+        shards for the ``_controlled`` values (0: none, and those are NaN).
 
     Examples
     --------
@@ -811,31 +856,20 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
     if len(shards) >= _FLIGHT_LAW_SHARDS:  # else too few shards to fit them
         density = _solver_outgoing_density(parse_restitution(restitution))
         flight_law = None if density is None else flight_law_prediction(shards, density)
-    controls = moment_controls(shards, flight_law)
-    controlled, controlled_err = _controlled(
-        lambda c, t: c / t, controls, time, [collisions], [time]
-    )
     flights = np.array([s.flights for s in shards], dtype=float)
     flight_time = np.array([s.flight_time_sum for s in shards])
     flight_time_squared = np.array([s.flight_time_squared_sum for s in shards])
     mean_t, mean_t_err = jackknife(lambda f, n: f / n, flight_time, flights)
     second_t, second_t_err = jackknife(lambda f, n: f / n, flight_time_squared, flights)
-    adjusted = (int_x, int_x2, flights, flight_time, flight_time_squared)
-    # each estimator takes the adjusted sums of int x dt, int x^2 dt, the flights, sum T and
-    # sum T^2, and the times
-    controlled_moments = {
-        name: _controlled(estimator, controls, time, adjusted, [time])
-        for name, estimator in (
-            ("mean_x", lambda ix, ix2, n, f, f2, t: _mean_x(ix, t)),
-            ("delta_x", lambda ix, ix2, n, f, f2, t: _delta_x(ix, ix2, t)),
-            ("mean_flight_time", lambda ix, ix2, n, f, f2, t: f / n),
-            ("flight_time_second_moment", lambda ix, ix2, n, f, f2, t: f2 / n),
-        )
-    }
-    controlled_columns = {
-        column: [float(value)]
-        for name, pair in controlled_moments.items()
-        for column, value in zip((f"{name}_controlled", f"{name}_controlled_err"), pair)
+    sums = (collisions, int_x, int_x2, flights, flight_time, flight_time_squared)
+    martingale = moment_controls(shards)
+    controls = moment_controls(shards, flight_law)
+    # the flight-law controls in use: the *_controlled columns lean on eq. (kernel3)
+    kernel3 = controls is not None and martingale is not None
+    kernel3 = kernel3 and controls.shape[1] > martingale.shape[1]
+    estimates = {
+        **_controlled_moments(martingale, time, sums, "martingale"),
+        **_controlled_moments(controls, time, sums, "controlled"),
     }
     total = merge_shards(shards)
     return pd.DataFrame(
@@ -847,13 +881,12 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
             "delta_x_err": [float(delta_x_err)],
             "collision_rate": [float(rate)],
             "collision_rate_err": [float(rate_err)],
-            "collision_rate_controlled": [float(controlled)],
-            "collision_rate_controlled_err": [float(controlled_err)],
             "mean_flight_time": [float(mean_t)],
             "mean_flight_time_err": [float(mean_t_err)],
             "flight_time_second_moment": [float(second_t)],
             "flight_time_second_moment_err": [float(second_t_err)],
-            **controlled_columns,
+            **estimates,
+            "kernel3_controls": [bool(kernel3)],
             "flights": [int(total.flights)],
             "total_time": [float(total.time)],
             "collisions": [int(total.collisions)],

@@ -144,8 +144,8 @@ MOMENT_CONTROLS = (*CONTROL_VARIATE_SUMS, *MOMENT_CONTROL_SUMS)
 #: The fewer control variates of the summary's moments with few shards, and those of the bins
 #: of P(0, v), P(x) and <v^2>_x.
 RATE_CONTROLS = (*CONTROL_VARIATE_SUMS, "noise_squared_sum")
-#: The shards per control variate that a correction needs: with fewer, the cross-fitted
-#: slopes' noise makes the jackknife error too small (``histograms.shard_controls``).
+#: The shards per control variate that a correction needs: with fewer, the jackknife error
+#: of the corrected estimate scatters so much that z has heavy tails (``histograms.shard_controls``).
 SHARDS_PER_CONTROL = 3
 #: The fraction of the recording whose steps ``EARLY_SUMS`` sum over: those that start before
 #: ``EARLY_FRACTION`` x shard_time.

@@ -133,10 +133,12 @@ def save_figure(figure, pdf, png, dpi, provenance: dict) -> None:
 
 def simulated_bins(p0v):
     """The bins of a merged P(0, v) table that can be drawn: not the under/overflow
-    bins, at least one collision, a finite error; the controlled estimate (``p0v_controlled``,
-    the return-law and martingale controls) where the table has one."""
-    if "p0v_controlled" in p0v and np.isfinite(p0v["p0v_controlled"]).any():
-        p0v = p0v.assign(p0v=p0v["p0v_controlled"], p0v_err=p0v["p0v_controlled_err"])
+    bins, at least one collision, a finite error; the martingale-controlled estimate
+    (``p0v_martingale``) where the table has one, else the plain counts.  Never the
+    return-law controlled ``p0v_controlled``: it leans on eq. (kernel3), the theory the
+    figures hold the simulation against."""
+    if "p0v_martingale" in p0v and np.isfinite(p0v["p0v_martingale"]).any():
+        p0v = p0v.assign(p0v=p0v["p0v_martingale"], p0v_err=p0v["p0v_martingale_err"])
     return drawable_bins(p0v, "v", "p0v")[lambda bins: bins["count"] > 0]
 
 

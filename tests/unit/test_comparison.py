@@ -82,42 +82,60 @@ def test_z_is_against_the_exact_value_where_there_is_one_and_the_solver_otherwis
     assert (rows.estimator == "plain").all()  # the summary has no controlled estimate
 
 
-def test_the_table_shows_the_estimate_with_the_smaller_error():
-    """The plain estimate or the one corrected by control variates, whichever has the smaller
-    error, and says which; a NaN controlled estimate (too few shards) is passed over."""
+def test_the_table_shows_the_estimator_fixed_in_advance_whatever_the_errors():
+    """simulation is the martingale-controlled estimate of every quantity, even where the
+    plain or the eq. (kernel3) one has the smaller error; the plain one only where the
+    martingale one is NaN (too few shards).  The eq. (kernel3) estimate has its own columns
+    and z, filled only where the summary says its controls are in use."""
     simulated = _summary(
         {
             "mean_x": 6.02,
-            "mean_x_controlled": 6.001,
+            "mean_x_martingale": 6.001,
+            "mean_x_controlled": 6.03,
             "delta_x": 10.3,
-            "delta_x_controlled": 10.2,
+            "delta_x_martingale": 10.2,
+            "delta_x_controlled": 10.25,
             "collision_rate": 0.3330,
-            "collision_rate_controlled": np.nan,
+            "collision_rate_martingale": np.nan,
+            "collision_rate_controlled": 0.3331,
         },
         {
             "mean_x": 0.01,
-            "mean_x_controlled": 0.002,
+            "mean_x_martingale": 0.002,
+            "mean_x_controlled": 0.001,
             "delta_x": 0.05,
-            "delta_x_controlled": 0.06,
+            "delta_x_martingale": 0.06,
+            "delta_x_controlled": 0.01,
             "collision_rate": 0.0002,
-            "collision_rate_controlled": np.nan,
+            "collision_rate_martingale": np.nan,
+            "collision_rate_controlled": 0.0001,
         },
     )
     solved = pd.Series({"mean_x": 6.0, "delta_x": 6 * 3**0.5, "collision_rate": 1 / 3})
-    rows = moments_table(moment_rows("0.6", Fraction(3, 5), simulated, solved))
-    rows = rows.set_index("quantity")
+    rows = moments_table(
+        moment_rows("0.6", Fraction(3, 5), {**simulated, "kernel3_controls": True}, solved)
+    ).set_index("quantity")
     assert rows.loc["mean_x", ["simulation", "simulation_err", "estimator"]].tolist() == [
         6.001,
         0.002,
-        "controlled",
+        "martingale",
     ]
     assert rows.loc["mean_x", "z"] == pytest.approx(0.5)
-    assert rows.loc["delta_x", "estimator"] == "plain" and rows.loc["delta_x", "simulation"] == 10.3
+    assert rows.loc["mean_x", "kernel3_z"] == pytest.approx(30.0)
+    assert rows.loc["delta_x", "estimator"] == "martingale"  # its error is the larger
+    assert rows.loc["delta_x", "simulation"] == 10.2
     assert rows.loc["collision_rate", "estimator"] == "plain"
+    assert rows.loc["collision_rate", "kernel3_controlled"] == 0.3331
     markdown = moments_markdown(
-        moments_table(moment_rows("0.6", Fraction(3, 5), simulated, solved))
+        moments_table(
+            moment_rows("0.6", Fraction(3, 5), {**simulated, "kernel3_controls": True}, solved)
+        )
     )
-    assert "| controlled " in markdown
+    assert "| martingale " in markdown and "eq. (kernel3)" in markdown
+    without = moments_table(
+        moment_rows("0.6", Fraction(3, 5), {**simulated, "kernel3_controls": False}, solved)
+    )
+    assert without.kernel3_controlled.isna().all() and without.kernel3_z.isna().all()
 
 
 @pytest.mark.parametrize(
@@ -622,11 +640,12 @@ def test_validation_chi2_rows_get_a_sign_flip_p_value_from_the_shards(restitutio
     chi2_rows = [
         check
         for check in rows.index
-        if check.endswith("chi2_per_bin") and not check.startswith("p0v_controlled")
+        if check.endswith("chi2_per_bin")
+        and not check.startswith(("p0v_controlled", "p0v_martingale"))
     ]
     assert chi2_rows == ["p0v_chi2_per_bin", "px_chi2_per_bin", "v2_given_x_chi2_per_bin"]
-    # the controlled P(0, v) has no per-shard shares to flip: its rows have no p
-    assert "p0v_controlled_chi2_per_bin" in rows.index
+    # the controlled P(0, v)s have no per-shard shares to flip: their rows have no p
+    assert {"p0v_controlled_chi2_per_bin", "p0v_martingale_chi2_per_bin"} <= set(rows.index)
     for check in chi2_rows:
         assert 1e-3 < rows.loc[check, "p_sign_flip"] <= 1.0, check
         assert "sign flips of the 16 shards" in rows.loc[check, "detail"]

@@ -147,3 +147,25 @@ def test_panel_titles_sit_where_matplotlib_would_place_them():
         figure.draw_without_rendering()
     placed, automatic = (axis.title.get_window_extent().bounds for axis in axes[0])
     assert placed[1:] == pytest.approx(automatic[1:], abs=1e-9)  # same height and size
+
+
+def test_figs_4_and_5_draw_the_martingale_estimate_never_the_kernel3_one():
+    """simulated_bins: p0v_martingale where the table has it, else the plain counts; the
+    return-law controlled p0v_controlled (eq. (kernel3)) is never drawn."""
+    table = pd.DataFrame(
+        {
+            "v_lo": [0.1, 1.0],
+            "v_hi": [1.0, 10.0],
+            "v": [0.3, 3.0],
+            "count": [10, 10],
+            "p0v": [1.0, 0.1],
+            "p0v_err": [0.1, 0.01],
+            "p0v_martingale": [1.1, 0.11],
+            "p0v_martingale_err": [0.05, 0.005],
+            "p0v_controlled": [2.0, 0.2],
+            "p0v_controlled_err": [0.01, 0.001],
+        }
+    )
+    assert plotting.simulated_bins(table).p0v.tolist() == [1.1, 0.11]
+    plain = table.assign(p0v_martingale=np.nan, p0v_martingale_err=np.nan)
+    assert plotting.simulated_bins(plain).p0v.tolist() == [1.0, 0.1]

@@ -42,6 +42,8 @@ def test_run_produces_the_documented_tables(finished_run):
             "p0v",
             "p0v_err",
             "count",
+            "p0v_martingale",
+            "p0v_martingale_err",
             "p0v_controlled",
             "p0v_controlled_err",
         ]
@@ -142,6 +144,8 @@ def test_run_draws_every_figure_and_writes_the_moments_table(finished_run):
     assert list(table.columns) == list(MOMENT_COLUMNS) and len(table) == 6
     assert sorted(table.r_label.astype(str).unique()) == ["0.333333", "0.5"]
     assert (table.reference == "exact").all()
+    # two or three shards: too few for any control, the plain estimate, no eq. (kernel3) one
+    assert (table.estimator == "plain").all() and table.kernel3_controlled.isna().all()
     for label, paper in (
         ("0.5", {"mean_x": 6.0, "delta_x": 10.4}),
         ("0.333333", {"mean_x": 3.89, "delta_x": 7.68}),
@@ -184,12 +188,13 @@ def test_run_writes_the_validation_table(finished_run):
         chi2_rows = [
             check
             for check in rows.index
-            if check.endswith("chi2_per_bin") and not check.startswith("p0v_controlled")
+            if check.endswith("chi2_per_bin")
+            and not check.startswith(("p0v_controlled", "p0v_martingale"))
         ]
         assert rows.loc[chi2_rows, "p_sign_flip"].between(0.0, 1.0, inclusive="right").all()
-        # two or three shards: too few for the controlled P(0, v), whose rows stay empty
-        controlled = rows[rows.index.str.startswith("p0v_controlled")]
-        assert len(controlled) == 3 and controlled.value.isna().all()
+        # two or three shards: too few for the controlled P(0, v)s, whose rows stay empty
+        controlled = rows[rows.index.str.startswith(("p0v_controlled", "p0v_martingale"))]
+        assert len(controlled) == 6 and controlled.value.isna().all()
         assert rows.drop(index=chi2_rows).p_sign_flip.isna().all()
         assert rows.loc["p0v_largest_relative_error", "value"] > 0.0
     markdown = (finished_run / "results/tables/validation.md").read_text()
