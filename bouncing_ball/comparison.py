@@ -80,9 +80,10 @@ INDEPENDENT_ESTIMATOR = "martingale"
 
 
 def independent_estimate(summary, quantity):
-    """(value, error, estimator) of ``quantity`` in a simulation summary by the fixed rule of
-    ``INDEPENDENT_ESTIMATOR``: ``{quantity}_martingale`` where the summary has it (finite),
-    else the plain ``{quantity}``; estimator is "martingale" or "plain".
+    """The estimate of ``quantity`` that judges agreement: independent of the theory.
+
+    By the fixed rule of ``INDEPENDENT_ESTIMATOR``: ``{quantity}_martingale`` where the summary
+    has it (finite), else the plain ``{quantity}``; estimator is "martingale" or "plain".
 
     Parameters
     ----------
@@ -111,10 +112,24 @@ def independent_estimate(summary, quantity):
 
 
 def kernel3_estimate(summary, quantity):
-    """(value, error) of ``quantity`` corrected with the flight-law controls of eq. (kernel3)
-    (the summary's ``{quantity}_controlled`` where its ``kernel3_controls`` is true), else
+    """The estimate of ``quantity`` corrected with the flight-law controls of eq. (kernel3).
+
+    The summary's ``{quantity}_controlled`` where its ``kernel3_controls`` is true, else
     (NaN, NaN): an estimate that leans on the theory it is held against, shown beside the
-    independent one, never instead of it."""
+    independent one, never instead of it.
+
+    Parameters
+    ----------
+    summary : mapping
+        The merge stage's summary row.
+    quantity : str
+        One of ``QUANTITIES``.
+
+    Returns
+    -------
+    tuple of float
+        (value, error).
+    """
     column = f"{quantity}_controlled"
     if column in summary and bool(summary.get("kernel3_controls", False)):
         return float(summary[column]), float(summary[f"{column}_err"])
@@ -1161,11 +1176,17 @@ COMPARE_COLUMNS = (
 
 
 def _scalar_rows(equilibrium, summary, dof):
-    """The rows of ``compare`` of the scalars, plain and controlled where finite."""
+    """The rows of ``compare`` of the scalars: plain, martingale-controlled (independent of the
+    theory: the estimate that judges agreement) and controlled (with eq. (kernel3) where the
+    summary's ``kernel3_controls`` says so), each where finite."""
     rows = []
     for quantity in COMPARED_SCALARS:
         reference = float(getattr(equilibrium, quantity))
-        for estimator, column in (("plain", quantity), ("controlled", f"{quantity}_controlled")):
+        for estimator, column in (
+            ("plain", quantity),
+            ("martingale", f"{quantity}_martingale"),
+            ("controlled", f"{quantity}_controlled"),
+        ):
             if column not in summary:
                 continue
             value, error = float(summary[column]), float(summary[f"{column}_err"])
@@ -1204,9 +1225,11 @@ def compare(equilibrium, result) -> pd.DataFrame:
     The z of every scalar, and the chi^2 per bin and sign-flip p of each table.
 
     The scalars <x>, Delta x, I, <T>, <T^2> (eqs. (xandDeltax), (collrate), (meanT),
-    (meanT2)), plain and controlled where the result has a finite controlled estimate:
+    (meanT2)), plain, martingale-controlled (``independent_estimate``: the one that judges
+    agreement) and controlled with eq. (kernel3), each where the result has a finite estimate:
     z = (simulation - equilibrium) / simulation_err, the error the delete-one jackknife's
-    over the shards, so z has a Student t law with ``dof`` = shards - 1 degrees of freedom.
+    over the shards, so z has a Student t law with at most ``dof`` = shards - 1 degrees of
+    freedom (fewer after the control fits).
 
     The tables P(0, v), P(x) and <v^2>_x, each bin against the equilibrium's average over it
     (``EquilibriumBase.p0v_bin_average``, ``px_bin_average``, ``v2_given_x_bin_average``),
@@ -1255,9 +1278,9 @@ def compare(equilibrium, result) -> pd.DataFrame:
         raise ValueError(f"result: needs at least 2 shards for errors, got {result.shards}")
     shards = list(result.tallies)
     per_shard = shard_ratios(shards)
-    rows = _scalar_rows(equilibrium, result.summary.iloc[0], result.shards - 1)
+    rows = _scalar_rows(equilibrium, result.summary_table.iloc[0], result.shards - 1)
 
-    p0v = result.p0v
+    p0v = result.p0v_histogram
     usable = (
         (p0v.v_lo >= max(equilibrium.smallest_speed, np.finfo(float).tiny))
         & np.isfinite(p0v.v_hi)
@@ -1276,7 +1299,7 @@ def compare(equilibrium, result) -> pd.DataFrame:
     )
 
     if equilibrium.distribution_available:
-        position = result.position
+        position = result.position_histogram
         low, high = POSITION_RANGE
         inside = (
             (position.x_lo >= low * (1.0 - 1e-9))

@@ -300,10 +300,10 @@ def check_restitution(restitution) -> float:
     >>> from bouncing_ball.distribution import check_restitution
     >>> print(check_restitution("1/3"), check_restitution(0.6))
     0.3333333333333333 0.6
-    >>> check_restitution(0.999)
+    >>> check_restitution(0.9995)
     Traceback (most recent call last):
     ...
-    ValueError: restitution 0.999: w(F), P(x) and P(x, v) are computed to 1e-8 only for ...
+    ValueError: restitution 0.9995: w(F), P(x) and P(x, v) are computed to 1e-8 only for ...
     """
     exact = parse_restitution(restitution, "restitution")
     if not in_range(exact, DISTRIBUTION_RESTITUTION_RANGE):

@@ -564,20 +564,29 @@ RESULT_KIND = "SimulationResult"
 def _summary_scalar(column):
     """A read-only attribute: ``column`` of ``summary_table``'s one row, as a float; its
     docstring says which scalar of ``SCALARS`` it is and which estimate."""
-    name = column.removesuffix("_err").removesuffix("_controlled")
+    name = column.removesuffix("_err").removesuffix("_controlled").removesuffix("_martingale")
     symbol, what = SCALARS[name]
     if column == name:
         doc = f"{symbol}, {what}: the shards' estimate."
     elif column == f"{name}_err":
         doc = f"The delete-one jackknife error of ``{name}`` over the shards."
-    elif column == f"{name}_controlled":
+    elif column == f"{name}_martingale":
         doc = (
-            f"{symbol} corrected by the martingale control variates (the same expectation, "
-            "less variance); NaN with too few shards to fit them "
+            f"{symbol} corrected by the martingale (noise-sum) control variates: the same "
+            "expectation for the simulated process, less variance, independent of the theory "
+            "(the estimate that judges agreement); NaN with too few shards to fit them "
             "(``tallies.SHARDS_PER_CONTROL`` per control)."
         )
+    elif column == f"{name}_controlled":
+        doc = (
+            f"{symbol} corrected by every control variate, the flight-law controls of "
+            "eq. (kernel3) included where r is in the solver's range (the summary's "
+            "``kernel3_controls``): built from the theory under test; NaN with too few shards."
+        )
     else:
-        doc = f"The delete-one jackknife error of ``{name}_controlled``; NaN where it is."
+        doc = (
+            f"The delete-one jackknife error of ``{column.removesuffix('_err')}``; NaN where it is."
+        )
 
     def value(self) -> float:
         return float(self.summary_table[column].iloc[0])
@@ -630,10 +639,15 @@ class SimulationResult:
         I (eq. (collrate)), <x>, Delta x (eq. (xandDeltax)), and <T>, <T^2> per flight.
     collision_rate_err, mean_x_err, delta_x_err, mean_flight_time_err, flight_time_second_moment_err : float
         Their delete-one jackknife errors over the shards.
+    collision_rate_martingale, mean_x_martingale, delta_x_martingale, mean_flight_time_martingale, flight_time_second_moment_martingale : float
+        The same corrected by the martingale (noise-sum) control variates: the same
+        expectation for the simulated process, less variance, independent of the theory (the
+        estimates that judge agreement); NaN with too few shards to fit the controls
+        (``tallies.SHARDS_PER_CONTROL`` per control); each with ``*_err``.
     collision_rate_controlled, mean_x_controlled, delta_x_controlled, mean_flight_time_controlled, flight_time_second_moment_controlled : float
-        The same corrected by the martingale control variates (the same expectation, less
-        variance); NaN with too few shards to fit the controls
-        (``tallies.SHARDS_PER_CONTROL`` per control).
+        The same corrected by every control, the flight-law controls of eq. (kernel3)
+        included where r is in the solver's range: built from the theory under test, shown
+        beside the independent estimates, never instead of them.
     collision_rate_controlled_err, mean_x_controlled_err, delta_x_controlled_err, mean_flight_time_controlled_err, flight_time_second_moment_controlled_err : float
         Their jackknife errors; NaN as they are.
     relaxation_eigenvalue, relaxation_eigenvalue_err : float
@@ -698,22 +712,34 @@ class SimulationResult:
 
     collision_rate = _summary_scalar("collision_rate")
     collision_rate_err = _summary_scalar("collision_rate_err")
+    collision_rate_martingale = _summary_scalar("collision_rate_martingale")
+    collision_rate_martingale_err = _summary_scalar("collision_rate_martingale_err")
     collision_rate_controlled = _summary_scalar("collision_rate_controlled")
     collision_rate_controlled_err = _summary_scalar("collision_rate_controlled_err")
     mean_x = _summary_scalar("mean_x")
     mean_x_err = _summary_scalar("mean_x_err")
+    mean_x_martingale = _summary_scalar("mean_x_martingale")
+    mean_x_martingale_err = _summary_scalar("mean_x_martingale_err")
     mean_x_controlled = _summary_scalar("mean_x_controlled")
     mean_x_controlled_err = _summary_scalar("mean_x_controlled_err")
     delta_x = _summary_scalar("delta_x")
     delta_x_err = _summary_scalar("delta_x_err")
+    delta_x_martingale = _summary_scalar("delta_x_martingale")
+    delta_x_martingale_err = _summary_scalar("delta_x_martingale_err")
     delta_x_controlled = _summary_scalar("delta_x_controlled")
     delta_x_controlled_err = _summary_scalar("delta_x_controlled_err")
     mean_flight_time = _summary_scalar("mean_flight_time")
     mean_flight_time_err = _summary_scalar("mean_flight_time_err")
+    mean_flight_time_martingale = _summary_scalar("mean_flight_time_martingale")
+    mean_flight_time_martingale_err = _summary_scalar("mean_flight_time_martingale_err")
     mean_flight_time_controlled = _summary_scalar("mean_flight_time_controlled")
     mean_flight_time_controlled_err = _summary_scalar("mean_flight_time_controlled_err")
     flight_time_second_moment = _summary_scalar("flight_time_second_moment")
     flight_time_second_moment_err = _summary_scalar("flight_time_second_moment_err")
+    flight_time_second_moment_martingale = _summary_scalar("flight_time_second_moment_martingale")
+    flight_time_second_moment_martingale_err = _summary_scalar(
+        "flight_time_second_moment_martingale_err"
+    )
     flight_time_second_moment_controlled = _summary_scalar("flight_time_second_moment_controlled")
     flight_time_second_moment_controlled_err = _summary_scalar(
         "flight_time_second_moment_controlled_err"
@@ -765,8 +791,11 @@ class SimulationResult:
         """Every scalar with its error, as a tidy table: a row per (observable, estimator).
 
         The plain estimates and their delete-one jackknife errors over the shards, with
-        ``dof`` = shards - 1; the control-variate estimates (``*_controlled``) with
-        ``dof`` = shards - 1 - the controls fitted (``histograms.moment_controls``); and the
+        ``dof`` = shards - 1; the estimates corrected by the martingale (noise-sum) controls
+        (``*_martingale``, independent of the theory: the ones that judge agreement,
+        ``comparison.independent_estimate``) and by every control, those of eq. (kernel3)
+        included where r is in the solver's range (``*_controlled``), each with ``dof`` =
+        shards - 1 - the controls fitted (``histograms.moment_controls``, at most); and the
         bounce chain's relaxation eigenvalue lambda (``bounce_chain_decay``), dof =
         shards - 1.  Only the estimates that exist are rows: a controlled one needs
         ``tallies.SHARDS_PER_CONTROL`` shards per control and a finite error, lambda two
@@ -779,7 +808,8 @@ class SimulationResult:
             Columns ``observable`` (the attribute's name: ``collision_rate``, ``mean_x``,
             ``delta_x``, ``mean_flight_time``, ``flight_time_second_moment``,
             ``relaxation_eigenvalue``), ``symbol``, ``estimator`` (``"plain"``,
-            ``"controlled"``, or ``"bounce-chain fit"`` for lambda), ``value``, ``error``
+            ``"martingale"``, ``"controlled"``, or ``"bounce-chain fit"`` for lambda),
+            ``value``, ``error``
             (finite and positive), ``shards`` and ``dof``.
 
         Examples
@@ -797,6 +827,17 @@ class SimulationResult:
         rows = []
         for name, (symbol, _) in SCALARS.items():
             rows.append((name, symbol, "plain", row[name], row[f"{name}_err"], shards - 1))
+            if f"{name}_martingale" in row:
+                rows.append(
+                    (
+                        name,
+                        symbol,
+                        "martingale",
+                        row[f"{name}_martingale"],
+                        row[f"{name}_martingale_err"],
+                        shards - 1 - int(row["control_variates"]),
+                    )
+                )
             rows.append(
                 (
                     name,

@@ -103,7 +103,7 @@ def _default_config():
 
 def test_default_config_is_consistent():
     grid = check_config(_default_config())
-    assert list(grid) == ["0.25", "0.333333", "0.5", "0.75"]
+    assert list(grid) == ["0.25", "0.333333", "0.5", "0.75", "0.95", "0.99"]
 
 
 @pytest.mark.parametrize(
@@ -372,9 +372,9 @@ def test_a_study_whose_bins_need_more_memory_than_a_job_may_use_is_refused():
         ("solver.position_grid.min", 1.0e-310),
         ("solver.position_grid.max", 1.0e13),
         ("exact.position_grid.min", 1.0e-310),
-        ("solver.speeds.min", -2.0e4),
-        ("solver.speeds.max", 2.0e4),
-        ("exact.speeds.max", 2.0e4),
+        ("solver.speeds.min", -2.0e6),
+        ("solver.speeds.max", 2.0e6),
+        ("exact.speeds.max", 2.0e6),
         ("solver.forces.min", 1.0e-5),
     ],
 )
