@@ -2,8 +2,8 @@
 
 For each r of ``RESTITUTIONS`` and each of two estimators,
   * ``paper``: the paper's c = 5 and plain tallies (time averages, counts over time);
-  * ``default``: the default config's c and every variance reduction the project uses
-    (the ``*_controlled`` estimate of ``histograms`` where a table has one: the summary's
+  * ``default``: the default config's c and the variance reductions independent of the theory
+    (the martingale-controlled estimate of ``histograms`` where a table has one: the summary's
     moments, P(0, v), P(x), <v^2>_x),
 ``SHARDS`` shards run in two processes and each observable's relative standard error is
 measured from their scatter (the jackknife of ``histograms``), times the CPU seconds of the
@@ -46,13 +46,14 @@ OBSERVABLES = (*MOMENTS, *DISTRIBUTIONS)
 
 def moment_relative_squared_errors(shards, r, controlled):
     """{observable: (relative standard error)^2} of the moments of ``MOMENTS`` from ``shards``:
-    plain, or (``controlled``) the summary's ``*_controlled`` estimate where it has one."""
+    plain, or (``controlled``) the summary's estimate that the moments table shows, the
+    martingale-controlled ``*_martingale`` (``comparison.independent_estimate``)."""
     from bouncing_ball.histograms import position_moments_summary
 
     summary = position_moments_summary(shards, r).iloc[0]
     values = {}
     for observable, name in MOMENTS.items():
-        column = f"{name}_controlled" if controlled else name
+        column = f"{name}_martingale" if controlled else name
         if column not in summary or not np.isfinite(summary[column]):
             column = name
         values[observable] = (summary[f"{column}_err"] / summary[column]) ** 2
@@ -61,9 +62,14 @@ def moment_relative_squared_errors(shards, r, controlled):
 
 def _median_relative_squared_error(table, name, keep, controlled):
     """The median over the bins ``keep`` of (error / value)^2 of column ``name`` of ``table``,
-    or (``controlled``) of its ``_controlled`` column where the table has one."""
-    if controlled and f"{name}_controlled" in table:
-        name = f"{name}_controlled"
+    or (``controlled``) of its martingale-controlled column (``_martingale``, else
+    ``_controlled``: P(x) and <v^2>_x, whose controls are the noise sums) where it has one:
+    the estimates independent of the theory."""
+    if controlled:
+        for suffix in ("_martingale", "_controlled"):
+            if f"{name}{suffix}" in table:
+                name = f"{name}{suffix}"
+                break
     value, error = table[name].to_numpy(), table[f"{name}_err"].to_numpy()
     keep = keep.to_numpy() & np.isfinite(value) & np.isfinite(error) & (value > 0)
     return float(np.median((error[keep] / value[keep]) ** 2))
