@@ -853,7 +853,13 @@ def _outgoing_speed_rows(quantity, simulated, restitution, shards, solver_curve,
             "bin_centre": at,
             "p_sign_flip": np.nan,
             "detail": f"max of p0v_err / p0v over the bins with {low:g} <= v <= {high:g}, "
-            f"at v = {_number(at, 3)}",
+            f"at v = {_number(at, 3)}"
+            + (
+                f"; {empty} of them without a collision (an infinite relative error: the run "
+                "is too short there)"
+                if (empty := int(np.sum(~np.isfinite(relative))))
+                else ""
+            ),
         }
     )
     return rows
