@@ -20,6 +20,7 @@ int dF F^(-1/2) w(F) exp(-1/(12F) - F x), a density per length with F per length
 """
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -48,12 +49,9 @@ DIMENSIONS = {
 
 
 def _positive(value, name: str) -> float:
-    if isinstance(value, bool):
-        raise TypeError(f"{name} must be a number, got {value!r}")
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be a number, got {value!r}") from None
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name} must be a real number, got {value!r}")
+    number = float(value)
     if not 0.0 < number < math.inf:
         raise ValueError(f"{name} must be positive and finite, got {value!r}")
     return number
