@@ -1443,7 +1443,7 @@ class Equilibrium(EquilibriumBase):
 
     >>> ball = Equilibrium("1/2", gravity=9.81, noise=0.05)
     >>> print(f"<x> = {ball.mean_x:.6e} m, 6 L = {6 * ball.units.length:.6e} m")
-    <x> = 1.588880e-05 m, 6 L = 1.588880e-05 m
+    <x> = 1.588855e-05 m, 6 L = 1.588855e-05 m
 
     The exact solutions are their own class, ``ExactEquilibrium("1/2")``, not a flag of this
     one: each class is built one way, with one signature, and both are ``EquilibriumBase``.
