@@ -1230,6 +1230,9 @@ def compare(equilibrium, result) -> pd.DataFrame:
 
     The z of every scalar, and the chi^2 per bin and sign-flip p of each table.
 
+    The two must be in the same units (``units``, of ``Equilibrium(r, gravity=, noise=)`` and
+    ``simulate(..., gravity=, noise=)``); the scalars' columns are in them.
+
     The scalars <x>, Delta x, I, <T>, <T^2> (eqs. (xandDeltax), (collrate), (meanT),
     (meanT2)), plain, martingale-controlled (``independent_estimate``: the one that judges
     agreement) and controlled with eq. (kernel3), each where the result has a finite estimate:
@@ -1263,7 +1266,7 @@ def compare(equilibrium, result) -> pd.DataFrame:
     Raises
     ------
     ValueError
-        If the two are of different r, or the result has fewer than 2 shards.
+        If the two are of different r or units, or the result has fewer than 2 shards.
 
     Examples
     --------
@@ -1280,13 +1283,20 @@ def compare(equilibrium, result) -> pd.DataFrame:
             f"result: simulated at r = {result.restitution}, the equilibrium is at "
             f"r = {equilibrium.restitution}"
         )
+    if equilibrium.units != result.units:
+        raise ValueError(
+            f"result: simulated in {result.units}, the equilibrium is in {equilibrium.units}; "
+            "give both the same gravity and noise"
+        )
     if result.shards < 2:
         raise ValueError(f"result: needs at least 2 shards for errors, got {result.shards}")
     shards = list(result.tallies)
     per_shard = shard_ratios(shards)
     rows = _scalar_rows(equilibrium, result.summary_table.iloc[0], result.shards - 1)
 
-    p0v = result.p0v_histogram
+    # the tables in the paper's units, as the shards' tallies are (their rows have no dimension)
+    equilibrium = equilibrium._paper_twin()
+    p0v = result._p0v_paper
     usable = (
         (p0v.v_lo >= max(equilibrium.smallest_speed, np.finfo(float).tiny))
         & np.isfinite(p0v.v_hi)
@@ -1305,7 +1315,7 @@ def compare(equilibrium, result) -> pd.DataFrame:
     )
 
     if equilibrium.distribution_available:
-        position = result.position_histogram
+        position = result._position_paper
         low, high = POSITION_RANGE
         inside = (
             (position.x_lo >= low * (1.0 - 1e-9))

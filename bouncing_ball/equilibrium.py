@@ -36,6 +36,7 @@ uses ``check_solver_settings``); the solver loads them on first use.
 
 import abc
 import collections
+import contextlib
 import functools
 import inspect
 import math
@@ -54,6 +55,7 @@ from .restitution import (
     parse_restitution,
     restitution_label,
 )
+from .units import PhysicalUnits
 
 __all__ = [
     "EquilibriumBase",
@@ -213,20 +215,32 @@ def _checked(value, name: str, *, low: float | None = None, strictly: bool = Fal
     return array
 
 
-def _heights(value, name: str) -> np.ndarray:
-    """``_checked`` heights: x = 0, or ``distribution.SMALLEST_POSITION`` <= x <=
-    ``distribution.LARGEST_POSITION`` (ValueError naming ``name`` and the bound)."""
+#: The paper's units, g = Lambda = 1.
+_PAPER_UNITS = PhysicalUnits()
+
+
+def _heights(value, name: str, units: PhysicalUnits = _PAPER_UNITS) -> np.ndarray:
+    """``_checked`` heights in ``units``, in the paper's units: x = 0, or
+    ``distribution.SMALLEST_POSITION`` <= x / L <= ``distribution.LARGEST_POSITION``
+    (ValueError naming ``name`` and the bounds in ``units``)."""
     from .distribution import LARGEST_POSITION, SMALLEST_POSITION
 
     x = _checked(value, name, low=0.0)
-    bad = ((x > 0.0) & (x < SMALLEST_POSITION)) | (x > LARGEST_POSITION)
+    paper = units.to_paper(x, "length")
+    bad = ((x > 0.0) & (paper < SMALLEST_POSITION)) | (paper > LARGEST_POSITION)
     if bad.any():
         raise ValueError(
             f"{name} = {x[bad].flat[0]:g} is outside the heights computed: x = 0 or "
-            f"{SMALLEST_POSITION:g} <= x <= {LARGEST_POSITION:g} "
-            "(distribution.SMALLEST_POSITION, LARGEST_POSITION)"
+            f"{units.to_physical(SMALLEST_POSITION, 'length'):g} <= x <= "
+            f"{units.to_physical(LARGEST_POSITION, 'length'):g} "
+            "(distribution.SMALLEST_POSITION, LARGEST_POSITION" + _in_units(units, "length") + ")"
         )
-    return x
+    return paper
+
+
+def _in_units(units: PhysicalUnits, dimension: str) -> str:
+    """How a bound of the paper's units is shown in ``units`` (nothing in the paper's)."""
+    return "" if units.is_paper else f", times the unit of {dimension}"
 
 
 def _broadcast(first, second, names):
@@ -261,8 +275,17 @@ class EquilibriumBase(abc.ABC):
     Every method takes arrays and broadcasts like numpy (a scalar in, a numpy scalar out), and
     refuses input that has no answer with a ValueError naming the argument.
 
+    Every argument and result is in the object's ``units`` (``units.PhysicalUnits``, of the
+    gravity g and noise strength Lambda of eq. (eqmo); the paper's g = Lambda = 1 by default):
+    heights and speeds, times, densities, moments and rates each times its unit L^a T^b
+    (``units.DIMENSIONS``).  r, beta, m, the bounce counts and eigenvalues and the relative
+    accuracies have no dimension; q is per speed.  ``solution`` and ``weight_function``, the
+    solver's own objects, are in the paper's units whatever ``units``.
+
     Attributes
     ----------
+    units : units.PhysicalUnits
+        g and Lambda, and the units L, T, V they make.
     restitution : fractions.Fraction
         r exactly, as parsed (the key of the solve and of the exact formulas).
     r : float
@@ -290,9 +313,44 @@ class EquilibriumBase(abc.ABC):
     >>> import bouncing_ball as bb
     >>> isinstance(bb.ExactEquilibrium("1/2"), bb.EquilibriumBase)
     True
-    >>> sorted(name for name in bb.EquilibriumBase.__abstractmethods__ if name[0] != "_")[:3]
-    ['accuracy', 'collision_rate', 'delta_x']
+    >>> sorted(name for name in bb.EquilibriumBase.__abstractmethods__ if name[0] != "_")
+    ['accuracy', 'distribution_available', 'position_accuracy', 'solution', 'weight_function']
+
+    In physical units, a ball under g = 9.81 m/s^2 and a noise of Lambda = 0.05 m^2/s^3:
+
+    >>> eq = bb.ExactEquilibrium("1/2", gravity=9.81, noise=0.05)
+    >>> print(f"<x> = {eq.mean_x:.4e} m = 6 L, I = {eq.collision_rate:.2f} per s = 1 / (3 T)")
+    <x> = 1.5889e-05 m = 6 L, I = 641.57 per s = 1 / (3 T)
     """
+
+    _units = _PAPER_UNITS  # each object sets its own
+
+    def _set_units(self, gravity, noise) -> None:
+        self._units = PhysicalUnits(gravity, noise)
+
+    @property
+    def units(self) -> PhysicalUnits:
+        """The units of every argument and result (``units.PhysicalUnits``): gravity g and
+        noise strength Lambda of eq. (eqmo), and the length L = Lambda^2 / g^3, time
+        T = Lambda / g^2 and speed V = Lambda / g they make (1 each in the paper's units)."""
+        return self._units
+
+    def _physical(self, value, dimension: str):
+        """A paper-unit ``value`` in ``units`` (``value`` itself in the paper's units)."""
+        return self._units.to_physical(value, dimension)
+
+    def _paper(self, value, dimension: str):
+        """A ``value`` in ``units`` in the paper's units (itself in the paper's units)."""
+        return self._units.to_paper(value, dimension)
+
+    def _paper_twin(self):
+        """This object in the paper's units: a shallow copy sharing the solve and everything
+        computed from it (all kept in the paper's units)."""
+        import copy
+
+        twin = copy.copy(self)
+        twin._units = _PAPER_UNITS
+        return twin
 
     def _set_restitution(self, exact: Fraction) -> None:
         from .asymptotics import large_speed_decay_rate, large_speed_exponent, small_speed_exponent
@@ -328,35 +386,40 @@ class EquilibriumBase(abc.ABC):
 
     @property
     def q(self) -> float:
-        """q of P(0, v) ~ v^-m e^(-q v) as v -> inf, eqs. (asym4), (asym6)."""
-        return self._exponents[2]
+        """q of P(0, v) ~ v^-m e^(-q v) as v -> inf, eqs. (asym4), (asym6): per speed."""
+        return self._physical(self._exponents[2], "per_speed")
 
-    # --- what each class supplies
     @property
-    @abc.abstractmethod
     def collision_rate(self) -> float:
         """I = M_1 = int v P(0, v) dv, eq. (collrate): collisions per unit time (inf below
         r_c)."""
+        return self._physical(self._paper_scalar("collision_rate"), "rate")
 
     @property
-    @abc.abstractmethod
     def mean_x(self) -> float:
         """<x>, the time average of the height, eq. (xandDeltax)."""
+        return self._physical(self._paper_scalar("mean_x"), "length")
 
     @property
-    @abc.abstractmethod
     def delta_x(self) -> float:
         """Delta x = (<x^2> - <x>^2)^(1/2), eq. (xandDeltax)."""
+        return self._physical(self._paper_scalar("delta_x"), "length")
 
     @property
-    @abc.abstractmethod
     def mean_flight_time(self) -> float:
         """<T>, the mean time between two collisions, eq. (meanT) (0 below r_c)."""
+        return self._physical(self._paper_scalar("mean_flight_time"), "time")
 
     @property
-    @abc.abstractmethod
     def flight_time_second_moment(self) -> float:
         """<T^2> per collision, eq. (meanT2) (0 below r_c)."""
+        return self._physical(self._paper_scalar("flight_time_second_moment"), "time_squared")
+
+    # --- what each class supplies, in the paper's units
+    @abc.abstractmethod
+    def _paper_scalar(self, name: str) -> float:
+        """collision_rate, mean_x, delta_x, mean_flight_time or flight_time_second_moment in
+        the paper's units."""
 
     @property
     @abc.abstractmethod
@@ -376,12 +439,14 @@ class EquilibriumBase(abc.ABC):
     @property
     @abc.abstractmethod
     def solution(self):
-        """P(0, v) at the solver's nodes, a ``solver.OutgoingSpeedSolution``."""
+        """P(0, v) at the solver's nodes, a ``solver.OutgoingSpeedSolution``, in the paper's
+        units whatever ``units``."""
 
     @property
     @abc.abstractmethod
     def weight_function(self):
-        """w(F) of eq. (weightfunc) as an object with ``__call__(F)`` and ``log(F)``."""
+        """w(F) of eq. (weightfunc) as an object with ``__call__(F)`` and ``log(F)``, in the
+        paper's units whatever ``units`` (``weight`` gives w(F) in ``units``)."""
 
     @abc.abstractmethod
     def _outgoing(self, v):  # P(0, v), v > 0
@@ -433,14 +498,19 @@ class EquilibriumBase(abc.ABC):
 
     # --- the public methods
     @functools.cached_property
-    def smallest_speed(self) -> float:
-        """The smallest v > 0 at which P(0, v) is a double: below it A v^-beta (eq. (asym1))
-        comes within e^10 of the largest double (``p0v`` refuses such v); 0 where it stays
-        below for every v > 0 (small beta, r near 1)."""
+    def _paper_smallest_speed(self) -> float:
+        """``smallest_speed`` in the paper's units."""
         reference = 1e-30  # where P(0, v) is its power law to rounding
         prefactor = float(self._outgoing(np.array([reference]))[0]) * reference**self.beta
         largest = np.log(np.finfo(float).max) - 10.0
         return float(np.exp((np.log(prefactor) - largest) / self.beta))
+
+    @property
+    def smallest_speed(self) -> float:
+        """The smallest v > 0 at which P(0, v) is a double: below it A v^-beta (eq. (asym1))
+        comes within e^10 of the largest double (``p0v`` refuses such v); 0 where it stays
+        below for every v > 0 (small beta, r near 1).  A speed, in ``units``."""
+        return self._physical(self._paper_smallest_speed, "speed")
 
     def p0v(self, v):
         """P(0, v) on the outgoing side of the floor, eq. (P(0,v)) (exact) or eq. (inteq).
@@ -460,8 +530,9 @@ class EquilibriumBase(abc.ABC):
         Returns
         -------
         numpy.ndarray or numpy.float64
-            P(0, v), the shape of ``v``; inf at v = 0, where P(0, v) ~ v^-beta diverges
-            (eq. (asym1)); 0 where it underflows (v beyond ~700 / q).
+            P(0, v), the shape of ``v``, per unit length and speed; inf at v = 0, where
+            P(0, v) ~ v^-beta diverges (eq. (asym1)); 0 where it underflows (v beyond
+            ~700 / q).
 
         Raises
         ------
@@ -474,18 +545,20 @@ class EquilibriumBase(abc.ABC):
         >>> print(ExactEquilibrium("1/2").p0v([0.5, 1.0, 2.0]).round(6))
         [0.404354 0.122626 0.022556]
         """
-        v = _checked(v, "v", low=0.0)
-        tiny = (v > 0.0) & (v < self.smallest_speed)
+        given = _checked(v, "v", low=0.0)
+        v = self._paper(given, "speed")
+        tiny = (given > 0.0) & (v < self._paper_smallest_speed)
         if tiny.any():
             raise ValueError(
-                f"v = {v[tiny].flat[0]:g} is below smallest_speed = {self.smallest_speed:.3g} at "
-                f"r = {self._label}, where P(0, v) ~ A v^-beta (eq. (asym1)) exceeds the largest "
-                "double; give v = 0 (P = inf) or v >= smallest_speed"
+                f"v = {given[tiny].flat[0]:g} is below smallest_speed = "
+                f"{self.smallest_speed:.3g} at r = {self._label}, where P(0, v) ~ A v^-beta "
+                "(eq. (asym1)) exceeds the largest double; give v = 0 (P = inf) or "
+                "v >= smallest_speed"
             )
         result = np.full(v.shape, np.inf)
-        positive = v > 0.0
+        positive = given > 0.0
         result[positive] = self._outgoing(v[positive])
-        return _out(result)
+        return _out(self._physical(result, "phase_space_density"))
 
     def px(self, x):
         """P(x), the density of the height x, eq. (P(x)1) (eq. (P(x)2) for the exact solutions).
@@ -520,12 +593,12 @@ class EquilibriumBase(abc.ABC):
         [0.503776 0.183784 0.018862]
         """
         self._check_distribution("px")
-        x = _heights(x, "x")
+        x = _heights(x, "x", self._units)
         result = np.full(x.shape, self._floor_density())
         positive = x > 0.0
         if positive.any():
             result[positive] = self._position(x[positive])
-        return _out(result)
+        return _out(self._physical(result, "per_length"))
 
     def v2_given_x(self, x):
         """<v^2>_x, the mean squared velocity at height x, eq. (moment2):
@@ -557,12 +630,12 @@ class EquilibriumBase(abc.ABC):
         [1.853157 3.710784]
         """
         self._check_distribution("v2_given_x")
-        x = _heights(x, "x")
+        x = _heights(x, "x", self._units)
         result = np.full(x.shape, 1.0 / self._floor_density())
         positive = x > 0.0
         if positive.any():
             result[positive] = self._speed_squared(x[positive])
-        return _out(result)
+        return _out(self._physical(result, "speed_squared"))
 
     def pxv(self, x, v):
         """P(x, v), the joint density of height and velocity, eq. (fpsol); at x = 0 the
@@ -606,22 +679,28 @@ class EquilibriumBase(abc.ABC):
         from .distribution import LARGEST_VELOCITY
 
         self._check_distribution("pxv")
-        x = _heights(x, "x")
-        v = _checked(v, "v")
+        x = _heights(x, "x", self._units)
+        v = self._paper(_checked(v, "v"), "speed")
         x, v = _broadcast(x, v, ("x", "v"))
         result = np.zeros(x.shape)
         computed = np.abs(v) <= LARGEST_VELOCITY
         if computed.any():
-            result[computed] = self._joint(x[computed], v[computed])
+            with self._paper_bounds():
+                result[computed] = self._joint(x[computed], v[computed])
         result[(x == 0.0) & (v == 0.0)] = np.inf
-        return _out(result)
+        return _out(self._physical(result, "phase_space_density"))
 
-    @functools.cached_property
+    @property
     def smallest_force(self) -> float:
         """The smallest F > 0 at which w(F) is a double: 0 where w(F) ~ F^gamma e^(-S/F)
         vanishes as F -> 0 (S >= 0, r up to 0.73: ``distribution.small_force_decay``); where
         S < 0 it grows without bound, and below this F it comes within e^10 of the largest
-        double (``weight`` refuses such F)."""
+        double (``weight`` refuses such F).  Per length, in ``units``."""
+        return self._physical(self._paper_smallest_force, "per_length")
+
+    @functools.cached_property
+    def _paper_smallest_force(self) -> float:
+        """``smallest_force`` in the paper's units."""
         from scipy import optimize
 
         from .distribution import small_force_decay
@@ -647,6 +726,9 @@ class EquilibriumBase(abc.ABC):
         continues it by its small-F form below and by its power law F^((2 beta - 5)/6) above,
         whose first neglected term is relative (F / F_max)^(-2/3) at most (F_max = 1e8).
 
+        In ``units`` F is per length and w(F) per square root of a length: P(x) =
+        int dF F^(-1/2) w(F) exp(-1/(12 F L) - F x), eq. (P(x)1), with L the unit of length.
+
         Parameters
         ----------
         F : array_like
@@ -655,7 +737,7 @@ class EquilibriumBase(abc.ABC):
         Returns
         -------
         numpy.ndarray or numpy.float64
-            w(F), the shape of ``F``; 0 where it underflows (F below ~1e-4 where S > 0).
+            w(F), the shape of ``F``; 0 where it underflows (F below ~1e-4 L^-1 where S > 0).
 
         Raises
         ------
@@ -670,34 +752,42 @@ class EquilibriumBase(abc.ABC):
         [0.229053 0.153341]
         """
         self._check_distribution("weight")
-        force = _checked(F, "F", low=0.0, strictly=True)
-        small = force < self.smallest_force
+        given = _checked(F, "F", low=0.0, strictly=True)
+        force = self._paper(given, "per_length")
+        small = (force < self._paper_smallest_force) | (force == 0.0)
         if small.any():
             raise ValueError(
-                f"F = {force[small].flat[0]:g} is below smallest_force = {self.smallest_force:.3g}"
-                f" at r = {self._label}, where w(F) ~ F^gamma e^(-S/F) with S < 0 exceeds the "
-                "largest double (distribution.small_force_decay)"
+                f"F = {given[small].flat[0]:g} is below smallest_force = "
+                f"{self.smallest_force:.3g} at r = {self._label}, where w(F) ~ F^gamma e^(-S/F) "
+                "with S < 0 exceeds the largest double (distribution.small_force_decay)"
+                if self._paper_smallest_force > 0.0
+                else f"F = {given[small].flat[0]:g} is 0 in the paper's units (F L underflows)"
             )
         with np.errstate(over="ignore", divide="ignore"):  # e^(-S/F) underflows at tiny F
-            return _out(np.asarray(self._weight(force), dtype=float))
+            weight = np.asarray(self._weight(force), dtype=float)
+            return _out(self._physical(weight, "per_root_length"))
 
     def _flight_times(self, T, name: str, per_collision: bool = False) -> np.ndarray:
-        """``T`` checked: >= 0, and each T > 0 at least the T below which nu(T) (rho(T) =
-        nu / I with ``per_collision``) exceeds the largest double (``shortest_flight_time``);
-        ValueError naming ``name``, r and the bound otherwise."""
+        """``T`` (in ``units``) checked and in the paper's units: >= 0, and each T > 0 at
+        least the T below which nu(T) (rho(T) = nu / I with ``per_collision``) exceeds the
+        largest double (``shortest_flight_time``); ValueError naming ``name``, r and the bound
+        in ``units`` otherwise."""
         from . import flight_time
 
-        times = _checked(T, name, low=0.0)
+        given = _checked(T, name, low=0.0)
+        times = self._paper(given, "time")
         amplitude = self._short_flight_amplitude()
-        if per_collision and np.isfinite(self.collision_rate):
-            amplitude /= self.collision_rate
+        rate = self._paper_scalar("collision_rate")
+        if per_collision and np.isfinite(rate):
+            amplitude /= rate
         shortest = flight_time.shortest_flight_time(amplitude, self.beta)
-        bad = (times > 0.0) & (times < shortest)
+        bad = (given > 0.0) & ((times < shortest) | (times == 0.0))
         if bad.any():
             raise ValueError(
-                f"{name} must be 0 or >= {shortest:.3g} at r = {self._label}: below, "
-                f"{'rho' if per_collision else 'nu'}(T) ~ T^(-beta/2) (eq. (short)) exceeds "
-                f"the largest double; got {times[bad].flat[0]:g}"
+                f"{name} must be 0 or >= {self._physical(shortest, 'time'):.3g} at "
+                f"r = {self._label}: below, {'rho' if per_collision else 'nu'}(T) ~ "
+                f"T^(-beta/2) (eq. (short)) exceeds the largest double; got "
+                f"{given[bad].flat[0]:g}"
             )
         return times
 
@@ -722,8 +812,8 @@ class EquilibriumBase(abc.ABC):
         Returns
         -------
         numpy.ndarray or numpy.float64
-            nu(T), the shape of ``T``, finite; inf at T = 0, where nu ~ T^(-beta/2)
-            (eq. (short)).
+            nu(T), the shape of ``T``, per time squared, finite; inf at T = 0, where
+            nu ~ T^(-beta/2) (eq. (short)).
 
         Raises
         ------
@@ -741,7 +831,7 @@ class EquilibriumBase(abc.ABC):
         positive = times > 0.0
         if positive.any():
             result[positive] = self._flight_rate(times[positive])
-        return _out(result)
+        return _out(self._physical(result, "rate_per_time"))
 
     def flight_time_density(self, T):
         """rho(T) = nu(T) / I, the density of the time between two collisions (per collision);
@@ -758,7 +848,7 @@ class EquilibriumBase(abc.ABC):
         Returns
         -------
         numpy.ndarray or numpy.float64
-            rho(T), the shape of ``T``, finite; inf at T = 0 (eq. (short)).
+            rho(T), the shape of ``T``, per time, finite; inf at T = 0 (eq. (short)).
 
         Raises
         ------
@@ -772,13 +862,14 @@ class EquilibriumBase(abc.ABC):
         [0.196832 0.061925]
         """
         times = self._flight_times(T, "T", per_collision=True)
-        if not np.isfinite(self.collision_rate):
+        rate = self._paper_scalar("collision_rate")
+        if not np.isfinite(rate):
             return _out(np.where(times == 0.0, np.inf, 0.0))
         nu = np.full(times.shape, np.inf)
         positive = times > 0.0
         if positive.any():
             nu[positive] = self._flight_rate(times[positive])
-        return _out(nu / self.collision_rate)
+        return _out(self._physical(nu / rate, "rate"))
 
     def return_speed_density(self, v, u):
         """v G_g(v, u) of eq. (kernel3): the density of the speed v at the next collision of a
@@ -796,7 +887,8 @@ class EquilibriumBase(abc.ABC):
         Returns
         -------
         numpy.ndarray or numpy.float64
-            v G_g(v, u), the broadcast shape; it integrates to 1 over v (eq. (normG)).  Finite
+            v G_g(v, u), the broadcast shape, per speed; it integrates to 1 over v
+            (eq. (normG)).  Finite
             for every finite v and every u in range (computed in logs,
             ``kernel.return_speed_density``): 0 only where it underflows (below ~1e-308, e.g.
             far from v ~ u at large u).
@@ -809,34 +901,48 @@ class EquilibriumBase(abc.ABC):
         """
         from .kernel import SMALLEST_OUTGOING_SPEED, return_speed_density
 
-        v = _checked(v, "v", low=0.0)
-        u = _checked(u, "u", low=SMALLEST_OUTGOING_SPEED)
+        v = self._paper(_checked(v, "v", low=0.0), "speed")
+        given = _checked(u, "u", low=0.0)
+        u = self._paper(given, "speed")
+        small = u < SMALLEST_OUTGOING_SPEED
+        if small.any():
+            smallest = self._physical(SMALLEST_OUTGOING_SPEED, "speed")
+            raise ValueError(
+                f"u must be >= {smallest:g} (kernel.SMALLEST_OUTGOING_SPEED"
+                f"{_in_units(self._units, 'speed')}), got {given[small].flat[0]:g}"
+            )
         v, u = _broadcast(v, u, ("v", "u"))
-        return _out(return_speed_density(v, u))
+        return _out(self._physical(return_speed_density(v, u), "per_speed"))
 
     # --- averages over the bins and cells of a simulation's tables (``SimulationResult``)
     def _speed_bins(self, lo, hi):
-        """Speed bins checked: smallest_speed <= lo < hi, finite, lo > 0 (ValueError naming
-        lo or hi and the bound)."""
-        lo, hi = _broadcast(
+        """Speed bins (in ``units``) checked and in the paper's units: smallest_speed <= lo <
+        hi, finite, lo > 0 (ValueError naming lo or hi and the bound)."""
+        given_lo, given_hi = _broadcast(
             _checked(lo, "lo", low=0.0, strictly=True), _checked(hi, "hi"), ("lo", "hi")
         )
-        if np.any(lo < self.smallest_speed):
+        lo, hi = self._paper(given_lo, "speed"), self._paper(given_hi, "speed")
+        small = (lo < self._paper_smallest_speed) | (lo == 0.0)
+        if np.any(small):
             raise ValueError(
-                f"lo = {lo[lo < self.smallest_speed].flat[0]:g} is below smallest_speed = "
+                f"lo = {given_lo[small].flat[0]:g} is below smallest_speed = "
                 f"{self.smallest_speed:.3g} at r = {self._label}"
             )
         if np.any(hi <= lo):
-            raise ValueError(f"hi must be > lo, got hi = {hi[hi <= lo].flat[0]:g}")
+            raise ValueError(f"hi must be > lo, got hi = {given_hi[hi <= lo].flat[0]:g}")
         return lo, hi
 
     def _height_bins(self, lo, hi, what: str):
-        """Height bins checked: lo = 0 or ``distribution.SMALLEST_POSITION`` <= lo < hi <=
-        ``distribution.LARGEST_POSITION`` (ValueError naming lo or hi and the bound)."""
+        """Height bins (in ``units``) checked and in the paper's units: lo = 0 or
+        ``distribution.SMALLEST_POSITION`` <= lo < hi <= ``distribution.LARGEST_POSITION``
+        (ValueError naming lo or hi and the bound)."""
         self._check_distribution(what)
-        lo, hi = _broadcast(_heights(lo, "lo"), _heights(hi, "hi"), ("lo", "hi"))
+        lo, hi = _broadcast(
+            _heights(lo, "lo", self._units), _heights(hi, "hi", self._units), ("lo", "hi")
+        )
         if np.any(hi <= lo):
-            raise ValueError(f"hi must be > lo, got hi = {hi[hi <= lo].flat[0]:g}")
+            given = self._physical(hi[hi <= lo].flat[0], "length")
+            raise ValueError(f"hi must be > lo, got hi = {given:g}")
         return lo, hi
 
     def p0v_bin_average(self, lo, hi):
@@ -873,7 +979,8 @@ class EquilibriumBase(abc.ABC):
         [0.212134 0.051676]
         """
         lo, hi = self._speed_bins(lo, hi)
-        return _out(np.asarray(self._outgoing_bin_average(lo, hi), dtype=float).reshape(lo.shape))
+        average = np.asarray(self._outgoing_bin_average(lo, hi), dtype=float).reshape(lo.shape)
+        return _out(self._physical(average, "phase_space_density"))
 
     def px_bin_average(self, lo, hi):
         """P(x) averaged over height bins as a simulation's P(x) table measures it (the time
@@ -906,7 +1013,8 @@ class EquilibriumBase(abc.ABC):
         [0.31801854 0.1429493 ]
         """
         lo, hi = self._height_bins(lo, hi, "px_bin_average")
-        return _out(np.asarray(self._position_bin_average(lo, hi), dtype=float).reshape(lo.shape))
+        average = np.asarray(self._position_bin_average(lo, hi), dtype=float).reshape(lo.shape)
+        return _out(self._physical(average, "per_length"))
 
     def v2_given_x_bin_average(self, lo, hi):
         """<v^2>_x of eq. (moment2) averaged over height bins with the weight P(x), as a
@@ -936,9 +1044,8 @@ class EquilibriumBase(abc.ABC):
         [2.53258574 4.23045873]
         """
         lo, hi = self._height_bins(lo, hi, "v2_given_x_bin_average")
-        return _out(
-            np.asarray(self._speed_squared_bin_average(lo, hi), dtype=float).reshape(lo.shape)
-        )
+        average = np.asarray(self._speed_squared_bin_average(lo, hi), dtype=float)
+        return _out(self._physical(average.reshape(lo.shape), "speed_squared"))
 
     def pxv_cell_average(self, x_lo, x_hi, v_lo, v_hi):
         """P(x, v) of eq. (fpsol) averaged over cells of (x, v), as a simulation's P(x, v)
@@ -975,18 +1082,25 @@ class EquilibriumBase(abc.ABC):
         from . import distribution
 
         self._check_distribution("pxv_cell_average")
+        units = self._units
+        _checked(x_lo, "x_lo", low=0.0, strictly=True)
         x_lo, x_hi = _broadcast(
-            _checked(x_lo, "x_lo", low=0.0, strictly=True), _heights(x_hi, "x_hi"), ("x_lo", "x_hi")
+            _heights(x_lo, "x_lo", units), _heights(x_hi, "x_hi", units), ("x_lo", "x_hi")
         )
         v_lo, v_hi = _broadcast(_checked(v_lo, "v_lo"), _checked(v_hi, "v_hi"), ("v_lo", "v_hi"))
+        v_lo, v_hi = self._paper(v_lo, "speed"), self._paper(v_hi, "speed")
         if np.any(x_hi <= x_lo):
-            raise ValueError(f"x_hi must be > x_lo, got x_hi = {x_hi[x_hi <= x_lo].flat[0]:g}")
+            given = self._physical(x_hi[x_hi <= x_lo].flat[0], "length")
+            raise ValueError(f"x_hi must be > x_lo, got x_hi = {given:g}")
         if np.any(v_hi <= v_lo):
-            raise ValueError(f"v_hi must be > v_lo, got v_hi = {v_hi[v_hi <= v_lo].flat[0]:g}")
+            given = self._physical(v_hi[v_hi <= v_lo].flat[0], "speed")
+            raise ValueError(f"v_hi must be > v_lo, got v_hi = {given:g}")
         x_lo, x_hi, v_lo, v_hi = np.broadcast_arrays(x_lo, x_hi, v_lo, v_hi)
-        return _out(
-            distribution.distribution_cell_average(x_lo, x_hi, v_lo, v_hi, self.weight_function)
-        )
+        with self._paper_bounds():
+            average = distribution.distribution_cell_average(
+                x_lo, x_hi, v_lo, v_hi, self.weight_function
+            )
+        return _out(self._physical(average, "phase_space_density"))
 
     # --- the relaxation of the bounce-speed chain (``relaxation``), computed on first use
     _relaxation_step = None  # the solver's step of the matrix (``Equilibrium``: its own)
@@ -1038,8 +1152,8 @@ class EquilibriumBase(abc.ABC):
 
     @property
     def relaxation_time(self) -> float:
-        """n_c <T>: the time the ball takes for ``correlation_bounces`` bounces, in the paper's
-        units (g = Lambda = 1); of order (1 - r)^-2 as r -> 1.
+        """n_c <T>: the time the ball takes for ``correlation_bounces`` bounces, in ``units``;
+        of order (1 - r)^-2 time units T = Lambda / g^2 as r -> 1.
 
         The time scale on which the state at the floor forgets its past (docs/methods.md,
         "Relaxation of the bounce chain"): n bounces take n <T> (``mean_flight_time``) up to
@@ -1056,7 +1170,8 @@ class EquilibriumBase(abc.ABC):
         >>> print(round(Equilibrium("1/2").relaxation_time, 4))
         14.6093
         """
-        return self._relaxation.correlation_bounces * self.mean_flight_time
+        bounces = self._relaxation.correlation_bounces
+        return self._physical(bounces * self._paper_scalar("mean_flight_time"), "time")
 
     @property
     def relaxation_accuracy(self) -> float:
@@ -1074,7 +1189,7 @@ class EquilibriumBase(abc.ABC):
 
     def observables(self) -> dict:
         """The scalars: r, beta, m, q, collision_rate, mean_x, delta_x, mean_flight_time,
-        flight_time_second_moment and accuracy, as a dict.
+        flight_time_second_moment and accuracy, as a dict, in ``units``.
 
         Returns
         -------
@@ -1090,9 +1205,26 @@ class EquilibriumBase(abc.ABC):
         more = ("mean_flight_time", "flight_time_second_moment", "accuracy")
         return {name: float(getattr(self, name)) for name in names + more}
 
+    @contextlib.contextmanager
+    def _paper_bounds(self):
+        """A ValueError raised inside, by a check of the paper's units, says so."""
+        try:
+            yield
+        except ValueError as error:
+            if self._units.is_paper:
+                raise
+            units = self._units
+            raise ValueError(
+                f"{error} (in the paper's units, g = Lambda = 1: heights x / L, speeds v / V, "
+                f"L = {units.length:.6g}, V = {units.speed:.6g})"
+            ) from None
+
     def __repr__(self):
+        units = self._units
+        given = "" if units.is_paper else f", gravity={units.gravity!r}, noise={units.noise!r}"
         return (
-            f"{type(self).__name__}(r={self.restitution}): I = {self.collision_rate:.10g}, "
+            f"{type(self).__name__}(r={self.restitution}{given}): "
+            f"I = {self.collision_rate:.10g}, "
             f"<x> = {self.mean_x:.10g}, Delta x = {self.delta_x:.10g}, "
             f"<T> = {self.mean_flight_time:.10g}, <T^2> = {self.flight_time_second_moment:.10g}; "
             f"beta = {self.beta:.6g}, m = {self.m:.6g}, q = {self.q:.6g}"
@@ -1237,9 +1369,21 @@ class Equilibrium(EquilibriumBase):
         Chebyshev nodes per panel of the interpolated w(F) (``distribution.PANEL_CHEBYSHEV_NODES``;
         the config's ``solver.weight_panel_nodes``), 10 to 40 (``WEIGHT_PANEL_NODES_RANGE``,
         where P(x) meets the 1e-8 accuracy target).
+    gravity : float, optional
+        g > 0, finite: the acceleration toward the floor, eq. (eqmo) (1: the paper's units;
+        9.81 for metres and seconds on Earth).
+    noise : float, optional
+        Lambda > 0, finite: the strength of the random force, <eta(t) eta(t')> =
+        2 Lambda delta(t - t'), eq. (eqmo), the velocity variance the noise adds per unit time
+        being 2 Lambda (1: the paper's units; m^2/s^3 with g in m/s^2).  With ``gravity`` it
+        fixes ``units`` (``units.PhysicalUnits``): every argument and result is in them,
+        each times its unit L^a T^b, L = Lambda^2 / g^3, T = Lambda / g^2.  The solve is the
+        same whatever the units (it is in the paper's).
 
     Attributes
     ----------
+    units : units.PhysicalUnits
+        g and Lambda, and the units they make.
     r : float
     restitution : fractions.Fraction
         r exactly, as parsed.
@@ -1294,6 +1438,13 @@ class Equilibrium(EquilibriumBase):
     >>> print(eq.px([0.1, 1.0]).round(6))  # builds w(F) first
     [0.503776 0.183784]
 
+    In metres and seconds, a ball under g = 9.81 m/s^2 shaken with Lambda = 0.05 m^2/s^3
+    (the same solve: <x> is 6 L, L = Lambda^2 / g^3):
+
+    >>> ball = Equilibrium("1/2", gravity=9.81, noise=0.05)
+    >>> print(f"<x> = {ball.mean_x:.6e} m, 6 L = {6 * ball.units.length:.6e} m")
+    <x> = 1.588855e-05 m, 6 L = 1.588855e-05 m
+
     The exact solutions are their own class, ``ExactEquilibrium("1/2")``, not a flag of this
     one: each class is built one way, with one signature, and both are ``EquilibriumBase``.
     Passing ``exact=`` raises a TypeError that names ``ExactEquilibrium``.
@@ -1307,10 +1458,11 @@ class Equilibrium(EquilibriumBase):
             )
         return super().__new__(cls)
 
-    def __init__(self, r, *, quadrature_step=None, weight_panel_nodes=None):
+    def __init__(self, r, *, quadrature_step=None, weight_panel_nodes=None, gravity=1.0, noise=1.0):
         from . import flight_time, solver
 
         self._set_restitution(_solver_restitution(r))
+        self._set_units(gravity, noise)
         self.quadrature_step, self.weight_panel_nodes = check_solver_settings(
             quadrature_step, weight_panel_nodes
         )
@@ -1334,19 +1486,8 @@ class Equilibrium(EquilibriumBase):
         calling ``__init__`` (``_restored``)."""
         return (_restored, (type(self), dict(self.__dict__)))
 
-    collision_rate = property(
-        lambda self: self._averages["collision_rate"], doc=EquilibriumBase.collision_rate.__doc__
-    )
-    mean_x = property(lambda self: self._averages["mean_x"], doc=EquilibriumBase.mean_x.__doc__)
-    delta_x = property(lambda self: self._averages["delta_x"], doc=EquilibriumBase.delta_x.__doc__)
-    mean_flight_time = property(
-        lambda self: self._averages["mean_flight_time"],
-        doc=EquilibriumBase.mean_flight_time.__doc__,
-    )
-    flight_time_second_moment = property(
-        lambda self: self._averages["flight_time_second_moment"],
-        doc=EquilibriumBase.flight_time_second_moment.__doc__,
-    )
+    def _paper_scalar(self, name: str) -> float:
+        return self._averages[name]
 
     @property
     def distribution_available(self) -> bool:
@@ -1407,8 +1548,8 @@ class Equilibrium(EquilibriumBase):
         return float(
             max(
                 abs(averages["normalization"] - 1.0),
-                abs(averages["mean_x"] / self.mean_x - 1.0),
-                abs(averages["delta_x"] / self.delta_x - 1.0),
+                abs(averages["mean_x"] / self._paper_scalar("mean_x") - 1.0),
+                abs(averages["delta_x"] / self._paper_scalar("delta_x") - 1.0),
             )
         )
 
@@ -1507,6 +1648,12 @@ class ExactEquilibrium(EquilibriumBase):
     ----------
     r : str or fractions.Fraction
         ``"1/2"`` or ``"1/3"`` (or 0.5).
+    gravity : float, optional
+        g > 0, finite, of eq. (eqmo) (1: the paper's units); with ``noise``, the units of
+        every argument and result (``units.PhysicalUnits``).
+    noise : float, optional
+        Lambda > 0, finite: <eta(t) eta(t')> = 2 Lambda delta(t - t'), eq. (eqmo) (1: the
+        paper's units).
 
     Attributes
     ----------
@@ -1527,8 +1674,9 @@ class ExactEquilibrium(EquilibriumBase):
     [0.815666 0.199051]
     """
 
-    def __init__(self, r):
+    def __init__(self, r, *, gravity=1.0, noise=1.0):
         self._set_restitution(_exact_restitution(r))
+        self._set_units(gravity, noise)
 
     @property
     def distribution_available(self) -> bool:
@@ -1557,7 +1705,7 @@ class ExactEquilibrium(EquilibriumBase):
 
         s = np.arange(
             solver.coordinate_of_speed(1e-12),
-            solver.coordinate_of_speed(700.0 / self.q),
+            solver.coordinate_of_speed(700.0 / self._exponents[2]),
             solver.DEFAULT_STEP,
         )
         nodes = solver.speed_of_coordinate(s)
@@ -1586,25 +1734,19 @@ class ExactEquilibrium(EquilibriumBase):
 
         return exact.position_moments(self.restitution)
 
-    @property
-    def collision_rate(self) -> float:
-        return float(self._moments["collision_rate"])
-
-    @property
-    def mean_x(self) -> float:
-        return float(self._moments["mean_x"])
-
-    @property
-    def delta_x(self) -> float:
-        return float(self._moments["delta_x"])
-
     @functools.cached_property
-    def mean_flight_time(self) -> float:
-        return self._flight_moment(1) / self.collision_rate
+    def _flight_moments(self) -> dict:
+        """<T> and <T^2> per collision, in the paper's units (computed on first use)."""
+        rate = self._paper_scalar("collision_rate")
+        return {
+            "mean_flight_time": self._flight_moment(1) / rate,
+            "flight_time_second_moment": self._flight_moment(2) / rate,
+        }
 
-    @functools.cached_property
-    def flight_time_second_moment(self) -> float:
-        return self._flight_moment(2) / self.collision_rate
+    def _paper_scalar(self, name: str) -> float:
+        if name in ("mean_flight_time", "flight_time_second_moment"):
+            return self._flight_moments[name]
+        return float(self._moments[name])
 
     def _flight_moment(self, k: int) -> float:
         """int du u P(0, u) E[T^k | u], eqs. (meanT), (meanT2), by adaptive quadrature."""
@@ -1697,7 +1839,7 @@ class ExactEquilibrium(EquilibriumBase):
         values = []
         for t in np.asarray(times, dtype=float).ravel():
             lo = math.log(1e-7 * math.sqrt(t))
-            hi = math.log(0.5 * t + 12.0 * math.sqrt(t) + 60.0 / self.q)
+            hi = math.log(0.5 * t + 12.0 * math.sqrt(t) + 60.0 / self._exponents[2])
             peak = math.log(max(math.sqrt(t), 0.5 * t))
             value, _ = integrate.quad(
                 integrand, lo, hi, args=(t,), points=[peak], epsabs=0.0, epsrel=1e-12, limit=400

@@ -28,6 +28,7 @@ import numpy as np
 
 from .restitution import parse_restitution, restitution_label
 from .settings import MAX_SHARDS, ShardSettings, real_number
+from .units import PhysicalUnits
 
 __all__ = [
     "simulate",
@@ -36,6 +37,7 @@ __all__ = [
     "load",
     "DEFAULT_SETTINGS",
     "SCALARS",
+    "COLUMN_DIMENSIONS",
 ]
 
 # the shard settings ``simulate`` uses where it is not told otherwise (the default config's
@@ -87,6 +89,24 @@ def _shard_settings(shard_time, settings, restitution):
         )
     except (KeyError, TypeError) as error:
         raise ValueError(f"settings: {error}") from None
+
+
+def _settings_in_paper_units(shard_time, settings, units):
+    """``shard_time`` and the ``settings`` mapping's equilibration_time (in ``units``) in the
+    paper's units, which the shards run in; a ``ShardSettings`` (the shards' own settings, in
+    the paper's units) is refused in other units."""
+    if units.is_paper:
+        return shard_time, settings
+    if isinstance(settings, ShardSettings):
+        raise ValueError(
+            "settings: a ShardSettings is in the paper's units (the shards'); with gravity and "
+            "noise give settings as a dict (its equilibration_time in those units)"
+        )
+    shard_time = units.to_paper(real_number(shard_time, "shard_time"), "time")
+    if isinstance(settings, dict) and "equilibration_time" in settings:
+        given = real_number(settings["equilibration_time"], "settings.equilibration_time")
+        settings = {**settings, "equilibration_time": units.to_paper(given, "time")}
+    return shard_time, settings
 
 
 def _root_seed(seed):
@@ -335,7 +355,7 @@ class SimulationInterrupted(KeyboardInterrupt):
         self.result, self.finished, self.requested = result, finished, requested
 
 
-def _interrupted(exact, seed, settings, finished, requested):
+def _interrupted(exact, seed, settings, finished, requested, units=None):
     """The ``SimulationInterrupted`` of a run stopped with ``finished`` shards done."""
     done = sorted(finished)
     head = f"simulate r={exact} interrupted: {len(done)} of {requested} shards finished"
@@ -355,6 +375,7 @@ def _interrupted(exact, seed, settings, finished, requested):
                 tallies=tuple(finished[index] for index in done),
                 shard_indices=tuple(done),
                 requested_shards=requested,
+                units=units or PhysicalUnits(),
             )
     if result is not None:
         message = (
@@ -396,7 +417,18 @@ class _Progress:
             self.bar.close()
 
 
-def simulate(r, *, shards, shard_time, seed=None, settings=None, processes=1, progress=True):
+def simulate(
+    r,
+    *,
+    shards,
+    shard_time,
+    seed=None,
+    settings=None,
+    processes=1,
+    progress=True,
+    gravity=1.0,
+    noise=1.0,
+):
     """Simulate the bouncing ball at r (the paper's Sec. IV) in independent shards, and
     estimate the equilibrium observables with their jackknife errors.
 
@@ -438,6 +470,14 @@ def simulate(r, *, shards, shard_time, seed=None, settings=None, processes=1, pr
         Show the shards done as a progress bar (``tqdm.auto``): a widget in a notebook, a
         line on stderr in a terminal; nothing where stderr is a file or a pipe, or with
         False.
+    gravity, noise : float, optional
+        g > 0 and Lambda > 0, finite, of eq. (eqmo) (1: the paper's units), as
+        ``Equilibrium``'s.  ``shard_time`` and ``settings``' equilibration_time are times in
+        these units, and the result reports its observables and tables in them
+        (``SimulationResult.units``).  The shards run in the paper's units on the same random
+        streams, so a run's numbers are the paper-unit run's times their units.  The other
+        settings (the bins, min_step_floor) are the shards' own, in the paper's units, and
+        ``settings`` must then be a dict.
 
     Returns
     -------
@@ -498,8 +538,10 @@ def simulate(r, *, shards, shard_time, seed=None, settings=None, processes=1, pr
 
     exact = parse_restitution(r, "r")
     label = restitution_label(exact)
+    units = PhysicalUnits(gravity, noise)
     shards = _whole_number(shards, "shards", 2, MAX_SHARDS)
     processes = _whole_number(processes, "processes", 1)
+    shard_time, settings = _settings_in_paper_units(shard_time, settings, units)
     run_settings = _shard_settings(shard_time, settings, exact)
     if exact < CRITICAL_RESTITUTION and not run_settings.min_step_floor > 0.0:
         raise ValueError(
@@ -523,7 +565,7 @@ def simulate(r, *, shards, shard_time, seed=None, settings=None, processes=1, pr
                 arguments, shards, processes, finished, lambda: progress_line.show(len(finished))
             )
     except KeyboardInterrupt:
-        raise _interrupted(exact, seed, run_settings, finished, shards) from None
+        raise _interrupted(exact, seed, run_settings, finished, shards, units) from None
     finally:
         progress_line.close()
     _check_recorded(finished, run_settings)
@@ -532,6 +574,7 @@ def simulate(r, *, shards, shard_time, seed=None, settings=None, processes=1, pr
         seed=seed,
         settings=run_settings,
         tallies=tuple(finished[index] for index in range(shards)),
+        units=units,
     )
 
 
@@ -544,6 +587,46 @@ SCALARS = {
     "mean_flight_time": ("<T>", "the mean time of flight between collisions"),
     "flight_time_second_moment": ("<T^2>", "the mean squared time of flight"),
 }
+
+#: The dimension (a key of ``units.DIMENSIONS``) of each column of the result's tables that has
+#: one, by its name without ``_err``, ``_controlled``: the scalars of ``SCALARS``, the bins'
+#: edges and centres, and the tables' values.  The other columns (counts, probabilities,
+#: correlations, r) have none.
+COLUMN_DIMENSIONS = {
+    "collision_rate": "rate",
+    "mean_x": "length",
+    "delta_x": "length",
+    "mean_flight_time": "time",
+    "flight_time_second_moment": "time_squared",
+    "total_time": "time",
+    **dict.fromkeys(("x_lo", "x_hi", "x"), "length"),
+    **dict.fromkeys(("v_lo", "v_hi", "v", "u_lo", "u_hi"), "speed"),
+    **dict.fromkeys(("t_lo", "t_hi", "t"), "time"),
+    "p0v": "phase_space_density",
+    "pxv": "phase_space_density",
+    "px": "per_length",
+    "v2_given_x": "speed_squared",
+    "density": "rate",  # rho(T) per flight
+}
+
+
+def _column_dimension(column: str):
+    """The dimension of a table's ``column`` (``COLUMN_DIMENSIONS``), None if it has none."""
+    return COLUMN_DIMENSIONS.get(column.removesuffix("_err").removesuffix("_controlled"))
+
+
+def _in_units(table, units):
+    """A table of the paper's units in ``units``: each column with a dimension times its
+    unit (``table`` itself in the paper's units)."""
+    if units.is_paper:
+        return table
+    converted = table.copy()
+    for column in converted.columns:
+        dimension = _column_dimension(column)
+        if dimension is not None:
+            converted[column] = units.to_physical(converted[column].to_numpy(float), dimension)
+    return converted
+
 
 #: The names of the tables in other releases' spelling, and the table each is.
 _TABLE_NAMES = {
@@ -627,6 +710,11 @@ class SimulationResult:
     requested_shards : int
         The shards asked for; ``partial`` (shown in the repr and the summary) when fewer
         finished: a run stopped by Ctrl-C (``SimulationInterrupted``).
+    units : units.PhysicalUnits
+        The gravity and noise of ``simulate`` (the paper's g = Lambda = 1 by default): the
+        scalars, ``total_time``, ``observables()`` and every table are in these units, each
+        column times its unit (``COLUMN_DIMENSIONS``).  ``settings`` and ``tallies`` are
+        the shards' own, in the paper's units.
     shards : int
         The shards of ``tallies``.
     partial : bool
@@ -690,8 +778,11 @@ class SimulationResult:
     tallies: tuple = field(repr=False)
     shard_indices: tuple = field(default=None, repr=False)
     requested_shards: int = None
+    units: PhysicalUnits = field(default_factory=PhysicalUnits)
 
     def __post_init__(self):
+        if not isinstance(self.units, PhysicalUnits):
+            raise TypeError(f"units must be a units.PhysicalUnits, got {self.units!r}")
         if self.shard_indices is None:
             object.__setattr__(self, "shard_indices", tuple(range(len(self.tallies))))
         if self.requested_shards is None:
@@ -774,18 +865,23 @@ class SimulationResult:
 
     @property
     def total_time(self) -> float:
-        """The simulated time recorded, summed over the shards."""
-        return float(self.merged.time)
+        """The simulated time recorded, summed over the shards, in ``units``."""
+        return float(self.units.to_physical(float(self.merged.time), "time"))
+
+    @cached_property
+    def _summary_paper(self):
+        """``summary_table`` in the paper's units."""
+        from .histograms import position_moments_summary
+
+        summary = position_moments_summary(list(self.tallies), self.r)
+        return summary.assign(requested_shards=self.requested_shards, partial=self.partial)
 
     @cached_property
     def summary_table(self):
         """One row: the scalars, their errors and the counts
         (``histograms.position_moments_summary``), with ``requested_shards`` and
-        ``partial``."""
-        from .histograms import position_moments_summary
-
-        summary = position_moments_summary(list(self.tallies), self.r)
-        return summary.assign(requested_shards=self.requested_shards, partial=self.partial)
+        ``partial``; in ``units``."""
+        return _in_units(self._summary_paper, self.units)
 
     def observables(self):
         """Every scalar with its error, as a tidy table: a row per (observable, estimator).
@@ -868,19 +964,30 @@ class SimulationResult:
         return table[present].reset_index(drop=True)
 
     @cached_property
-    def p0v_histogram(self):
-        """P(0, v) averaged over the speed bins (``histograms.outgoing_speed_histogram``):
-        v_lo, v_hi, v, p0v, p0v_err, count."""
+    def _p0v_paper(self):
+        """``p0v_histogram`` in the paper's units."""
         from .histograms import outgoing_speed_histogram
 
         return outgoing_speed_histogram(list(self.tallies), self.restitution)
 
     @cached_property
-    def position_histogram(self):
-        """P(x) and <v^2>_x averaged over the position bins (``histograms.position_histogram``)."""
+    def p0v_histogram(self):
+        """P(0, v) averaged over the speed bins (``histograms.outgoing_speed_histogram``):
+        v_lo, v_hi, v, p0v, p0v_err, count; in ``units``."""
+        return _in_units(self._p0v_paper, self.units)
+
+    @cached_property
+    def _position_paper(self):
+        """``position_histogram`` in the paper's units."""
         from .histograms import position_histogram
 
         return position_histogram(list(self.tallies))
+
+    @cached_property
+    def position_histogram(self):
+        """P(x) and <v^2>_x averaged over the position bins (``histograms.position_histogram``),
+        in ``units``."""
+        return _in_units(self._position_paper, self.units)
 
     @property
     def px_histogram(self):
@@ -896,26 +1003,27 @@ class SimulationResult:
     @cached_property
     def pxv_histogram(self):
         """P(x, v) averaged over the cells (``histograms.distribution_histogram``): x_lo, x_hi,
-        v_lo, v_hi, pxv, pxv_err."""
+        v_lo, v_hi, pxv, pxv_err; in ``units``."""
         from .histograms import distribution_histogram
 
-        return distribution_histogram(list(self.tallies))
+        return _in_units(distribution_histogram(list(self.tallies)), self.units)
 
     @cached_property
     def flight_time_histogram(self):
         """rho(T) per flight averaged over the flight-time bins
-        (``histograms.flight_time_histogram``): t_lo, t_hi, t, density, density_err."""
+        (``histograms.flight_time_histogram``): t_lo, t_hi, t, density, density_err; in
+        ``units``."""
         from .histograms import flight_time_histogram
 
-        return flight_time_histogram(list(self.tallies))
+        return _in_units(flight_time_histogram(list(self.tallies)), self.units)
 
     @cached_property
     def return_speed_histogram(self):
         """The return speed's bin probabilities given the outgoing speed's bin
-        (``histograms.return_speed_table``)."""
+        (``histograms.return_speed_table``), the bins' edges in ``units``."""
         from .histograms import return_speed_table
 
-        return return_speed_table(list(self.tallies))
+        return _in_units(return_speed_table(list(self.tallies)), self.units)
 
     @cached_property
     def bounce_autocorrelation(self):
@@ -952,8 +1060,8 @@ class SimulationResult:
 
     def provenance(self) -> dict:
         """What ``save`` records with the shards: the kind, r, the seed (an int, or a
-        SeedSequence's entropy, spawn key and pool size), the settings, the shard indices and
-        the shards asked for (JSON-ready)."""
+        SeedSequence's entropy, spawn key and pool size), the settings, the shard indices,
+        the shards asked for and the units (gravity and noise) (JSON-ready)."""
         from .restitution import exact_string
 
         return {
@@ -964,6 +1072,7 @@ class SimulationResult:
             "settings": self.settings.as_mapping(),
             "shard_indices": [int(index) for index in self.shard_indices],
             "requested_shards": int(self.requested_shards),
+            "units": {"gravity": self.units.gravity, "noise": self.units.noise},
         }
 
     def save(self, path):
@@ -1003,8 +1112,10 @@ class SimulationResult:
         def shown(name, symbol):
             return f"{symbol} = {row[name]:.6g} +- {row[name + '_err']:.2g}"
 
+        units = self.units
+        given = "" if units.is_paper else f"gravity={units.gravity!r}, noise={units.noise!r}, "
         return (
-            f"SimulationResult(r={self.restitution}, "
+            f"SimulationResult(r={self.restitution}, {given}"
             + (
                 f"PARTIAL: shards={self.shards} of {self.requested_shards} (interrupted), "
                 if self.partial
@@ -1024,8 +1135,8 @@ class SimulationResult:
 
 def load(path) -> SimulationResult:
     """The ``SimulationResult`` a file of ``SimulationResult.save`` holds: its shards'
-    tallies, settings, seed and r, so every table and observable is bit-identical to the
-    saved result's.
+    tallies, settings, seed, r and units, so every table and observable is bit-identical to
+    the saved result's.
 
     Parameters
     ----------
@@ -1080,6 +1191,7 @@ def load(path) -> SimulationResult:
             tallies=tuple(shards[index] for index in indices),
             shard_indices=indices,
             requested_shards=int(provenance["requested_shards"]),
+            units=PhysicalUnits(**provenance.get("units", {})),
         )
     except (KeyError, TypeError, ValueError) as error:
         raise UnreadableFileError(f"{path}: not a readable SimulationResult ({error})") from None

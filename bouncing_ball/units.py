@@ -11,14 +11,19 @@ is by the only length and time the two constants make,
 quantity with length dimension a and time dimension b is its dimensionless value times
 L^a T^b: <x> and Delta x (a = 1) by g^-3 Lambda^2 and I (b = -1) by g^2 Lambda^-1, as the
 paper's closing paragraph says.  r is dimensionless, and so are the exponents beta, m and the
-bounce counts; the decay rate q of eq. (asym4) is per speed (V^-1).
+bounce counts; the decay rate q of eq. (asym4) is per speed (V^-1).  The weight function
+w(F) of eq. (weightfunc) is per square root of a length: P(x) of eq. (P(x)1) is
+int dF F^(-1/2) w(F) exp(-1/(12F) - F x), a density per length with F per length.
 
 ``DIMENSIONS`` lists (a, b) of every quantity the library returns or takes, by name, and
 ``PhysicalUnits`` converts.
 """
 
 import math
+import numbers
 from dataclasses import dataclass
+
+import numpy as np
 
 __all__ = ["DIMENSIONS", "PhysicalUnits"]
 
@@ -36,17 +41,17 @@ DIMENSIONS = {
     "per_length": (-1, 0),  # P(x), and the force variable F of eq. (weightfunc)
     "per_speed": (-1, 1),  # a density per unit speed (the return-speed law), q of eq. (asym4)
     "phase_space_density": (-2, 1),  # P(x, v), P(0, v): per unit length and speed
-    "rate_per_time": (0, -2),  # the flight-rate density I rho(T)
+    "rate_per_time": (0, -2),  # the flight-rate density nu(T) = I rho(T)
+    # w(F) of eq. (weightfunc): P(x) = int dF F^(-1/2) w(F) exp(-1/(12F) - F x), eq. (P(x)1),
+    # with P(x) per length and F per length, so w(F) is per square root of a length
+    "per_root_length": (-0.5, 0),
 }
 
 
 def _positive(value, name: str) -> float:
-    if isinstance(value, bool):
-        raise TypeError(f"{name} must be a number, got {value!r}")
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be a number, got {value!r}") from None
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name} must be a real number, got {value!r}")
+    number = float(value)
     if not 0.0 < number < math.inf:
         raise ValueError(f"{name} must be positive and finite, got {value!r}")
     return number
@@ -62,7 +67,17 @@ class PhysicalUnits:
         g > 0, finite: the constant acceleration toward the floor (e.g. 9.81 for m/s^2).
     noise : float, optional
         Lambda > 0, finite: the strength of the random force, <eta(t) eta(t')> =
-        2 Lambda delta(t - t') (a speed squared per time, e.g. m^2/s^3).
+        2 Lambda delta(t - t') (a speed squared per time, e.g. m^2/s^3): the variance of the
+        velocity grows by 2 Lambda per unit time under the noise alone.
+
+    Raises
+    ------
+    TypeError
+        If gravity or noise is not a real number (a bool included).
+    ValueError
+        If gravity or noise is not positive and finite, or the two make a unit of some
+        dimension of ``DIMENSIONS`` (L^a T^b) that is not a finite, normal double (g and
+        Lambda many decades from 1 in opposite directions).
 
     Attributes
     ----------
@@ -87,6 +102,19 @@ class PhysicalUnits:
     def __post_init__(self):
         object.__setattr__(self, "gravity", _positive(self.gravity, "gravity"))
         object.__setattr__(self, "noise", _positive(self.noise, "noise"))
+        smallest = np.finfo(float).tiny
+        for dimension in DIMENSIONS:
+            try:
+                factor = self.factor(dimension)
+            except (OverflowError, ZeroDivisionError):
+                factor = math.nan
+            if not smallest <= factor < math.inf:
+                raise ValueError(
+                    f"gravity = {self.gravity!r} and noise = {self.noise!r} make a unit "
+                    f"(L^a T^b of DIMENSIONS[{dimension!r}], L = noise^2 / gravity^3, "
+                    f"T = noise / gravity^2) that is not a finite, normal double: the values "
+                    "converted would be lost"
+                )
 
     @property
     def length(self) -> float:

@@ -461,6 +461,7 @@ MEMBER_VALUES = {
     "correlation_bounces": lambda eq: eq.correlation_bounces,
     "relaxation_time": lambda eq: eq.relaxation_time,
     "observables": lambda eq: [v for k, v in eq.observables().items() if k != "accuracy"],
+    "units": lambda eq: [eq.units.gravity, eq.units.noise],
 }
 # each class's own error bound: not a value to agree on, each held to the 1e-8 target
 ERROR_BOUNDS = {"accuracy", "position_accuracy", "relaxation_accuracy"}
