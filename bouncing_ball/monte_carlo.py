@@ -612,7 +612,9 @@ COLUMN_DIMENSIONS = {
 
 def _column_dimension(column: str):
     """The dimension of a table's ``column`` (``COLUMN_DIMENSIONS``), None if it has none."""
-    return COLUMN_DIMENSIONS.get(column.removesuffix("_err").removesuffix("_controlled"))
+    return COLUMN_DIMENSIONS.get(
+        column.removesuffix("_err").removesuffix("_controlled").removesuffix("_martingale")
+    )
 
 
 def _in_units(table, units):

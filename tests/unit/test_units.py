@@ -218,7 +218,7 @@ def runs():
     shard_time, equilibration = 300.0, 1000.0
     paper = bb.simulate(
         0.6,
-        shards=8,
+        shards=16,
         shard_time=shard_time,
         seed=11,
         settings={"equilibration_time": equilibration},
@@ -226,7 +226,7 @@ def runs():
     )
     physical = bb.simulate(
         0.6,
-        shards=8,
+        shards=16,
         shard_time=shard_time * UNITS.time,
         seed=11,
         settings={"equilibration_time": equilibration * UNITS.time},
@@ -262,14 +262,26 @@ def test_simulate_in_units_is_the_paper_run_times_its_units(runs):
             )
     table = physical.observables().set_index(["observable", "estimator"])
     reference = paper.observables().set_index(["observable", "estimator"])
-    assert table.loc[("delta_x", "plain"), "value"] == pytest.approx(
-        reference.loc[("delta_x", "plain"), "value"] * UNITS.length, rel=ROUNDING
-    )
+    assert list(table.index) == list(reference.index)
+    dimensions = {
+        "collision_rate": "rate",
+        "mean_x": "length",
+        "delta_x": "length",
+        "mean_flight_time": "time",
+        "flight_time_second_moment": "time_squared",
+        "relaxation_eigenvalue": "dimensionless",
+    }
+    for (observable, estimator), row in table.iterrows():  # every estimator, martingale too
+        factor = UNITS.factor(dimensions[observable])
+        for column in ("value", "error"):
+            assert row[column] == pytest.approx(
+                reference.loc[(observable, estimator), column] * factor, rel=ROUNDING
+            ), (observable, estimator, column)
 
 
 def test_simulate_in_units_agrees_with_equilibrium_in_units(runs):
     """<x> simulated in metres against Equilibrium's: z = (sim - eq) / err, Student t with
-    7 dof; |z| > 5 has probability 2e-3 under the null."""
+    15 dof; |z| > 5 has probability 2e-3 under the null."""
     _, physical = runs
     eq = bb.Equilibrium(0.6, gravity=GRAVITY, noise=NOISE)
     z = (physical.mean_x - eq.mean_x) / physical.mean_x_err
