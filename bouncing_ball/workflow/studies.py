@@ -367,8 +367,9 @@ COVERAGE_MOMENTS = (
     "flight_time_second_moment",
 )
 COVERAGE_SYMBOLS = {**SYMBOLS, "mean_flight_time": "<T>", "flight_time_second_moment": "<T^2>"}
-#: The estimators of each moment: the plain tallies and the control-variate ones.
-COVERAGE_ESTIMATORS = ("plain", "controlled")
+#: The estimators of each moment: the plain tallies, the martingale-controlled ones (independent
+#: of the theory) and the controlled ones (with eq. (kernel3) where r is in the solver's range).
+COVERAGE_ESTIMATORS = ("plain", "martingale", "controlled")
 #: |z| beyond this counts as a miss in the coverage report.
 COVERAGE_Z_LIMIT = 2.0
 
@@ -389,7 +390,10 @@ def run_z_scores(summary: pd.Series, reference: dict) -> dict:
     out = {}
     for moment in COVERAGE_MOMENTS:
         for estimator in COVERAGE_ESTIMATORS:
-            column = moment if estimator == "plain" else f"{moment}_controlled"
+            column = moment if estimator == "plain" else f"{moment}_{estimator}"
+            if column not in summary:  # a summary from before the martingale columns
+                out[moment, estimator] = np.nan
+                continue
             value, error = float(summary[column]), float(summary[f"{column}_err"])
             finite = np.isfinite(value) and np.isfinite(error) and error > 0.0
             out[moment, estimator] = (value - reference[moment]) / error if finite else np.nan
