@@ -1,35 +1,14 @@
-"""The fitter on data with known truth: exact recovery without noise, honest intervals with noise."""
+"""The fitter on data with known truth: exact recovery without noise, and its refusals (the
+coverage of its intervals with noise is in tests/statistical/test_fit_coverage.py)."""
 
 import numpy as np
 import pandas as pd
 import pytest
+from fit_support import CASES, _bins, synthetic_shards
 
 from bouncing_ball import fits
 from bouncing_ball.bins import outgoing_speed_bin_average
 from bouncing_ball.histograms import jackknife, outgoing_speed_density
-
-SHARDS = 16
-CASES = {
-    # side: (r whose theory is the truth, true log-prefactor and exponents, bin edges, time per shard)
-    fits.SMALL_SPEED: (0.25, (np.log(0.47), 1.75), np.geomspace(1e-4, 1e-2, 21), 2.0e5),
-    fits.LARGE_SPEED: (0.25, (np.log(0.6), 1.5, 2.0), np.geomspace(0.5, 4.0, 10), 2.0e5),
-}
-
-
-def _bins(edges):
-    return edges[:-1], edges[1:]
-
-
-def synthetic_shards(rng, side, truth, edges, time):
-    """Poisson counts per shard and bin, with shard-to-shard fluctuations shared by all bins
-    (a common factor and a common tilt), as collision cascades make them."""
-    lower, upper = _bins(edges)
-    rate = fits.bin_average(fits.FORMS[side], lower, upper, *truth) * 0.5 * (upper**2 - lower**2)
-    tilt = np.log(np.sqrt(lower * upper) / np.sqrt(lower[0] * upper[-1]))
-    z = rng.standard_normal((SHARDS, 2))
-    factor = np.exp(0.05 * z[:, :1] + 0.03 * z[:, 1:] * tilt[None, :])
-    counts = rng.poisson(rate[None, :] * time * factor)
-    return counts, np.full(SHARDS, time)
 
 
 @pytest.mark.parametrize("side", list(CASES))
@@ -41,38 +20,6 @@ def test_recovers_exact_parameters_without_noise(side):
     expected = [np.exp(truth[0]), *truth[1:]]
     assert list(fit.parameters.values()) == pytest.approx(expected, rel=1e-7)
     assert fit.chi2 < 1e-10
-
-
-@pytest.mark.parametrize("side", list(CASES))
-def test_intervals_cover_the_truth_as_often_as_they_claim(side):
-    """The 95% intervals (jackknife errors over 16 shards, Student t) cover the truth 95% of
-    the time, the joint test of the exponents rejects the truth 5% of the time at p < 0.05,
-    and the estimates are unbiased; on shards with a shard-wide factor and tilt."""
-    r, truth, edges, time = CASES[side]
-    lower, upper = _bins(edges)
-    rng = np.random.default_rng(20061121)
-    names = fits.EXPONENT_NAMES[side]
-    within_95, estimates = dict.fromkeys(names, 0), {n: [] for n in names}
-    joint_rejected = 0
-    trials = 600
-    t95 = fits.interval_factor(SHARDS)
-    for _ in range(trials):
-        counts, times = synthetic_shards(rng, side, truth, edges, time)
-        _, errors = jackknife(
-            lambda c, t: outgoing_speed_density(c, t, lower, upper), counts, times
-        )
-        fit = fits.fit_shards(side, lower, upper, counts, times, errors, r, free=True)
-        # the truth is the theory of r = 0.25, which fit_shards tests jointly
-        joint_rejected += fit.joint_p_value < 0.05
-        for name, true in zip(names, truth[1:]):
-            within_95[name] += abs(fit.parameters[name] - true) <= t95 * fit.errors[name]
-            estimates[name].append(fit.parameters[name])
-    for name, true in zip(names, truth[1:]):
-        # binomial 3-sigma band around the claimed coverage (600 trials: +-0.027)
-        assert abs(within_95[name] / trials - 0.95) <= 3 * np.sqrt(0.95 * 0.05 / trials), name
-        spread = np.std(estimates[name])
-        assert abs(np.mean(estimates[name]) - true) <= 3 * spread / np.sqrt(trials), name
-    assert abs(joint_rejected / trials - 0.05) <= 3 * np.sqrt(0.05 * 0.95 / trials)
 
 
 def test_window_from_range_and_too_few_bins():
