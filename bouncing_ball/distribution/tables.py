@@ -145,6 +145,9 @@ def distribution_table(weight, solution, positions, speeds):
     return pd.DataFrame({"x": x.ravel(), "v": v.ravel(), "pxv": pxv.ravel()}), worst
 
 
+# ---------------------------------------------------------------------------------------------
+# the checks of rule solve's tables
+
 #: How far the measured exponents of P(x) (``measured_exponents``) may lie from the predicted
 #: ones (``predicted_exponents``) over DISTRIBUTION_RESTITUTION_RANGE: the small-x slopes at
 #: x ~ 1e-7 carry corrections of relative order x^((beta - 1)/3) (the log at r = 1/2: -0.06),
