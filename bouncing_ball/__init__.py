@@ -64,26 +64,31 @@ def __dir__():
     return sorted(set(globals()) | set(__all__))
 
 
+def _module_files(name) -> list:
+    """The source files of a module of this package, dotted below it: its .py file, or every
+    .py file of a subpackage (``"distribution"``: its __init__ and each of its modules)."""
+    path = PACKAGE.joinpath(*name.split("."))
+    return sorted(path.rglob("*.py")) if path.is_dir() else [path.with_suffix(".py")]
+
+
 def source_digest(modules=None, files=()) -> str:
     """A short hash of the source of the named modules of this package (all if None), dotted
-    below it (``"solver"``, ``"workflow.io"``), and of ``files`` (a rule's script).
+    below it (``"solver"``, ``"workflow.io"``; a subpackage's name, ``"distribution"``, covers
+    every file of it), and of ``files`` (a rule's script).
 
     The workflow passes it to its rules as a parameter, so that editing the
     code behind a stage re-runs that stage and nothing else, and touching a
     file without changing it re-runs nothing.
     """
-    names = (
-        sorted(
-            ".".join(path.relative_to(PACKAGE).with_suffix("").parts)
-            for path in PACKAGE.rglob("*.py")
-        )
+    paths = (
+        sorted(PACKAGE.rglob("*.py"))
         if modules is None
-        else sorted(modules)
+        else [path for name in sorted(modules) for path in _module_files(name)]
     )
     digest = hashlib.sha256()
-    for name in names:
-        digest.update(name.encode())
-        digest.update(PACKAGE.joinpath(*name.split(".")).with_suffix(".py").read_bytes())
+    for path in paths:
+        digest.update(".".join(path.relative_to(PACKAGE).with_suffix("").parts).encode())
+        digest.update(path.read_bytes())
     for path in files:
         digest.update(Path(path).name.encode())
         digest.update(Path(path).read_bytes())

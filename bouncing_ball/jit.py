@@ -414,9 +414,11 @@ def _flag_is_set_compiled(flag):
 
 
 #: What numba compiles: the modules with compiled functions and what those call into or read
-#: constants from (the key of numba's cache folder); an edit elsewhere does not recompile.
+#: constants from (the key of numba's cache folder), each a file (a module of a subpackage by
+#: its dotted name); an edit elsewhere does not recompile.
 COMPILED = (
-    "distribution",
+    "distribution.complex_kernel",
+    "distribution.ray_density",
     "free_flight",
     "jit",
     "kernel",

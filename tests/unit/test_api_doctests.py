@@ -24,15 +24,26 @@ DOCUMENTED = sorted(
 MODULES = API_MODULES + DOCUMENTED
 
 
+def _with_submodules(module) -> list:
+    """The module, and every module of it if it is a package (bouncing_ball.distribution):
+    doctest finds a function's Examples in the module that defines it only."""
+    if not hasattr(module, "__path__"):
+        return [module]
+    found = pkgutil.walk_packages(module.__path__, prefix=f"{module.__name__}.")
+    return [module, *(importlib.import_module(info.name) for info in found)]
+
+
 @pytest.mark.parametrize("name", MODULES)
 def test_examples_run(name, capsys):
-    module = importlib.import_module(name)
-    result = doctest.testmod(
-        module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE, verbose=False
-    )
+    attempted = failed = 0
+    for module in _with_submodules(importlib.import_module(name)):
+        result = doctest.testmod(
+            module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE, verbose=False
+        )
+        attempted, failed = attempted + result.attempted, failed + result.failed
     report = capsys.readouterr().out
-    assert result.attempted > 0, f"{name} has no Examples"
-    assert result.failed == 0, report
+    assert attempted > 0, f"{name} has no Examples"
+    assert failed == 0, report
 
 
 def _missing_sections(obj) -> list[str]:

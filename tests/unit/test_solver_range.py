@@ -135,7 +135,7 @@ def test_the_smallest_force_is_not_a_lone_accurate_point(monkeypatch):
     def accurate(density, force):
         return bool(force >= 3e-3 or 1e-5 < force < 5e-4)
 
-    monkeypatch.setattr(distribution, "_accurate", accurate)
+    monkeypatch.setattr(distribution.interpolated_weight, "_accurate", accurate)
     smallest = distribution._smallest_force(None, 2e-6)
     assert 3e-3 <= smallest <= 3e-3 * 10.0 ** (1.0 / 8.0)
 

@@ -12,7 +12,7 @@ rule solve:
         weight="results/solver/r{r}/weight.parquet",
     log:
         "logs/solver/r{r}.log",
-    # longer where r > 1/2 (w(F) on narrower panels, bouncing_ball/distribution.py): first;
+    # longer where r > 1/2 (w(F) on narrower panels, bouncing_ball/distribution/): first;
     # the others after the exact solutions and the longest batches of shards, so that they
     # do not compile the solver at the same time
     priority: solve_priority
