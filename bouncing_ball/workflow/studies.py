@@ -170,7 +170,7 @@ def shape(values) -> tuple[float, float]:
 def outgoing_speed_check(shards, restitution, minimum_count: int) -> dict:
     """The simulated P(0, v) (bin averages, jackknife errors) against the exact one
     (``comparison.exact_outgoing_speed_residuals``) over the finite bins with at least
-    ``minimum_count`` collisions: their number, chi^2 / n of their z and the largest ``|z|``."""
+    ``minimum_count`` collisions: their number, chi^2 / n of their z and the largest ``abs(z)``."""
     table = outgoing_speed_histogram(shards)
     z = exact_outgoing_speed_residuals(table[table["count"] >= minimum_count], restitution).residual
     if z.empty:
@@ -370,7 +370,7 @@ COVERAGE_SYMBOLS = {**SYMBOLS, "mean_flight_time": "<T>", "flight_time_second_mo
 #: The estimators of each moment: the plain tallies, the martingale-controlled ones (independent
 #: of the theory) and the controlled ones (with eq. (kernel3) where r is in the solver's range).
 COVERAGE_ESTIMATORS = ("plain", "martingale", "controlled")
-#: |z| beyond this counts as a miss in the coverage report.
+#: abs(z) beyond this counts as a miss in the coverage report.
 COVERAGE_Z_LIMIT = 2.0
 
 
@@ -409,13 +409,13 @@ def student_t_coverage(shards: int, limit: float = COVERAGE_Z_LIMIT) -> tuple[fl
     shards : int
         n, at least 2.
     limit : float, optional
-        The |z| counted as a miss, positive.
+        The abs(z) counted as a miss, positive.
 
     Returns
     -------
     tuple of float
         E[z^2] = (n - 1) / (n - 3), NaN for n <= 3 (where it is infinite), and
-        P(|z| > ``limit``) = 2 P(t_{n-1} < -limit) (``scipy.special.stdtr``).
+        P(abs(z) > ``limit``) = 2 P(t_{n-1} < -limit) (``scipy.special.stdtr``).
 
     Examples
     --------
@@ -450,7 +450,7 @@ def coverage_rows(z_scores: pd.DataFrame, shards: int) -> pd.DataFrame:
         One row per (r_label, moment, estimator), in the order of ``COVERAGE_MOMENTS`` and
         ``COVERAGE_ESTIMATORS``: ``runs`` (finite z), ``mean_z`` and ``mean_z_err`` (its
         standard error), ``mean_z2`` and ``mean_z2_err`` (the standard error of z^2 over the
-        runs), ``miss`` (the fraction of |z| > ``COVERAGE_Z_LIMIT``) and ``miss_err`` (its
+        runs), ``miss`` (the fraction of abs(z) > ``COVERAGE_Z_LIMIT``) and ``miss_err`` (its
         binomial error if the errors are right, sqrt(P (1 - P) / runs) with P =
         ``expected_miss``: never 0, and the scale on which a departure from P is judged),
         ``expected_mean_z2``, ``expected_miss``.
