@@ -212,13 +212,14 @@ def test_extreme_r_runs_end_to_end_within_its_budget(tmp_path):
 
 
 def test_r_outside_the_solver_range_is_refused_before_any_job(tmp_path):
-    """r = 0.95 gave all-NaN P(x) and a job that succeeded; 0.9999 crashed the solve job:
-    refused before any job, naming the target and the range."""
+    """Above the range of the whole distribution (0.9995, 0.9999) and below the solver's
+    (0.015): refused before any job, naming the target and the range (all-NaN P(x) in a job
+    that succeeds, or a crashed solve job, otherwise)."""
     directory = copy_repository(tmp_path, SMALL)
-    for label in ("0.95", "0.9999", "0.015"):
+    for label in ("0.9995", "0.9999", "0.015"):
         result = snakemake(directory, f"results/solver/r{label}/summary.parquet")
         assert result.returncode != 0
-        assert "outside the solver's range 0.02 <= r <= 0.9" in result.stdout + result.stderr
+        assert "outside the solver's range 0.02 <= r <= 0.999" in result.stdout + result.stderr
     assert not (directory / "results/solver").exists()
 
 
@@ -293,8 +294,9 @@ def test_tables_of_another_config_without_snakemakes_record_are_named(finished_r
         "results/simulation/r0.5/shards2-2.parquet: shard_time = 2000.0 (config: 3000.0)" in message
     )
     assert "results/simulation/r0.333333/summary.parquet: shard_time = 2000.0" in message
-    # the rm command lists the stale files sorted: distribution.parquet comes first
-    assert "rm results/simulation/r0.333333/distribution.parquet" in message
+    # the rm command lists the stale files sorted: bounce_chain.parquet comes first
+    assert "rm results/simulation/r0.333333/bounce_chain.parquet" in message
+    assert " results/simulation/r0.333333/distribution.parquet" in message
     assert " results/simulation/r0.333333/p0v.parquet" in message
     assert {path: path.stat().st_mtime_ns for path in (directory / "results").rglob("*")} == before
     for path in (directory / "results/simulation").rglob("*.parquet"):

@@ -126,18 +126,18 @@ def test_coverage_report_scatters_every_moment_and_estimator_against_students_t(
         (label, moment, estimator)
         for label in ("0.5", "0.333333")
         for moment in moments
-        for estimator in ("plain", "controlled")
+        for estimator in ("plain", "martingale", "controlled")
     ]
     # t with 3 degrees of freedom: E[t^2] = 3, P(|t| > 2) = 0.1393
-    assert table.expected_mean_z2.tolist() == pytest.approx([3.0] * 20)
-    assert table.expected_miss.tolist() == pytest.approx([0.139326] * 20, abs=1e-6)
-    plain, controlled = table[table.estimator == "plain"], table[table.estimator == "controlled"]
+    assert table.expected_mean_z2.tolist() == pytest.approx([3.0] * 30)
+    assert table.expected_miss.tolist() == pytest.approx([0.139326] * 30, abs=1e-6)
+    plain, controlled = table[table.estimator == "plain"], table[table.estimator != "plain"]
     assert (plain.runs == 2).all() and (plain.shards == 4).all()
     assert finite(plain, ["mean_z", "mean_z_err", "mean_z2", "mean_z2_err", "miss", "miss_err"])
-    # 4 shards are too few to fit the control slopes: no controlled z
+    # 4 shards are too few to fit the control slopes: no martingale or controlled z
     assert (controlled.runs == 0).all() and controlled.mean_z2.isna().all()
     markdown = (studies_run / "results/studies/coverage.md").read_text()
-    assert "r = 0.5: 2 runs" in markdown and markdown.count("\n| 0.") == 20
+    assert "r = 0.5: 2 runs" in markdown and markdown.count("\n| 0.") == 30
     _, provenance = read_table(
         studies_run / "results/studies/coverage/r0.333333_run1/shard3.parquet"
     )
