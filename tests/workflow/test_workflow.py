@@ -207,7 +207,7 @@ def test_the_report_has_every_figure_and_table_with_its_caption(finished_run, tm
     result = snakemake(finished_run, "--report", str(report))
     assert result.returncode == 0, result.stderr[-3000:]
     text = report.read_text()
-    for name in [*(f"fig{n}.png" for n in range(1, 12)), "moments.csv", "validation.csv"]:
+    for name in [*(f"fig{n}.png" for n in range(1, 14)), "moments.csv", "validation.csv"]:
         assert name in text, name
     for phrase in (
         "The exponents beta(r)",
