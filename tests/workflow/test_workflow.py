@@ -342,6 +342,7 @@ def test_adding_an_r_runs_only_its_jobs_and_the_aggregates(finished_run, tmp_pat
                     "flight_time",
                     "return_speed",
                     "summary",
+                    "bounce_chain",
                 )
             ),
             *(
@@ -357,7 +358,8 @@ def test_adding_an_r_runs_only_its_jobs_and_the_aggregates(finished_run, tmp_pat
                 )
             ),
             "results/fits/r0.6.parquet",
-            *(f"results/figures/fig{n}.{ext}" for n in (6, 7, 9) for ext in ("pdf", "png")),
+            *(f"results/figures/fig{n}.{ext}" for n in (6, 7, 9, 12) for ext in ("pdf", "png")),
+            "results/theory/relaxation.parquet",
             "results/tables/position_asymptotics.csv",
             "results/tables/position_asymptotics.md",
             "results/tables/moments.csv",
@@ -475,7 +477,15 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
     }
     # the merge's controls of P(0, v) and the flight moments read the return-speed law and the
     # solver's P(0, v): the merged tables and what draws them (Fig. 5 besides the solved ones)
-    solved_and_merged = {**solved, "merge_shards": 2, "fig5": 1}
+    solved_and_merged = {
+        **solved,
+        "merge_shards": 2,
+        "fig5": 1,
+        "relaxation": 1,  # lambda_2 from the solver's matrix
+        "fig12": 1,
+        "quasi_elastic": 1,  # the solver's P(0, v) near r = 1
+        "fig13": 1,
+    }
     for module, expected in (
         ("kernel", solved_and_merged),
         ("solver", solved_and_merged),

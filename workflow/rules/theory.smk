@@ -66,10 +66,7 @@ rule relaxation:
     params:
         inelasticity=config["figures"]["fig12_inelasticity"],
         simulated=[exact_string(value) for value in RESTITUTION.values()],
-        code=code(
-            ("relaxation", "solver", "asymptotics", "restitution", "bins"),
-            "relaxation.py",
-        ),
+        code=code(stages.SOLVER, "relaxation.py"),
     script:
         "../../scripts/relaxation.py"
 
