@@ -91,6 +91,8 @@ REFUSE_P = 1.0e-6
 QUANTITIES = ("mean_x", "mean_x2", "collision_rate")
 _SUMS = ("time", "collisions", "int_x", "int_x2")
 
+#: The least ratio of ``relaxation_time_bound`` to the relaxation time over r_c < r < 1.
+RELAXATION_BOUND_MARGIN = 1.04
 #: The default ``equilibration_time`` in relaxation times (``default_equilibration_time``).
 EQUILIBRATION_RELAXATION_TIMES = 20
 #: The least default ``equilibration_time``, where the relaxation time is short or undefined.
@@ -153,14 +155,16 @@ def equilibration_relaxation_time(restitution) -> float | None:
 
 
 def relaxation_time_bound(restitution) -> float:
-    """An upper bound of the relaxation time at r that needs no solve: 3 / (r - r_c) + 4 / (1 - r)^2.
+    """An upper bound of the relaxation time at r that needs no solve: 2.4 / (r - r_c) + 2.8 / (1 - r)^2.
 
     The relaxation time (``equilibration_relaxation_time``) diverges as 1.93 / (r - r_c) at
-    r_c (eq. (rc)) and as (8/3) / (1 - r)^2 at r -> 1 (docs/quasi_elastic.md); this sum of
-    the two, with margins, lies above it by a factor of at least 1.4 at every r_c < r < 1
-    (``tests/unit/test_equilibration.py`` holds it against the solver from r_c + 1e-5 to
-    0.9999, and the quasi-elastic limit beyond).  ``default_equilibration_time`` and
-    ``equilibration_problems`` solve eq. (inteq) only where the bound leaves the answer open.
+    r_c (eq. (rc)) and as (8/3) (1 - r)^-2 (1 - (1 - r)) at r -> 1 (docs/quasi_elastic.md);
+    this sum of the two, with margins, lies above it by a factor of at least
+    ``RELAXATION_BOUND_MARGIN`` at every r_c < r < 1 (``tests/unit/test_equilibration.py``
+    holds it against the solver on a grid from r_c + 1e-5 to 0.9999, and the quasi-elastic
+    form beyond), and keeps 20 of it below 1e3 up to r = 0.75.  ``default_equilibration_time``
+    and ``equilibration_problems`` solve eq. (inteq) only where the bound leaves the answer
+    open.
 
     Parameters
     ----------
@@ -181,7 +185,7 @@ def relaxation_time_bound(restitution) -> float:
     --------
     >>> from bouncing_ball.equilibration import relaxation_time_bound
     >>> print(round(relaxation_time_bound("1/2"), 3))
-    24.903
+    18.322
     """
     from .asymptotics import CRITICAL_RESTITUTION
     from .restitution import parse_restitution
@@ -189,7 +193,7 @@ def relaxation_time_bound(restitution) -> float:
     r = float(parse_restitution(restitution, "r"))
     if not r > CRITICAL_RESTITUTION:
         raise ValueError(f"r = {restitution}: at or below r_c there is no relaxation time")
-    return 3.0 / (r - CRITICAL_RESTITUTION) + 4.0 / (1.0 - r) ** 2
+    return 2.4 / (r - CRITICAL_RESTITUTION) + 2.8 / (1.0 - r) ** 2
 
 
 def _above_critical(restitution) -> bool:
