@@ -170,12 +170,9 @@ def efficiency_rows(measurements):
 
 
 def _timed_shard(arguments):
-    from bouncing_ball.equilibration import default_equilibration_time
-
     from .benchmark import _shard
 
-    r, recorded_time, shard, criterion_c = arguments
-    equilibration_time = default_equilibration_time(r)
+    r, recorded_time, equilibration_time, shard, criterion_c = arguments
     started = time.process_time()
     tallies = _shard(
         r,
@@ -193,6 +190,8 @@ def efficiency_benchmark(shards=SHARDS, shard_times=None):
     (``efficiency_rows``) with what was run."""
     from concurrent.futures import ProcessPoolExecutor
 
+    from bouncing_ball.equilibration import default_equilibration_time
+
     from .benchmark import PAPER_CRITERION_C, SHARD_SETTINGS, _shard
 
     shard_times = shard_times or SHARD_TIMES
@@ -201,8 +200,11 @@ def efficiency_benchmark(shards=SHARDS, shard_times=None):
     measurements = {}
     with ProcessPoolExecutor(2) as pool:
         for r, recorded_time in shard_times.items():
+            equilibration_time = default_equilibration_time(r)  # a solve: once per r, here
             for estimator, criterion_c in criteria.items():
-                jobs = [(r, recorded_time, k, criterion_c) for k in range(shards)]
+                jobs = [
+                    (r, recorded_time, equilibration_time, k, criterion_c) for k in range(shards)
+                ]
                 results = list(pool.map(_timed_shard, jobs))
                 tallies = [t for t, _ in results]
                 measurements[(estimator, r)] = {

@@ -610,11 +610,15 @@ COLUMN_DIMENSIONS = {
 }
 
 
+def _estimated_quantity(column: str) -> str:
+    """The quantity a table's ``column`` estimates: the column without its estimator's suffix
+    (``_martingale``, ``_controlled``) and its error's (``_err``)."""
+    return column.removesuffix("_err").removesuffix("_controlled").removesuffix("_martingale")
+
+
 def _column_dimension(column: str):
     """The dimension of a table's ``column`` (``COLUMN_DIMENSIONS``), None if it has none."""
-    return COLUMN_DIMENSIONS.get(
-        column.removesuffix("_err").removesuffix("_controlled").removesuffix("_martingale")
-    )
+    return COLUMN_DIMENSIONS.get(_estimated_quantity(column))
 
 
 def _in_units(table, units):
@@ -649,7 +653,7 @@ RESULT_KIND = "SimulationResult"
 def _summary_scalar(column):
     """A read-only attribute: ``column`` of ``summary_table``'s one row, as a float; its
     docstring says which scalar of ``SCALARS`` it is and which estimate."""
-    name = column.removesuffix("_err").removesuffix("_controlled").removesuffix("_martingale")
+    name = _estimated_quantity(column)
     symbol, what = SCALARS[name]
     if column == name:
         doc = f"{symbol}, {what}: the shards' estimate."
@@ -925,27 +929,10 @@ class SimulationResult:
         rows = []
         for name, (symbol, _) in SCALARS.items():
             rows.append((name, symbol, "plain", row[name], row[f"{name}_err"], shards - 1))
-            if f"{name}_martingale" in row:
-                rows.append(
-                    (
-                        name,
-                        symbol,
-                        "martingale",
-                        row[f"{name}_martingale"],
-                        row[f"{name}_martingale_err"],
-                        shards - 1 - int(row["control_variates"]),
-                    )
-                )
-            rows.append(
-                (
-                    name,
-                    symbol,
-                    "controlled",
-                    row[f"{name}_controlled"],
-                    row[f"{name}_controlled_err"],
-                    shards - 1 - int(row["control_variates"]),
-                )
-            )
+            for estimator in ("martingale", "controlled"):
+                column = f"{name}_{estimator}"
+                dof = shards - 1 - int(row["control_variates"])
+                rows.append((name, symbol, estimator, row[column], row[f"{column}_err"], dof))
         decay = self.bounce_chain_decay
         rows.append(
             (
