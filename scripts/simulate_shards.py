@@ -1,6 +1,6 @@
-"""Rules simulate_shards and study_shard: a batch of shards of one r, the paper's Sec. IV, each
+"""Rules simulate_shards and study_batch: a batch of shards of one r, the paper's Sec. IV, each
 shard on its own random stream -> results/simulation/r{r}/shards{first}-{last}.parquet (or
-results/studies/{study}/{run}/shard{k}.parquet, a batch of one shard)."""
+results/studies/{study}/{run}/shards{first}-{last}.parquet)."""
 
 import logging
 import time

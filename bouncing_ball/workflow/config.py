@@ -555,7 +555,8 @@ def exact_settings(config: dict) -> dict:
 @dataclass(frozen=True)
 class StudyRun:
     """One run of a study: shards of one r with one c and seed, filed under
-    results/studies/{study}/{run}/shard{k}.parquet."""
+    results/studies/{study}/{run}/shards{first}-{last}.parquet (batches of
+    ``simulation.shards_per_job`` shards)."""
 
     study: str
     run: str

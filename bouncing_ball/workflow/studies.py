@@ -15,7 +15,8 @@ per moment and estimator (plain, controlled) the scatter of the runs' z against 
 with n - 1 degrees of freedom: whether the jackknife errors are honest.
 """
 
-from itertools import islice
+from itertools import groupby
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -29,23 +30,30 @@ from .shards import read_shards
 
 
 def read_runs(paths, runs) -> dict:
-    """{run name: (shards, provenances)} of a report's input: ``paths`` in the order of
-    ``runs`` (the rule's ``params.runs``: dicts with ``run``, ``r_label`` and ``shards``, the
-    number of files of that run).  Each run's shards are checked by ``shards.read_shards``."""
+    """{run name: (shards, provenances)} of a report's input: the batch files ``paths``,
+    run by run in the order of ``runs`` (the rule's ``params.runs``: dicts with ``run``,
+    ``r_label`` and ``shards``).  Each run's shards are checked by ``shards.read_shards``."""
     return {run["run"]: read for run, read in iter_runs(paths, runs)}
 
 
 def iter_runs(paths, runs):
     """``read_runs`` one run at a time: (run, (shards, provenances)) in the order of
-    ``runs``, each run read when asked for (a report of many runs holds one in memory)."""
-    paths = list(paths)
-    if len(paths) != sum(run["shards"] for run in runs):
-        raise ValueError(
-            f"{len(paths)} shard files for {sum(run['shards'] for run in runs)} shards of the runs"
-        )
+    ``runs``, each run read when asked for (a report of many runs holds one in memory).  A
+    run's files are those in its directory, results/studies/{study}/{run}/; ValueError unless
+    the files are in the order of ``runs`` and hold the shards each run names."""
+    paths = [Path(path) for path in paths]
+    names = [run["run"] for run in runs]
+    order = [name for name, _ in groupby(path.parent.name for path in paths)]
+    if order != names:
+        raise ValueError(f"the batch files are of the runs {order}, not of {names} in that order")
     files = iter(paths)
-    for run in runs:
-        yield run, read_shards(list(islice(files, run["shards"])), run["r_label"])
+    for run, (_, group) in zip(runs, groupby(files, key=lambda path: path.parent.name)):
+        shards, provenances = read_shards(list(group), run["r_label"])
+        if len(shards) != run["shards"]:
+            raise ValueError(
+                f"run {run['run']}: {len(shards)} shards in its files, not {run['shards']}"
+            )
+        yield run, (shards, provenances)
 
 
 def cpu_seconds(provenances) -> float:

@@ -39,16 +39,15 @@ def test_the_profile_names_only_options_snakemake_and_the_slurm_plugin_know():
     assert profile["slurm-init-seconds-before-status-checks"] > 0
 
 
-def test_study_shards_are_grouped_and_a_group_asks_for_one_core():
-    """The pipeline's shards come in batches, one job each (simulation.shards_per_job); the
-    studies' shards, one job each, are grouped."""
+def test_shards_come_in_batches_and_a_job_asks_for_one_core():
+    """The pipeline's and the studies' shards come in batches, one job each
+    (simulation.shards_per_job): no rule is grouped, and every job is single-threaded."""
     profile = yaml.safe_load(PROFILE.read_text())
-    groups = dict(item.split("=") for item in profile["group-components"])
-    assert int(groups["shards"]) >= 2
+    assert "group-components" not in profile
     blocks = rule_blocks()
-    grouped = [name for name, body in blocks.items() if re.search(r'group:\n\s+"shards"', body)]
-    assert grouped == ["study_shard"]
-    # the plugin runs a group's jobs one after the other: one core per SLURM job
+    assert not [name for name, body in blocks.items() if re.search(r"\bgroup:", body)]
+    batched = {"simulate_shards", "study_batch"}
+    assert all("shards{first}-{last}.parquet" in blocks[name] for name in batched)
     assert profile["cores"] == 1
 
 

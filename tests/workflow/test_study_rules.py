@@ -83,16 +83,17 @@ def test_criterion_bias_report_has_every_r_and_c(studies_run):
     markdown = (studies_run / "results/studies/criterion_bias.md").read_text()
     assert markdown.count("\n| 1/") == 4
     _, provenance = read_table(
-        studies_run / "results/studies/criterion_bias/r0.5_c5/shard1.parquet"
+        studies_run / "results/studies/criterion_bias/r0.5_c5/shards0-1.parquet"
     )
-    assert provenance["rule"] == "study_shard" and provenance["seed"] == 7
+    assert provenance["rule"] == "study_batch" and provenance["seed"] == 7
     assert provenance["criterion_c"] == 5.0 and provenance["shard_time"] == 2.0e3
     # the test config's equilibration_time: auto, at r = 1/2 the least, 1e3
     assert SMALL["simulation"]["equilibration_time"] == "auto"
     assert provenance["equilibration_time"] == default_equilibration_time("1/2") == 1.0e3
-    # a batch of one shard (scripts/simulate_shards.py): its cost, one entry per shard
-    assert (provenance["first_shard"], provenance["last_shard"]) == (1, 1)
-    assert len(provenance["cpu_seconds"]) == 1 and provenance["cpu_seconds"][0] > 0
+    # a batch of the test config's shards_per_job = 2 shards (scripts/simulate_shards.py): its
+    # cost, one entry per shard
+    assert (provenance["first_shard"], provenance["last_shard"]) == (0, 1)
+    assert len(provenance["cpu_seconds"]) == 2 and min(provenance["cpu_seconds"]) > 0
 
 
 def test_r075_report_compares_every_run_and_all_with_the_solver(studies_run):
@@ -139,7 +140,7 @@ def test_coverage_report_scatters_every_moment_and_estimator_against_students_t(
     markdown = (studies_run / "results/studies/coverage.md").read_text()
     assert "r = 0.5: 2 runs" in markdown and markdown.count("\n| 0.") == 30
     _, provenance = read_table(
-        studies_run / "results/studies/coverage/r0.333333_run1/shard3.parquet"
+        studies_run / "results/studies/coverage/r0.333333_run1/shards2-3.parquet"
     )
     assert provenance["seed"] == 4 and provenance["r_label"] == "0.333333"
 
@@ -149,7 +150,7 @@ def test_the_studies_are_not_part_of_the_default_target(tmp_path):
     jobs = planned_jobs(directory)
     assert "simulate_shards" in jobs
     reports = {"criterion_bias_report", "r075_report", "coverage_report"}
-    assert not {"study_shard", "studies", *reports} & set(jobs)
+    assert not {"study_batch", "studies", *reports} & set(jobs)
 
 
 @pytest.mark.parametrize(

@@ -3,7 +3,12 @@
 # run with  snakemake --cores 2 studies
 from snakemake.exceptions import WorkflowError
 
-from bouncing_ball.workflow.config import check_types, read_yaml, study_runs
+from bouncing_ball.workflow.config import (
+    batch_ranges,
+    check_types,
+    read_yaml,
+    study_runs,
+)
 
 STUDIES_FILE = "config/studies.yaml"
 try:
@@ -23,15 +28,23 @@ except ValueError as error:
 R075_LABEL = restitution_label(parse_restitution(STUDIES["r075"]["restitution"]))
 
 
-# per study: every shard of every run, run by run, and what its report is told about the
-# runs, in the same order
-STUDY_SHARDS = {
-    study: [
-        f"results/studies/{study}/{name}/shard{shard}.parquet"
+# per study: the batch files of every run, run by run (batches of simulation.shards_per_job
+# shards, as the pipeline's), and what its report is told about the runs, in the same order
+STUDY_BATCHES = {
+    study: {
+        name: [
+            f"results/studies/{study}/{name}/shards{first}-{last}.parquet"
+            for first, last in batch_ranges(
+                run.shards, int(config["simulation"]["shards_per_job"])
+            )
+        ]
         for name, run in runs.items()
-        for shard in range(run.shards)
-    ]
+    }
     for study, runs in STUDY_RUNS.items()
+}
+STUDY_SHARDS = {
+    study: [path for paths in batches.values() for path in paths]
+    for study, batches in STUDY_BATCHES.items()
 }
 STUDY_RUN_TABLES = {
     study: [run.as_mapping() for run in runs.values()]
@@ -42,28 +55,41 @@ STUDY_TARGETS = expand(
 )
 
 
-rule study_shard:
+def study_batch_shards(wildcards):
+    """The shards of a study's batch file, shards{first}-{last}: first to last, both
+    included; refused unless it is a batch of the run (``STUDY_BATCHES``)."""
+    path = (
+        f"results/studies/{wildcards.study}/{wildcards.run}/"
+        f"shards{wildcards.first}-{wildcards.last}.parquet"
+    )
+    batches = STUDY_BATCHES[wildcards.study].get(wildcards.run)
+    if batches is None or path not in batches:
+        raise ValueError(
+            f"{path}: not a batch of a run of config/studies.yaml (simulation.shards_per_job "
+            "of the config)"
+        )
+    return list(range(int(wildcards.first), int(wildcards.last) + 1))
+
+
+rule study_batch:
     output:
-        "results/studies/{study}/{run}/shard{shard}.parquet",
+        "results/studies/{study}/{run}/shards{first}-{last}.parquet",
     log:
-        "logs/studies/{study}/{run}/shard{shard}.log",
+        "logs/studies/{study}/{run}/shards{first}-{last}.log",
     wildcard_constraints:
         study="|".join(STUDY_RUNS),
         run=r"[^/]+",
-    # one shard per job; several per SLURM job
-    # (profiles/slurm: group-components)
-    group:
-        "shards"
     conda:
         "../envs/bouncing-ball.yaml"
-    # minutes: an upper bound on a study shard (its CPU: python -m benchmarks, config/studies.yaml)
+    # minutes: an upper bound on a study shard (its CPU: python -m benchmarks, config/studies.yaml),
+    # per shard of the batch
     resources:
-        runtime=20,
+        runtime=lambda wildcards: 20 * len(study_batch_shards(wildcards)),
         mem_mb=500,
         cpus_per_task=1,
     params:
         restitution=lambda w: exact_string(STUDY_RUNS[w.study][w.run].restitution),
-        shards=lambda w: [int(w.shard)],  # a batch of one (scripts/simulate_shards.py)
+        shards=study_batch_shards,
         seed=lambda w: STUDY_RUNS[w.study][w.run].seed,
         settings=lambda w: STUDY_RUNS[w.study][w.run].settings.as_mapping(),
         code=SHARD_CODE,
