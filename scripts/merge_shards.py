@@ -7,13 +7,7 @@ bounce_chain}.parquet.  Refused where the shards' early parts disagree with the 
 
 import logging
 
-from bouncing_ball.equilibration import (
-    early_check,
-    early_check_message,
-    early_check_record,
-    relaxation_record,
-)
-from bouncing_ball.histograms import (
+from bouncing_ball.estimators import (
     bounce_autocorrelation,
     bounce_chain_decay,
     distribution_histogram,
@@ -25,6 +19,12 @@ from bouncing_ball.histograms import (
 )
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 from bouncing_ball.settings import ShardSettings
+from bouncing_ball.simulation.equilibration import (
+    early_check,
+    early_check_message,
+    early_check_record,
+    relaxation_record,
+)
 from bouncing_ball.workflow.io import write_tables
 from bouncing_ball.workflow.jobs import job_log
 from bouncing_ball.workflow.shards import read_shards

@@ -436,15 +436,15 @@ def known_restitutions(config: dict) -> dict[str, Fraction]:
 
 
 #: ``simulation.equilibration_time`` (or an override's) that follows from the relaxation time
-#: at each r: ``equilibration.default_equilibration_time``
+#: at each r: ``simulation.equilibration.default_equilibration_time``
 AUTO_EQUILIBRATION = "auto"
 
 
 def simulation_settings(config: dict, label: str) -> dict:
     """The simulation parameters of one r: the defaults with its overrides applied, and
-    ``equilibration_time: auto`` replaced by ``equilibration.default_equilibration_time`` at
+    ``equilibration_time: auto`` replaced by ``simulation.equilibration.default_equilibration_time`` at
     that r (the r of ``restitution`` or the figures with that label; for the label "", which
-    no r has, by ``equilibration.MIN_EQUILIBRATION_TIME``)."""
+    no r has, by ``simulation.equilibration.MIN_EQUILIBRATION_TIME``)."""
     simulation = config["simulation"]
     settings = {"min_step_floor": 0.0}  # optional key: the paper's rule alone
     settings.update({k: v for k, v in simulation.items() if k != "per_restitution"})
@@ -454,7 +454,7 @@ def simulation_settings(config: dict, label: str) -> dict:
     if settings["equilibration_time"] == AUTO_EQUILIBRATION:
         # imported here: the relaxation time needs the solver (scipy, numba), which importing
         # this module does not load
-        from ..equilibration import MIN_EQUILIBRATION_TIME, default_equilibration_time
+        from ..simulation.equilibration import MIN_EQUILIBRATION_TIME, default_equilibration_time
 
         settings["equilibration_time"] = (
             default_equilibration_time(_restitution_of_label(config, label))
@@ -483,8 +483,8 @@ def _restitution_of_label(config: dict, label: str) -> Fraction:
 def check_equilibration(config: dict) -> None:
     """Refuse, naming r, the relaxation time and the key, a simulated r whose shards
     (``simulation_settings``) are too short for the relaxation time there
-    (``equilibration.equilibration_problems``), before any job runs."""
-    from ..equilibration import equilibration_problems
+    (``simulation.equilibration.equilibration_problems``), before any job runs."""
+    from ..simulation.equilibration import equilibration_problems
 
     for label, exact in known_restitutions(config).items():
         settings = simulation_settings(config, label)

@@ -6,7 +6,7 @@ import logging
 
 import pandas as pd
 
-from bouncing_ball.histograms import position_moments_summary
+from bouncing_ball.estimators import position_moments_summary
 from bouncing_ball.restitution import parse_restitution
 from bouncing_ball.workflow.io import write_csv_and_markdown
 from bouncing_ball.workflow.jobs import job_log

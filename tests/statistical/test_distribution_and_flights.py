@@ -15,8 +15,8 @@ from shard_statistics import simulate_shards
 
 from bouncing_ball import exact
 from bouncing_ball.bins import LinearBins
-from bouncing_ball.comparison import sign_flip_test
-from bouncing_ball.histograms import position_moments_summary
+from bouncing_ball.estimators import position_moments_summary
+from bouncing_ball.validation import sign_flip_test
 
 R = Fraction(1, 2)
 SHARDS = 16

@@ -27,8 +27,8 @@ import pytest
 from solver_runs import MINIMUM_COUNT, SHARDS, assert_agrees, shards
 
 from bouncing_ball import flight_time, solver
-from bouncing_ball.comparison import sign_flip_test
-from bouncing_ball.histograms import position_moments_summary
+from bouncing_ball.estimators import position_moments_summary
+from bouncing_ball.validation import sign_flip_test
 
 RESTITUTIONS = [0.25, Fraction(1, 3), Fraction(1, 2), 0.75]
 

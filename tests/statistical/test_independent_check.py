@@ -26,10 +26,10 @@ import pytest
 from exact_results import TIME_AVERAGES
 from shard_statistics import DEFAULT_SETTINGS
 
-from bouncing_ball.comparison import outgoing_speed_checks, shard_ratios
-from bouncing_ball.histograms import outgoing_speed_histogram, position_moments_summary
+from bouncing_ball.estimators import outgoing_speed_histogram, position_moments_summary
 from bouncing_ball.settings import MIN_CRITERION_C
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
+from bouncing_ball.validation import outgoing_speed_checks, shard_ratios
 
 HALF = Fraction(1, 2)
 SHARDS = 64  # as the default run: all of MOMENT_CONTROLS and the flight-law controls

@@ -1,5 +1,5 @@
 """The control variates of the moments at r = 1/2 (tallies.MOMENT_CONTROL_SUMS, corrected
-by histograms.position_moments_summary): every sum has mean 0 under the simulated process,
+by estimators.position_moments_summary): every sum has mean 0 under the simulated process,
 and the corrected <x>, Delta x, I and <T> agree with the exact values of eq. (xandDeltax)
 (<T> = 1 / I), <T^2> with the solver's, each with a smaller error than the plain estimate.
 
@@ -15,7 +15,7 @@ from exact_results import TIME_AVERAGES
 from shard_statistics import simulate_shards
 
 from bouncing_ball import flight_time, solver
-from bouncing_ball.histograms import position_moments_summary
+from bouncing_ball.estimators import position_moments_summary
 from bouncing_ball.tallies import MOMENT_CONTROL_SUMS, MOMENT_CONTROLS, SHARDS_PER_CONTROL
 
 R = Fraction(1, 2)

@@ -14,12 +14,12 @@ from exact_results import TIME_AVERAGES
 from shard_statistics import CRITERION_C, outgoing_speed_bins, simulate_shards
 
 from bouncing_ball import exact
-from bouncing_ball.comparison import sign_flip_test
-from bouncing_ball.histograms import (
+from bouncing_ball.estimators import (
     outgoing_speed_histogram,
     position_histogram,
     position_moments_summary,
 )
+from bouncing_ball.validation import sign_flip_test
 
 SHARDS = 16
 SHARD_TIME = {Fraction(1, 2): 4.0e5, Fraction(1, 3): 7.0e5}
@@ -56,7 +56,7 @@ def test_moments_match_exact_values(shards, r, quantity):
 @pytest.mark.parametrize("r", list(TIME_AVERAGES), ids=str)
 def test_collision_rate_with_control_variates_matches_exact_value(shards, r):
     """I corrected by the martingale control variates (the summary's
-    collision_rate_controlled, histograms.control_variate_rate): the exact value within 3
+    collision_rate_controlled, estimators.control_variate_rate): the exact value within 3
     errors, an error smaller than the plain estimator's, at each c.  Smallest error rejected:
     0.6% (relative error at most 0.15%, asserted; z = 4)."""
     summary = position_moments_summary(shards[r], float(r)).iloc[0]
@@ -106,7 +106,7 @@ def test_outgoing_speed_density_rejects_a_small_error(shards, r):
 @pytest.mark.parametrize("r", list(TIME_AVERAGES), ids=str)
 def test_outgoing_speed_density_with_the_return_law_control(shards, r):
     """P(0, v) corrected by its return-law control (``p0v_controlled``,
-    histograms.return_law_prediction, which uses eq. (kernel3) and the solver's P(0, u) only
+    estimators.return_law_prediction, which uses eq. (kernel3) and the solver's P(0, u) only
     to weigh u inside a fine bin) against eq. (P(0,v)) in every bin with 0.01 <= v <= 5:
     every |z| < 5 (with 16 shards z is t-distributed with 15 degrees of freedom: a false
     alarm in about 0.5% of runs over 27 bins), and the worst relative error at most half

@@ -11,8 +11,8 @@ from shard_statistics import outgoing_speed_bins, simulate_shards
 
 from bouncing_ball import fits, solver
 from bouncing_ball.bins import outgoing_speed_bin_average
-from bouncing_ball.comparison import sign_flip_test
-from bouncing_ball.histograms import outgoing_speed_histogram, position_moments_summary
+from bouncing_ball.estimators import outgoing_speed_histogram, position_moments_summary
+from bouncing_ball.validation import sign_flip_test
 
 SHARDS = 16
 SHARD_TIME = {0.25: 3.0e5, 0.75: 3.0e6}

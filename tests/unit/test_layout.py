@@ -23,9 +23,6 @@ PHYSICS_FILES = sorted(
 #: The most lines a module of the package may hold: a module past it is split along its seams
 #: into a subpackage (as distribution/ and flight_time/ are).
 LARGEST_MODULE = 1100
-#: The modules still past LARGEST_MODULE: each is to be split along its seams, as
-#: distribution/ and flight_time/ are, and then leaves the list.
-TO_SPLIT = {"equilibrium.py", "comparison.py", "histograms.py", "simulation.py", "monte_carlo.py"}
 
 
 def _dotted(file: str) -> str:
@@ -101,19 +98,13 @@ def test_the_library_does_not_import_the_workflow(file):
 
 def test_no_module_is_past_the_largest_size():
     """Every module of the package (the workflow's and the subpackages' included) holds at most
-    LARGEST_MODULE lines, but those of TO_SPLIT; a module of TO_SPLIT is still past it."""
+    LARGEST_MODULE lines."""
     lines = {
         path.relative_to(bouncing_ball.PACKAGE).as_posix(): len(path.read_text().splitlines())
         for path in bouncing_ball.PACKAGE.rglob("*.py")
     }
-    too_large = {
-        file: count
-        for file, count in lines.items()
-        if count > LARGEST_MODULE and file not in TO_SPLIT
-    }
+    too_large = {file: count for file, count in lines.items() if count > LARGEST_MODULE}
     assert not too_large, f"split these along their seams (at most {LARGEST_MODULE}): {too_large}"
-    done = {file for file in TO_SPLIT if lines.get(file, 0) <= LARGEST_MODULE}
-    assert not done, f"split or small enough: drop {sorted(done)} from TO_SPLIT"
 
 
 def test_public_api_is_the_top_level():
@@ -126,18 +117,21 @@ def test_public_api_is_the_top_level():
 
 def test_the_simulation_stage_names_every_module_the_shard_loop_compiles():
     """An edit of any module numba compiles for the shard loop must re-run the shards: the
-    simulation stage's sources hold simulation.py and every compiled module it imports."""
+    simulation stage's sources hold the loop (simulation/loop.py) and every compiled module it
+    imports, of the simulation subpackage and of the package."""
     from bouncing_ball import jit
     from bouncing_ball.workflow import stages
 
-    tree = ast.parse((bouncing_ball.PACKAGE / "simulation.py").read_text())
-    imported = {
-        node.module.split(".")[0]
-        for node in ast.walk(tree)
-        if isinstance(node, ast.ImportFrom) and node.level == 1 and node.module
-    }
-    loop = ({"simulation"} | imported) & set(jit.COMPILED)
-    assert {"free_flight", "pcg64", "simulation", "tallies"} <= loop
+    tree = ast.parse((bouncing_ball.PACKAGE / "simulation" / "loop.py").read_text())
+    imported = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module:
+            if node.level == 1:
+                imported.add(f"simulation.{node.module}")
+            elif node.level == 2:
+                imported.add(node.module)
+    loop = ({"simulation.loop"} | imported) & set(jit.COMPILED)
+    assert {"free_flight", "pcg64", "simulation.loop", "simulation.step_tallies", "tallies"} <= loop
     assert loop <= set(stages.SIMULATION)
 
 

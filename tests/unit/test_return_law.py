@@ -1,4 +1,4 @@
-"""The return-law prediction of P(0, v) (``histograms.return_law_prediction``) against the
+"""The return-law prediction of P(0, v) (``estimators.return_law_prediction``) against the
 exact solutions: fed the exact equilibrium's outgoing speeds, it gives back the exact
 collisions per speed bin, eq. (inteq) being the balance it rests on."""
 
@@ -10,7 +10,7 @@ import pytest
 from scipy import integrate
 
 from bouncing_ball import exact
-from bouncing_ball.histograms import return_law_prediction
+from bouncing_ball.estimators import return_law_prediction
 from bouncing_ball.settings import RETURN_LAW_SPEED_BINS, ShardSettings
 from bouncing_ball.tallies import ShardTallies
 
@@ -88,7 +88,7 @@ def test_equilibrium_outgoing_speeds_predict_the_flight_moments(r):
     time between collisions 1 / I of eq. (xandDeltax) (3 at r = 1/2, 4/3 at r = 1/3) and
     the solver's <T^2>, per flight, to 1e-6 (a wrong E[T | u] is off by percents)."""
     from bouncing_ball import flight_time, solver
-    from bouncing_ball.histograms import flight_law_prediction
+    from bouncing_ball.estimators import flight_law_prediction
 
     def density(u):
         return exact.outgoing_speed_density(u, r)

@@ -23,7 +23,7 @@ from workflow_support import (
     snakemake,
 )
 
-from bouncing_ball.comparison import MOMENT_COLUMNS, VALIDATION_CHECKS, VALIDATION_COLUMNS
+from bouncing_ball.validation import MOMENT_COLUMNS, VALIDATION_CHECKS, VALIDATION_COLUMNS
 from bouncing_ball.workflow.config import check_config, read_yaml
 from bouncing_ball.workflow.io import read_table
 
@@ -447,7 +447,7 @@ def _packagecopy_repository(tmp_path):
 def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
     package, env = _packagecopy_repository(tmp_path)
     assert planned_jobs(finished_run, env) == {}
-    with open(package / "histograms.py", "a") as handle:
+    with open(package / "estimators" / "histograms.py", "a") as handle:
         handle.write("\n# an edit\n")
     # everything drawn from the simulation
     downstream = {"fig4": 1, "fig5": 1, "fig8": 1, "fig10": 1, "fig11": 1, **AGGREGATES}

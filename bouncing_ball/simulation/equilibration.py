@@ -5,7 +5,7 @@ Every shard starts at rest one unit above the floor and discards ``equilibration
 before it records.  Where the process relaxes more slowly than that (near r -> 1 the ball
 loses a fraction 1 - r^2 of its energy per bounce, and the collisions grow rare), every
 shard records part of the same transient: <x>, Delta x and I are biased alike in every
-shard, and the errors from their scatter (``histograms.jackknife``) do not see it.  Comparing
+shard, and the errors from their scatter (``estimators.jackknife``) do not see it.  Comparing
 the shards with each other, or batches of shards with the jackknife, cannot catch it either,
 since the shards are independent and share the bias.  What can see it is time within each
 shard: in equilibrium the early part of a recording (its first ``tallies.EARLY_FRACTION``,
@@ -58,8 +58,8 @@ import numpy as np
 import pandas as pd
 from scipy import special  # not scipy.stats, the slowest of scipy to import, in every merge
 
-from .histograms import deviations_from_mean
-from .tallies import EARLY_FRACTION, ShardTallies
+from ..estimators import deviations_from_mean
+from ..tallies import EARLY_FRACTION, ShardTallies
 
 __all__ = [
     "early_check",
@@ -131,7 +131,7 @@ def equilibration_relaxation_time(restitution) -> float | None:
 
     Examples
     --------
-    >>> from bouncing_ball.equilibration import equilibration_relaxation_time
+    >>> from bouncing_ball.simulation.equilibration import equilibration_relaxation_time
     >>> print(round(equilibration_relaxation_time("1/2"), 4))
     14.6093
     >>> print(equilibration_relaxation_time(0.1))
@@ -139,17 +139,17 @@ def equilibration_relaxation_time(restitution) -> float | None:
     >>> print(f"{equilibration_relaxation_time(0.99999):.4g}")
     2.667e+10
     """
-    from .asymptotics import CRITICAL_RESTITUTION
-    from .restitution import SOLVER_RESTITUTION_RANGE, parse_restitution
+    from ..asymptotics import CRITICAL_RESTITUTION
+    from ..restitution import SOLVER_RESTITUTION_RANGE, parse_restitution
 
     exact = parse_restitution(restitution, "r")
     if exact <= CRITICAL_RESTITUTION:
         return None
     if exact > SOLVER_RESTITUTION_RANGE[1]:
-        from .quasi_elastic import quasi_elastic_form
+        from ..quasi_elastic import quasi_elastic_form
 
         return quasi_elastic_form("bounce_chain_time", exact)
-    from .equilibrium import Equilibrium
+    from ..equilibrium import Equilibrium
 
     return float(Equilibrium(exact).relaxation_time)
 
@@ -183,12 +183,12 @@ def relaxation_time_bound(restitution) -> float:
 
     Examples
     --------
-    >>> from bouncing_ball.equilibration import relaxation_time_bound
+    >>> from bouncing_ball.simulation.equilibration import relaxation_time_bound
     >>> print(round(relaxation_time_bound("1/2"), 3))
     18.322
     """
-    from .asymptotics import CRITICAL_RESTITUTION
-    from .restitution import parse_restitution
+    from ..asymptotics import CRITICAL_RESTITUTION
+    from ..restitution import parse_restitution
 
     r = float(parse_restitution(restitution, "r"))
     if not r > CRITICAL_RESTITUTION:
@@ -197,8 +197,8 @@ def relaxation_time_bound(restitution) -> float:
 
 
 def _above_critical(restitution) -> bool:
-    from .asymptotics import CRITICAL_RESTITUTION
-    from .restitution import parse_restitution
+    from ..asymptotics import CRITICAL_RESTITUTION
+    from ..restitution import parse_restitution
 
     return parse_restitution(restitution, "r") > CRITICAL_RESTITUTION
 
@@ -221,7 +221,7 @@ def default_equilibration_time(restitution) -> float:
 
     Examples
     --------
-    >>> from bouncing_ball.equilibration import default_equilibration_time
+    >>> from bouncing_ball.simulation.equilibration import default_equilibration_time
     >>> default_equilibration_time("1/2"), default_equilibration_time(0.1)
     (1000.0, 1000.0)
     >>> default_equilibration_time(0.95), default_equilibration_time(0.99)
@@ -271,7 +271,7 @@ def equilibration_problems(
 
     Examples
     --------
-    >>> from bouncing_ball.equilibration import equilibration_problems
+    >>> from bouncing_ball.simulation.equilibration import equilibration_problems
     >>> equilibration_problems("1/2", 2e3, 1e3)
     []
     >>> for problem in equilibration_problems(0.95, 2e3, 50.0):
@@ -279,7 +279,7 @@ def equilibration_problems(
     r = 0.95: equilibration_time = 50 is shorter than 20 relaxation times (1016.13 each): ...
     r = 0.95: shard_time = 2000 is shorter than 8 relaxation times (1016.13 each): ...
     """
-    from .restitution import parse_restitution, restitution_label
+    from ..restitution import parse_restitution, restitution_label
 
     if not _above_critical(restitution):
         return []
@@ -348,7 +348,7 @@ def relaxation_record(restitution, shard_time: float, equilibration_time: float)
 
     Examples
     --------
-    >>> from bouncing_ball.equilibration import relaxation_record
+    >>> from bouncing_ball.simulation.equilibration import relaxation_record
     >>> record = relaxation_record("1/2", 2e3, 1e3)
     >>> round(record["shard_relaxation_times"], 1), record["problems"]
     (136.9, [])
@@ -386,7 +386,7 @@ def window_estimates(shards: list[ShardTallies]) -> pd.DataFrame:
     Examples
     --------
     >>> from types import SimpleNamespace
-    >>> from bouncing_ball.equilibration import window_estimates
+    >>> from bouncing_ball.simulation.equilibration import window_estimates
     >>> shard = SimpleNamespace(
     ...     time=10.0, collisions=5, int_x=20.0, int_x2=80.0,
     ...     early_time=2.0, early_collisions=1, early_int_x=4.0, early_int_x2=16.0,
@@ -436,7 +436,7 @@ def early_check(
     Three shards whose early parts agree with the rest within their scatter:
 
     >>> from types import SimpleNamespace
-    >>> from bouncing_ball.equilibration import early_check
+    >>> from bouncing_ball.simulation.equilibration import early_check
     >>> def shard(early_x, rest_x):
     ...     return SimpleNamespace(
     ...         time=10.0, collisions=5, int_x=2.0 * early_x + 8.0 * rest_x, int_x2=80.0,
@@ -633,7 +633,7 @@ def early_check_power(
     it shifts that part by 10.4 standard errors, which biases the final estimate by 1.3,
     and refuses at 2.04:
 
-    >>> from bouncing_ball.equilibration import REFUSE_P, early_check_power
+    >>> from bouncing_ball.simulation.equilibration import REFUSE_P, early_check_power
     >>> warn, refuse = early_check_power(64), early_check_power(64, p=REFUSE_P)
     >>> print(round(warn["difference_error"], 3), round(warn["early_shift"], 1))
     3.024 10.4
@@ -699,7 +699,7 @@ def early_check_power_table(
 
     Examples
     --------
-    >>> from bouncing_ball.equilibration import early_check_power_table
+    >>> from bouncing_ball.simulation.equilibration import early_check_power_table
     >>> print(early_check_power_table(decays=(0.0, 1.0)).round(2).to_string(index=False))
      decay  warn_bias  refuse_bias
        0.0       1.30         2.04
