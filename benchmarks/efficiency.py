@@ -87,7 +87,14 @@ def distribution_relative_squared_errors(shards, controlled, r=None, return_law=
         position_histogram,
     )
 
-    speeds = outgoing_speed_histogram(shards, r if controlled else None, return_law)
+    theory = None  # the solver's P(0, u), for the return-law control
+    if controlled and return_law is None:
+        from bouncing_ball.solver import solved_outgoing_density
+
+        theory = solved_outgoing_density(r)
+    speeds = outgoing_speed_histogram(
+        shards, r if controlled else None, theory, return_law=return_law
+    )
     positions = position_histogram(shards)
     cells = distribution_histogram(shards)
     in_speeds = (speeds.v_lo >= SPEEDS[0]) & (speeds.v_hi <= SPEEDS[1])

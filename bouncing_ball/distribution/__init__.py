@@ -13,7 +13,7 @@ with phi of eq. (phi) at s = 1/4.  The modules, in the order they build on each 
 - ``ray_density``: P(0, v) on a ray arg v = RAY_ANGLE, solved from eq. (inteq) on that ray, for
   r near 1;
 - ``outgoing_density``: P(0, v) as w(F) needs it, on the real axis and in the wedge
-  0 <= arg v <= THETA_MAX (``outgoing_speed_solution``, ``check_restitution``);
+  0 <= arg v <= THETA_MAX (``outgoing_speed_solution``);
 - ``weight_function``: w(F) by contour integrals of h(v) (``log_weight_function``), its
   small-F law w ~ F^gamma e^(-S/F) (``small_force_decay``, ``small_force_power``);
 - ``interpolated_weight``: w(F) interpolated in ln F (``WeightFunction``), and an exact w(F) in
@@ -112,7 +112,6 @@ from .outgoing_density import (
     _outgoing_density,
     _OutgoingDensity,
     _panels,
-    check_restitution,
     outgoing_speed_solution,
 )
 from .phase_space import (
@@ -237,7 +236,6 @@ __all__ = [
     "CELL_SPEED_NODES",
     "EXPONENT_TOLERANCES",
     "DISTRIBUTION_NOISE",
-    "check_restitution",
     "outgoing_speed_solution",
     "small_force_decay",
     "small_force_power",

@@ -11,10 +11,9 @@ import numpy as np
 
 from ..restitution import (
     DISTRIBUTION_RESTITUTION_RANGE,
-    SOLVER_RESTITUTION_RANGE,
-    check_solver_restitution,
+    check_distribution_range,
+    check_solver_range,
     in_range,
-    parse_restitution,
 )
 from .base import EquilibriumBase
 from .checks import SPEED_PANEL, check_solver_settings
@@ -100,18 +99,8 @@ def _restored(cls, state):
 
 
 def _solver_restitution(r) -> Fraction:
-    """r parsed and within the solver's range; the range is named whatever is wrong with r."""
-    low, high = SOLVER_RESTITUTION_RANGE
-    try:
-        exact = parse_restitution(r, "r")
-    except ValueError as error:
-        raise ValueError(f"{error}; the solver answers {low} <= r <= {high}") from None
-    if not in_range(exact, SOLVER_RESTITUTION_RANGE):
-        raise ValueError(
-            f"r: r = {r!r} is outside the solver's range {low} <= r <= {high}, where P(0, v) of "
-            "eq. (inteq) meets its 1e-8 accuracy target (restitution.SOLVER_RESTITUTION_RANGE)"
-        )
-    return exact
+    """r parsed and within the solver's range of r."""
+    return check_solver_range(r, "r")
 
 
 class Equilibrium(EquilibriumBase):
@@ -273,7 +262,7 @@ class Equilibrium(EquilibriumBase):
     def _check_distribution(self, what: str) -> None:
         if not self.distribution_available:
             try:
-                check_solver_restitution(self.r, "r")
+                check_distribution_range(self.r, "r")
             except ValueError as error:
                 raise ValueError(
                     f"{error}: Equilibrium.{what} needs w(F) of eq. (weightfunc), computed "

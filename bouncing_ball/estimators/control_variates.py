@@ -1,11 +1,10 @@
 """Martingale control variates: the shards' noise sums, and the return-law and flight-law
 predictions, as controls that lower the variance of an estimate."""
 
-import functools
+import numbers
 
 import numpy as np
 
-from ..restitution import SOLVER_RESTITUTION_RANGE, in_range
 from ..settings import RETURN_LAW_SPEED_BINS
 from ..tallies import (
     MOMENT_CONTROLS,
@@ -108,14 +107,18 @@ def _controlled(estimator, controls, times, adjusted, fixed=()):
     return jackknife(estimator, *parts, *fixed)
 
 
-@functools.lru_cache(maxsize=8)
-def _solver_outgoing_density(exact):
-    """The solver's P(0, u) of eq. (inteq) at the exact r, or None outside its range."""
-    if not in_range(exact, SOLVER_RESTITUTION_RANGE):
-        return None
-    from ..solver import solve_outgoing_speed_density  # numba and scipy: only where solved
-
-    return solve_outgoing_speed_density(exact).outgoing_speed_density
+def _restitution_float(restitution) -> float:
+    """The shards' r as the estimators take it: parsed (a ``Fraction`` or a real number, as
+    ``restitution.parse_restitution`` returns it), in (0, 1)."""
+    if isinstance(restitution, (str, bytes, bool)) or not isinstance(restitution, numbers.Real):
+        raise TypeError(
+            f"restitution: give r as parsed (restitution.parse_restitution), a Fraction or a "
+            f"float, not {restitution!r}"
+        )
+    r = float(restitution)
+    if not 0.0 < r < 1.0:
+        raise ValueError(f"restitution: r = {restitution!r} is outside 0 < r < 1")
+    return r
 
 
 def _occupied_fine_bins(shards):

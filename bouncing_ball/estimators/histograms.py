@@ -4,7 +4,6 @@ and the return speeds."""
 import numpy as np
 import pandas as pd
 
-from ..restitution import parse_restitution
 from ..tallies import (
     RATE_CONTROLS,
     SHARDS_PER_CONTROL,
@@ -13,7 +12,7 @@ from ..tallies import (
 from .control_variates import (
     _RETURN_LAW_SHARDS,
     _controlled,
-    _solver_outgoing_density,
+    _restitution_float,
     control_variate_adjusted,
     return_law_prediction,
     shard_controls,
@@ -51,7 +50,7 @@ def outgoing_speed_density(counts, time, lower, upper):
 
 
 def outgoing_speed_histogram(
-    shards: list[ShardTallies], restitution=None, return_law=None
+    shards: list[ShardTallies], restitution=None, outgoing_density=None, return_law=None
 ) -> pd.DataFrame:
     """P(0, v) on the outgoing side, bin averages weighted by v.
 
@@ -62,14 +61,17 @@ def outgoing_speed_histogram(
     ----------
     shards : list of ShardTallies
         The shards, all on the same speed bins.
-    restitution : float, str or fractions.Fraction, optional
-        The shards' r.  Given, and inside the solver's range
-        (``restitution.SOLVER_RESTITUTION_RANGE``), each bin's counts are also corrected by
-        its return-law control variate, counts minus ``return_law_prediction`` with the
-        solver's P(0, u) of eq. (inteq).
+    restitution : fractions.Fraction or float, optional
+        The shards' r as parsed (``restitution.parse_restitution``), 0 < r < 1; needed with
+        ``outgoing_density``.
+    outgoing_density : callable, optional
+        P(0, u) of the theory the controlled column leans on, given by the caller (the
+        solver's, ``solver.solved_outgoing_density``): with it, each bin's counts are also
+        corrected by its return-law control variate, counts minus ``return_law_prediction``.
+        The estimators never solve eq. (inteq) themselves.
     return_law : numpy.ndarray, optional
         ``return_law_prediction`` of these shards, if already at hand (a row per shard): used
-        instead of computing it from ``restitution``.
+        instead of computing it from ``restitution`` and ``outgoing_density``.
 
     Returns
     -------
@@ -86,8 +88,14 @@ def outgoing_speed_histogram(
         shards).  ``p0v_controlled`` is corrected by the bin's return-law control, built
         from eq. (kernel3), the theory under test, and with enough shards the martingale
         ones too: unbiased only if the simulated process follows eq. (kernel3) (NaN
-        without ``restitution`` or ``return_law``, outside the solver's range, or with
-        fewer than 4 shards).
+        without ``outgoing_density`` or ``return_law``, or with fewer than 4 shards).
+
+    Raises
+    ------
+    ValueError
+        If ``outgoing_density`` is given without ``restitution``, or r is outside (0, 1).
+    TypeError
+        If ``restitution`` is not parsed (a string).
 
     Examples
     --------
@@ -102,11 +110,11 @@ def outgoing_speed_histogram(
         return outgoing_speed_density(c, t, lower, upper)
 
     p0v, err = jackknife(density, counts, times)
-    if return_law is None and restitution is not None and len(shards) >= _RETURN_LAW_SHARDS:
-        exact = parse_restitution(restitution)
-        solver_density = _solver_outgoing_density(exact)
-        if solver_density is not None:
-            return_law = return_law_prediction(shards, float(exact), solver_density)
+    if outgoing_density is not None and restitution is None:
+        raise ValueError("restitution: the return-law control needs r beside outgoing_density")
+    r = None if restitution is None else _restitution_float(restitution)
+    if return_law is None and outgoing_density is not None and len(shards) >= _RETURN_LAW_SHARDS:
+        return_law = return_law_prediction(shards, r, outgoing_density)
     controls = shard_controls(shards, RATE_CONTROLS)
     martingale, martingale_err = _controlled(density, controls, times[:, 0], [counts], [times])
     if return_law is None:

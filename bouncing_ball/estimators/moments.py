@@ -3,7 +3,6 @@
 import numpy as np
 import pandas as pd
 
-from ..restitution import parse_restitution
 from ..tallies import (
     ShardTallies,
     merge_shards,
@@ -11,7 +10,7 @@ from ..tallies import (
 from .control_variates import (
     _FLIGHT_LAW_SHARDS,
     _controlled,
-    _solver_outgoing_density,
+    _restitution_float,
     flight_law_prediction,
     moment_controls,
 )
@@ -53,7 +52,9 @@ def _controlled_moments(controls, time, sums, suffix):
     return columns
 
 
-def position_moments_summary(shards: list[ShardTallies], restitution: float) -> pd.DataFrame:
+def position_moments_summary(
+    shards: list[ShardTallies], restitution, outgoing_density=None
+) -> pd.DataFrame:
     """One row of moments: <x>, Delta x, the collision rate I and the flight time's moments.
 
     <x> and Delta x are eq. (xandDeltax), I eq. (collrate); the flight time T has its mean and
@@ -79,9 +80,14 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
     ----------
     shards : list of ShardTallies
         The shards.
-    restitution : float, str or fractions.Fraction
-        The restitution coefficient r of the shards, written in column ``r``; the solver's
-        P(0, u) at r weighs the fine bins of the flight-law controls.
+    restitution : fractions.Fraction or float
+        The shards' r as parsed (``restitution.parse_restitution``), 0 < r < 1, written in
+        column ``r``.
+    outgoing_density : callable, optional
+        P(0, u) of the theory the ``*_controlled`` columns lean on, given by the caller (the
+        solver's, ``solver.solved_outgoing_density``): it weighs the fine bins of the
+        flight-law controls.  Without it those controls are left out (``kernel3_controls``
+        False).  The estimators never solve eq. (inteq) themselves.
 
     Returns
     -------
@@ -93,6 +99,13 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
         ``flights``, ``total_time``, ``collisions``, ``steps``, ``shards`` and
         ``shards_out_of_budget``; ``control_variates``, the number of controls fitted to the
         shards for the ``_controlled`` values (0: none, and those are NaN).
+
+    Raises
+    ------
+    TypeError
+        If ``restitution`` is not parsed (a string).
+    ValueError
+        If r is outside (0, 1).
 
     Examples
     --------
@@ -106,9 +119,9 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
     delta_x, delta_x_err = jackknife(_delta_x, int_x, int_x2, time)
     rate, rate_err = jackknife(lambda c, t: c / t, collisions, time)
     flight_law = None
-    if len(shards) >= _FLIGHT_LAW_SHARDS:  # else too few shards to fit them
-        density = _solver_outgoing_density(parse_restitution(restitution))
-        flight_law = None if density is None else flight_law_prediction(shards, density)
+    r = _restitution_float(restitution)
+    if outgoing_density is not None and len(shards) >= _FLIGHT_LAW_SHARDS:  # else too few
+        flight_law = flight_law_prediction(shards, outgoing_density)
     flights = np.array([s.flights for s in shards], dtype=float)
     flight_time = np.array([s.flight_time_sum for s in shards])
     flight_time_squared = np.array([s.flight_time_squared_sum for s in shards])
@@ -127,7 +140,7 @@ def position_moments_summary(shards: list[ShardTallies], restitution: float) -> 
     total = merge_shards(shards)
     return pd.DataFrame(
         {
-            "r": [float(restitution)],
+            "r": [r],
             "mean_x": [float(mean_x)],
             "mean_x_err": [float(mean_x_err)],
             "delta_x": [float(delta_x)],

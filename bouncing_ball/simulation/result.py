@@ -307,11 +307,21 @@ class SimulationResult:
         return float(self.units.to_physical(float(self.merged.time), "time"))
 
     @cached_property
+    def _theory_outgoing_density(self):
+        """The solver's P(0, u) at r, which the ``*_controlled`` estimates lean on (None outside
+        the solver's range of r)."""
+        from ..solver import solved_outgoing_density
+
+        return solved_outgoing_density(self.restitution)
+
+    @cached_property
     def _summary_paper(self):
         """``summary_table`` in the paper's units."""
         from ..estimators import position_moments_summary
 
-        summary = position_moments_summary(list(self.tallies), self.r)
+        summary = position_moments_summary(
+            list(self.tallies), self.restitution, self._theory_outgoing_density
+        )
         return summary.assign(requested_shards=self.requested_shards, partial=self.partial)
 
     @cached_property
@@ -389,7 +399,9 @@ class SimulationResult:
         """``p0v_histogram`` in the paper's units."""
         from ..estimators import outgoing_speed_histogram
 
-        return outgoing_speed_histogram(list(self.tallies), self.restitution)
+        return outgoing_speed_histogram(
+            list(self.tallies), self.restitution, self._theory_outgoing_density
+        )
 
     @cached_property
     def p0v_histogram(self):

@@ -24,9 +24,9 @@ from ..equilibrium import check_solver_settings
 from ..restitution import (
     EXACT_RESTITUTIONS,
     SOLVER_RESTITUTION_RANGE,
-    check_solver_restitution,
+    check_distribution_range,
+    check_solver_range,
     exact_string,
-    in_range,
     parse_restitution,
     restitution_grid,
     restitution_label,
@@ -191,14 +191,9 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
             f"got min = {solver_grid['min']}, max = {solver_grid['max']}"
         )
     for index, value in enumerate(config["restitution"]):
-        check_solver_restitution(value, f"restitution[{index}]")  # every r of the run is solved
+        check_distribution_range(value, f"restitution[{index}]")  # every r of the run is solved
     for index, value in enumerate(config["figures"]["fig13"]):  # P(0, v) alone
-        where = f"figures.fig13[{index}]"
-        if not in_range(parse_restitution(value, where), SOLVER_RESTITUTION_RANGE):
-            raise ValueError(
-                f"{where}: r = {value!r} is outside the solver's range {low} <= r <= {high} "
-                "for P(0, v) (solver.restitution_grid)"
-            )
+        check_solver_range(value, f"figures.fig13[{index}]")
     known = {**figure_restitutions(config, grid), **grid}
     for side in ("small_speed_window", "large_speed_window"):
         window = config["fits"][side]
@@ -421,7 +416,7 @@ def figure_restitutions(config: dict, grid: dict | None = None) -> dict[str, Fra
                     f"{where}: r = {values[index]!r} has no exact solution (only 1/2 and 1/3)"
                 )
             if figure != "fig5":  # drawn with the solver's answers
-                check_solver_restitution(values[index], where)
+                check_distribution_range(values[index], where)
             for other in (grid, shown):
                 if label in other and other[label] != value:
                     raise ValueError(shared_label_message(where, value, other[label]))

@@ -19,6 +19,7 @@ from bouncing_ball.estimators import (
     position_histogram,
     position_moments_summary,
 )
+from bouncing_ball.solver import solved_outgoing_density
 from bouncing_ball.validation import sign_flip_test
 
 SHARDS = 16
@@ -45,7 +46,7 @@ def shards(request):
 def test_moments_match_exact_values(shards, r, quantity):
     """<x>, Delta x and I of eq. (xandDeltax) within 3 standard errors.  Smallest error
     rejected: 4 times MAX_RELATIVE_ERROR (asserted), 2.4% in <x>, 4% in Delta x, 1% in I."""
-    summary = position_moments_summary(shards[r], float(r)).iloc[0]
+    summary = position_moments_summary(shards[r], r, solved_outgoing_density(r)).iloc[0]
     value, error = summary[quantity], summary[f"{quantity}_err"]
     expected = TIME_AVERAGES[r][quantity]
     assert error / expected <= MAX_RELATIVE_ERROR[quantity], "run too short for a sharp test"
@@ -59,7 +60,7 @@ def test_collision_rate_with_control_variates_matches_exact_value(shards, r):
     collision_rate_controlled, estimators.control_variate_rate): the exact value within 3
     errors, an error smaller than the plain estimator's, at each c.  Smallest error rejected:
     0.6% (relative error at most 0.15%, asserted; z = 4)."""
-    summary = position_moments_summary(shards[r], float(r)).iloc[0]
+    summary = position_moments_summary(shards[r], r, solved_outgoing_density(r)).iloc[0]
     value, error = summary["collision_rate_controlled"], summary["collision_rate_controlled_err"]
     expected = TIME_AVERAGES[r]["collision_rate"]
     assert error / expected <= 0.0015, "run too short for a sharp test"
@@ -112,7 +113,7 @@ def test_outgoing_speed_density_with_the_return_law_control(shards, r):
     alarm in about 0.5% of runs over 27 bins), and the worst relative error at most half
     the plain estimator's.  Smallest error rejected: 5 times the largest relative error
     (asserted at most 1%), 5%."""
-    table = outgoing_speed_histogram(shards[r], r)
+    table = outgoing_speed_histogram(shards[r], r, solved_outgoing_density(r))
     band = table[(table.v >= 0.01) & (table.v <= 5.0)]
     truth = exact.outgoing_speed_bin_average(band.v_lo.to_numpy(), band.v_hi.to_numpy(), r)
     relative = (band.p0v_controlled_err / band.p0v_controlled).to_numpy()

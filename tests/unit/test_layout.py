@@ -107,6 +107,48 @@ def test_no_module_is_past_the_largest_size():
     assert not too_large, f"split these along their seams (at most {LARGEST_MODULE}): {too_large}"
 
 
+#: What the estimators must not import: the theory they are held against (the simulation is the
+#: independent check of it); its P(0, u) comes in as an argument (``outgoing_density``).
+THEORY = {"solver", "distribution", "equilibrium", "relaxation", "exact", "quasi_elastic"}
+
+
+def _imported_modules(source: str, depth: int) -> set[str]:
+    """The package's modules a source imports (relative or absolute, at any level of the
+    file, inside functions too), by their first dotted part below bouncing_ball."""
+    found = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.ImportFrom):
+            if node.level == depth + 1:
+                names = [node.module] if node.module else [alias.name for alias in node.names]
+                found |= {name.split(".")[0] for name in names}
+            elif node.level == 0 and (node.module or "").startswith("bouncing_ball."):
+                found.add(node.module.split(".")[1])
+            elif node.level == 0 and node.module == "bouncing_ball":
+                found |= {alias.name for alias in node.names}
+        elif isinstance(node, ast.Import):
+            found |= {
+                alias.name.split(".")[1]
+                for alias in node.names
+                if alias.name.startswith("bouncing_ball.")
+            }
+    return found
+
+
+@pytest.mark.parametrize("file", [file for file in PHYSICS_FILES if file.startswith("estimators/")])
+def test_the_estimators_do_not_import_the_theory(file):
+    source = (bouncing_ball.PACKAGE / file).read_text()
+    assert not _imported_modules(source, file.count("/")) & THEORY, file
+
+
+def test_imported_modules_sees_every_form():
+    source = (
+        "from ..solver import x\nfrom .. import distribution\n"
+        "def f():\n    from bouncing_ball.exact import y\n    import bouncing_ball.relaxation\n"
+        "from .jackknife import jackknife"
+    )
+    assert _imported_modules(source, 1) == {"solver", "distribution", "exact", "relaxation"}
+
+
 def test_public_api_is_the_top_level():
     assert {"Equilibrium", "ExactEquilibrium", "simulate", "SimulationResult"} <= set(
         bouncing_ball.__all__

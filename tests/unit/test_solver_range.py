@@ -12,7 +12,7 @@ from bouncing_ball import distribution, exact, kernel, solver
 from bouncing_ball.restitution import (
     DISTRIBUTION_RESTITUTION_RANGE,
     SOLVER_RESTITUTION_RANGE,
-    check_solver_restitution,
+    check_distribution_range,
     in_range,
 )
 
@@ -28,14 +28,14 @@ def test_the_bounds_of_a_range_are_exact_decimals():
     assert in_range(Fraction(1, 50), SOLVER_RESTITUTION_RANGE)
     assert not in_range(Fraction(1, 50) - Fraction(1, 10**12), SOLVER_RESTITUTION_RANGE)
     for bound in ("1/50", "9/10", 0.02, LOW, HIGH):
-        assert check_solver_restitution(bound) == Fraction(str(bound))
+        assert check_distribution_range(bound) == Fraction(str(bound))
 
 
 @pytest.mark.parametrize("r", [0.91, 0.95, 0.99, "199/200", 0.998, 0.999, "999/1000"])
 def test_a_run_near_one_inside_the_range_of_the_whole_distribution_is_accepted(r):
     """Up to r = 0.999 w(F) is taken along the ray of P(0, v) (bouncing_ball.distribution), and
     P(x), P(x, v) meet 1e-8 (tests/numerical/test_distribution_any_r.py)."""
-    assert check_solver_restitution(r, "restitution[0]") == Fraction(str(r))
+    assert check_distribution_range(r, "restitution[0]") == Fraction(str(r))
 
 
 @pytest.mark.parametrize("r", [0.015, "1/100", 0.9991, "1999/2000", 0.9999])
@@ -43,7 +43,7 @@ def test_a_run_outside_the_range_of_the_whole_distribution_is_refused(r):
     """Every r of a run is solved by rule solve, whose P(x) and P(x, v) hold to 1e-8 only in
     DISTRIBUTION_RESTITUTION_RANGE: outside, the refusal names the key, both ranges and why."""
     with pytest.raises(ValueError, match=rf"restitution\[0\]: r = .* {LOW} <= r <= {HIGH}.*0.9999"):
-        check_solver_restitution(r, "restitution[0]")
+        check_distribution_range(r, "restitution[0]")
 
 
 @pytest.mark.parametrize("r", [0.9995, 0.9999, 0.015])
