@@ -373,6 +373,7 @@ def distribution_benchmark():
     return-speed tables (bouncing_ball.flight_time)."""
     from bouncing_ball import distribution, flight_time, solver
     from bouncing_ball.bins import linear_grid, log_bins, log_grid
+    from bouncing_ball.workflow import solver_tables
     from bouncing_ball.workflow.config import read_config
 
     config = read_config(REPOSITORY / "config" / "config.yaml")
@@ -384,10 +385,10 @@ def distribution_benchmark():
         far = distribution.outgoing_speed_solution(r)
         weight = distribution.interpolated_weight_function(far)
         built = time.perf_counter()
-        distribution.position_table(weight, log_grid(grids["position_grid"]))
-        distribution.weight_table(weight, log_grid(grids["forces"]))
+        solver_tables.position_frame(weight, log_grid(grids["position_grid"]))
+        solver_tables.weight_frame(weight, log_grid(grids["forces"]))
         tabulated = time.perf_counter()
-        distribution.distribution_table(
+        solver_tables.distribution_frame(
             weight, far, grids["positions"], linear_grid(grids["speeds"])
         )
         joint = time.perf_counter()

@@ -22,8 +22,10 @@ with phi of eq. (phi) at s = 1/4.  The modules, in the order they build on each 
   averages of P(x) in closed form under the F integral;
 - ``phase_space``: P(x, v) by eq. (fpsol) (x > 0), and at x = 0 from P(0, v) and eq. (bc); its
   cell averages;
-- ``exponents``: the asymptotic exponents of P(x), predicted and measured;
-- ``tables``: the tables of the pipeline's rule solve and their checks.
+- ``exponents``: the asymptotic exponents of P(x), predicted and measured.
+
+The tables of the pipeline's rule solve and their checks are the workflow's
+(``bouncing_ball.workflow.solver_tables``).
 
 Every name is importable from ``bouncing_ball.distribution`` itself.
 
@@ -116,6 +118,7 @@ from .outgoing_density import (
 )
 from .phase_space import (
     CELL_SPEED_NODES,
+    DISTRIBUTION_NOISE,
     FORCE_CHECK_NODES,
     FORCE_CHECK_PHASE,
     FORCE_RULE_GRID,
@@ -176,16 +179,6 @@ from .ray_density import (
     _w,
     _x,
 )
-from .tables import (
-    DISTRIBUTION_NOISE,
-    EXPONENT_TOLERANCES,
-    _non_finite_defects,
-    check_solve_tables,
-    distribution_table,
-    position_table,
-    solve_table_defects,
-    weight_table,
-)
 from .weight_function import (
     _KERNEL_TRANSFORMS,
     _RAY_PANEL_W,
@@ -234,7 +227,6 @@ __all__ = [
     "PANEL_CHEBYSHEV_NODES",
     "NOISE_TOLERANCE",
     "CELL_SPEED_NODES",
-    "EXPONENT_TOLERANCES",
     "DISTRIBUTION_NOISE",
     "outgoing_speed_solution",
     "small_force_decay",
@@ -256,12 +248,7 @@ __all__ = [
     "distribution_cell_average",
     "distribution_with_error",
     "distribution",
-    "weight_table",
-    "position_table",
-    "distribution_table",
     "predicted_exponents",
     "measured_exponents",
     "exponents_table",
-    "solve_table_defects",
-    "check_solve_tables",
 ]
