@@ -177,11 +177,11 @@ def efficiency_rows(measurements):
 
 
 def _timed_shard(arguments):
-    from .benchmark import _shard
+    from .shards import run_shard
 
     r, recorded_time, equilibration_time, shard, criterion_c = arguments
     started = time.process_time()
-    tallies = _shard(
+    tallies = run_shard(
         r,
         recorded_time,
         shard=shard,
@@ -199,11 +199,11 @@ def efficiency_benchmark(shards=SHARDS, shard_times=None):
 
     from bouncing_ball.simulation.equilibration import default_equilibration_time
 
-    from .benchmark import PAPER_CRITERION_C, SHARD_SETTINGS, _shard
+    from .shards import PAPER_CRITERION_C, SHARD_SETTINGS, run_shard
 
     shard_times = shard_times or SHARD_TIMES
     criteria = {"paper": PAPER_CRITERION_C, "default": SHARD_SETTINGS.criterion_c}
-    _shard(0.5, 10.0)  # compile or load the cache here before the pool forks
+    run_shard(0.5, 10.0)  # compile or load the cache here before the pool forks
     measurements = {}
     with ProcessPoolExecutor(2) as pool:
         for r, recorded_time in shard_times.items():

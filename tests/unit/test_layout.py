@@ -89,6 +89,19 @@ def test_imports_the_workflow_sees_every_form_in_a_subpackage(source, expected):
     assert imports_the_workflow(source, depth=1) is expected
 
 
+@pytest.mark.parametrize(
+    "source, expected",
+    [
+        ("from ...workflow.io import read_table", True),
+        ("from ... import workflow", True),
+        ("from ..workflow import io", False),  # a sibling subpackage's own workflow module
+        ("from ...solver import DEFAULT_STEP", False),
+    ],
+)
+def test_imports_the_workflow_sees_every_form_two_subpackages_deep(source, expected):
+    assert imports_the_workflow(source, depth=2) is expected
+
+
 @pytest.mark.parametrize("file", PHYSICS_FILES)
 def test_the_library_does_not_import_the_workflow(file):
     source = (bouncing_ball.PACKAGE / file).read_text()
@@ -147,6 +160,65 @@ def test_imported_modules_sees_every_form():
         "from .jackknife import jackknife"
     )
     assert _imported_modules(source, 1) == {"solver", "distribution", "exact", "relaxation"}
+
+
+BENCHMARKS = bouncing_ball.PACKAGE.parent / "benchmarks"
+
+
+def benchmark_imports(source: str) -> set[str]:
+    """The modules of ``benchmarks`` a module of it imports (relatively or as
+    ``benchmarks.x``, at its top or inside a function)."""
+    found = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.ImportFrom):
+            if node.level == 1:
+                names = [node.module] if node.module else [alias.name for alias in node.names]
+                found |= {name.split(".")[0] for name in names}
+            elif node.level == 0 and (node.module or "").startswith("benchmarks."):
+                found.add(node.module.split(".")[1])
+            elif node.level == 0 and node.module == "benchmarks":
+                found |= {alias.name for alias in node.names}
+        elif isinstance(node, ast.Import):
+            found |= {
+                alias.name.split(".")[1]
+                for alias in node.names
+                if alias.name.startswith("benchmarks.")
+            }
+    return found
+
+
+def import_cycle(graph: dict[str, set[str]]) -> list[str]:
+    """A cycle of ``graph`` (module: the modules it imports), as the modules along it, or []."""
+    state = {}  # 1: on the current path, 2: done
+
+    def visit(module, path):
+        state[module] = 1
+        for imported in sorted(graph.get(module, ())):
+            if state.get(imported) == 1:
+                return [*path[path.index(imported) :], imported]
+            if imported not in state and (cycle := visit(imported, [*path, imported])):
+                return cycle
+        state[module] = 2
+        return []
+
+    for module in sorted(graph):
+        if module not in state and (cycle := visit(module, [module])):
+            return cycle
+    return []
+
+
+def test_import_cycle_finds_a_cycle():
+    assert import_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+    assert import_cycle({"a": {"b", "c"}, "b": {"c"}, "c": set()}) == []
+    source = "from .efficiency import x\ndef f():\n    from .benchmark import _shard\n"
+    assert benchmark_imports(source) == {"efficiency", "benchmark"}
+
+
+def test_the_benchmarks_import_each_other_without_a_cycle():
+    """Each shared piece of the benchmarks has one home that the others import (a function
+    reaching back into the module that imports it is a cycle too)."""
+    graph = {path.stem: benchmark_imports(path.read_text()) for path in BENCHMARKS.glob("*.py")}
+    assert not import_cycle(graph), f"benchmarks import each other: {import_cycle(graph)}"
 
 
 def test_public_api_is_the_top_level():
