@@ -246,7 +246,7 @@ def _two_digits_up(time: float) -> float:
 
 
 def equilibration_problems(
-    restitution, shard_time: float, equilibration_time: float, where: str = ""
+    restitution, shard_time: float, equilibration_time: float, where: str = "", units=None
 ) -> list[str]:
     """What in a shard's times falls short of the relaxation time at r, one sentence each.
 
@@ -263,6 +263,9 @@ def equilibration_problems(
         The shard's settings, in the paper's time units.
     where : str, optional
         The prefix of the settings' names in the messages (e.g. ``"simulation."``).
+    units : units.PhysicalUnits, optional
+        The units the messages quote every time in (those the user gave ``simulate``); None:
+        the paper's.
 
     Returns
     -------
@@ -278,6 +281,14 @@ def equilibration_problems(
     ...     print(problem)  # doctest: +ELLIPSIS
     r = 0.95: equilibration_time = 50 is shorter than 20 relaxation times (1016.13 each): ...
     r = 0.95: shard_time = 2000 is shorter than 8 relaxation times (1016.13 each): ...
+
+    The same in seconds, for a ball under g = 9.81 and a noise strength Lambda = 0.05, whose
+    unit of time is Lambda / g^2 = 5.2e-4 s:
+
+    >>> from bouncing_ball.units import PhysicalUnits
+    >>> units = PhysicalUnits(gravity=9.81, noise=0.05)
+    >>> print(equilibration_problems(0.95, 2e3, 50.0, units=units)[0])  # doctest: +ELLIPSIS
+    r = 0.95: equilibration_time = 0.0259778 is shorter than 20 relaxation times (0.527935 each): ...
     """
     from ..restitution import parse_restitution, restitution_label
 
@@ -290,27 +301,32 @@ def equilibration_problems(
         return []  # the same answer, without solving eq. (inteq)
     relaxation = equilibration_relaxation_time(restitution)
     label = restitution_label(parse_restitution(restitution, "r"))
+
+    def shown(time):  # a time of the paper's units in those of the messages
+        return time if units is None else float(units.to_physical(time, "time"))
+
     problems = []
     needed = EQUILIBRATION_RELAXATION_TIMES * relaxation
     if equilibration_time < needed and needed > MIN_EQUILIBRATION_TIME:
         problems.append(
-            f"r = {label}: {where}equilibration_time = {equilibration_time:g} is shorter "
-            f"than {EQUILIBRATION_RELAXATION_TIMES} relaxation times ({relaxation:.6g} each): "
-            "the shards may record the start's transient; use the default (the workflow's "
-            f"equilibration_time: auto), {needed:.3g}"
+            f"r = {label}: {where}equilibration_time = {shown(equilibration_time):g} is "
+            f"shorter than {EQUILIBRATION_RELAXATION_TIMES} relaxation times "
+            f"({shown(relaxation):.6g} each): the shards may record the start's transient; use "
+            f"the default (the workflow's equilibration_time: auto), {shown(needed):.3g}"
         )
     shortest = SHARD_RELAXATION_TIMES * relaxation
     if shard_time < shortest:
         problems.append(
-            f"r = {label}: {where}shard_time = {shard_time:g} is shorter than "
-            f"{SHARD_RELAXATION_TIMES} relaxation times ({relaxation:.6g} each): the early "
-            "part of a recording, which the equilibration check compares with the rest, "
-            f"spans less than one, and the errors cannot be trusted; use at least {shortest:.3g}"
+            f"r = {label}: {where}shard_time = {shown(shard_time):g} is shorter than "
+            f"{SHARD_RELAXATION_TIMES} relaxation times ({shown(relaxation):.6g} each): the "
+            "early part of a recording, which the equilibration check compares with the rest, "
+            "spans less than one, and the errors cannot be trusted; use at least "
+            f"{shown(shortest):.3g}"
         )
     return problems
 
 
-def warn_equilibration_problems(restitution, shard_time, equilibration_time) -> None:
+def warn_equilibration_problems(restitution, shard_time, equilibration_time, units=None) -> None:
     """Warn of each of ``equilibration_problems`` (``simulate``).
 
     Parameters
@@ -318,14 +334,16 @@ def warn_equilibration_problems(restitution, shard_time, equilibration_time) -> 
     restitution : float, str or fractions.Fraction
         r, 0 < r < 1.
     shard_time, equilibration_time : float
-        The shard's settings.
+        The shard's settings, in the paper's time units.
+    units : units.PhysicalUnits, optional
+        The units the warnings quote every time in (None: the paper's).
 
     Returns
     -------
     None
         Each problem is an ``EquilibrationWarning``, attributed to the caller's caller.
     """
-    for problem in equilibration_problems(restitution, shard_time, equilibration_time):
+    for problem in equilibration_problems(restitution, shard_time, equilibration_time, units=units):
         warnings.warn(problem, EquilibrationWarning, stacklevel=3)
 
 

@@ -224,10 +224,11 @@ def _run_here(arguments, shards, finished, on_finished):
         on_finished()
 
 
-def _check_recorded(tallies, settings):
+def _check_recorded(tallies, settings, units=None):
     """Refuse shards (``{index: ShardTallies}``) that recorded no time (the step budget ran
     out in equilibration) or no flight: every estimate needs collisions in every shard (the
-    jackknife error is the scatter between the shards), and I = 0 +- 0 would be a claim."""
+    jackknife error is the scatter between the shards), and I = 0 +- 0 would be a claim.  The
+    messages quote shard_time in ``units`` (the paper's where None)."""
     for index, shard_tallies in sorted(tallies.items()):
         if not shard_tallies.time > 0.0:
             raise RuntimeError(
@@ -237,8 +238,11 @@ def _check_recorded(tallies, settings):
             )
     empty = [index for index, shard_tallies in sorted(tallies.items()) if shard_tallies.flights < 1]
     if empty:
+        shard_time = settings.shard_time
+        if units is not None:
+            shard_time = float(units.to_physical(shard_time, "time"))
         raise ValueError(
-            f"shard_time = {settings.shard_time!r} is too short: {len(empty)} of {len(tallies)} "
+            f"shard_time = {shard_time!r} is too short: {len(empty)} of {len(tallies)} "
             f"shards (the first: shard {empty[0]}) recorded no collision ending a flight, and "
             "every estimate needs collisions in every shard (the errors are the scatter "
             "between shards); use a shard_time of many mean flight times <T> = 1/I "
@@ -275,7 +279,7 @@ def _interrupted(exact, seed, settings, finished, requested, units=None):
         why = "too few for a result (an error needs 2 shards)"
     else:
         try:
-            _check_recorded(finished, settings)
+            _check_recorded(finished, settings, units)
         except (RuntimeError, ValueError) as error:
             why = f"no result: {error}"
         else:
@@ -452,6 +456,9 @@ def simulate(
     units = PhysicalUnits(gravity, noise)
     shards = whole_number(shards, "shards", 2, MAX_SHARDS)
     processes = whole_number(processes, "processes", 1)
+    shard_time = real_number(shard_time, "shard_time")
+    if not 0.0 < shard_time < math.inf:  # in the units given, before they are converted
+        raise ValueError(f"shard_time must be positive and finite, got {shard_time!r}")
     shard_time, settings = _settings_in_paper_units(shard_time, settings, units)
     run_settings = _shard_settings(shard_time, settings, exact)
     if exact < CRITICAL_RESTITUTION and not run_settings.min_step_floor > 0.0:
@@ -463,7 +470,7 @@ def simulate(
     seed = _root_seed(seed)
     from .equilibration import warn_equilibration_problems
 
-    warn_equilibration_problems(r, run_settings.shard_time, run_settings.equilibration_time)
+    warn_equilibration_problems(r, run_settings.shard_time, run_settings.equilibration_time, units)
     progress_line = _Progress(label, shards, progress)
     finished = {}
     arguments = (float(exact), seed, label, run_settings)
@@ -479,7 +486,7 @@ def simulate(
         raise _interrupted(exact, seed, run_settings, finished, shards, units) from None
     finally:
         progress_line.close()
-    _check_recorded(finished, run_settings)
+    _check_recorded(finished, run_settings, units)
     return SimulationResult(
         restitution=exact,
         seed=seed,

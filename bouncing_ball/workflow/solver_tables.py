@@ -52,6 +52,19 @@ def label(equilibrium) -> str:
     return restitution_label(equilibrium.restitution)
 
 
+def _in_paper_units(equilibrium):
+    """``equilibrium`` if it is in the paper's units (g = Lambda = 1), those of rule solve's
+    tables; else ValueError naming the argument and its units."""
+    units = equilibrium.units
+    if units.gravity != 1.0 or units.noise != 1.0:
+        raise ValueError(
+            f"equilibrium: rule solve's tables are in the paper's units (g = Lambda = 1), but "
+            f"this {type(equilibrium).__name__} is in units of gravity = {units.gravity:g}, "
+            f"noise = {units.noise:g}; build it with the defaults gravity=1.0, noise=1.0"
+        )
+    return equilibrium
+
+
 def _solve(equilibrium, what: str):
     """``equilibrium`` if it is an ``Equilibrium`` (a solve), else TypeError naming ``what``."""
     from ..equilibrium import Equilibrium
@@ -61,7 +74,7 @@ def _solve(equilibrium, what: str):
             f"{what} describes a solve of eq. (inteq) and takes an Equilibrium, got "
             f"{type(equilibrium).__name__}"
         )
-    return equilibrium
+    return _in_paper_units(equilibrium)
 
 
 def _relaxation_columns(equilibrium) -> dict:
@@ -93,7 +106,8 @@ def summary(equilibrium) -> dict:
     Parameters
     ----------
     equilibrium : bouncing_ball.Equilibrium
-        The solve, r in ``restitution.DISTRIBUTION_RESTITUTION_RANGE``.
+        The solve, r in ``restitution.DISTRIBUTION_RESTITUTION_RANGE``, in the paper's units
+        (gravity = noise = 1, the defaults).
 
     Returns
     -------
@@ -105,7 +119,8 @@ def summary(equilibrium) -> dict:
     TypeError
         For an equilibrium that is not an ``Equilibrium`` (it has no solve to describe).
     ValueError
-        Above ``restitution.DISTRIBUTION_RESTITUTION_RANGE`` (no w(F) there).
+        Above ``restitution.DISTRIBUTION_RESTITUTION_RANGE`` (no w(F) there), or for an
+        equilibrium in other units than the paper's.
 
     Examples
     --------
@@ -149,7 +164,7 @@ def check(equilibrium, tables, row=None) -> None:
     Parameters
     ----------
     equilibrium : bouncing_ball.Equilibrium
-        The solve.
+        The solve, in the paper's units (gravity = noise = 1, the defaults).
     tables : dict of str to pandas.DataFrame
         Any of p0v, flight_time, return_speed, position, distribution, weight, as the table
         functions here give them.
@@ -165,7 +180,7 @@ def check(equilibrium, tables, row=None) -> None:
     TypeError
         For an equilibrium that is not an ``Equilibrium``.
     ValueError
-        Naming r and every check that fails: first ``accuracy`` and ``position_accuracy``
+        For an equilibrium in other units than the paper's; naming r and every check that fails: first ``accuracy`` and ``position_accuracy``
         beyond the target (with the settings), then the tables' (naming the table and column).
 
     Examples
@@ -218,6 +233,7 @@ def p0v_table(equilibrium, speeds):
     Parameters
     ----------
     equilibrium : bouncing_ball.EquilibriumBase
+        In the paper's units (gravity = noise = 1, the defaults): ValueError otherwise.
     speeds : array_like
         Outgoing speeds, v >= ``equilibrium.smallest_speed`` and v > 0.
 
@@ -235,6 +251,7 @@ def p0v_table(equilibrium, speeds):
     0  1.0  0.122626
     1  2.0  0.022556
     """
+    equilibrium = _in_paper_units(equilibrium)
     import pandas as pd
 
     speeds = _positive(speeds, "speeds")
@@ -247,6 +264,7 @@ def position_table(equilibrium, positions):
     Parameters
     ----------
     equilibrium : bouncing_ball.EquilibriumBase
+        In the paper's units (gravity = noise = 1, the defaults): ValueError otherwise.
     positions : array_like
         Heights, x > 0, within the domain of ``px``.
 
@@ -264,6 +282,7 @@ def position_table(equilibrium, positions):
     0  0.1  0.503776    1.853157
     1  1.0  0.183784    3.710784
     """
+    equilibrium = _in_paper_units(equilibrium)
 
     equilibrium._check_distribution("position_table")
     positions = _positive(positions, "positions")
@@ -279,6 +298,7 @@ def distribution_table(equilibrium, positions, speeds):
     Parameters
     ----------
     equilibrium : bouncing_ball.EquilibriumBase
+        In the paper's units (gravity = noise = 1, the defaults): ValueError otherwise.
     positions : array_like
         Heights, x >= 0.
     speeds : array_like
@@ -299,6 +319,7 @@ def distribution_table(equilibrium, positions, speeds):
     >>> print(table["pxv"].to_numpy().round(6), worst < 1e-8)
     [0.074292 0.146809] True
     """
+    equilibrium = _in_paper_units(equilibrium)
 
     equilibrium._check_distribution("distribution_table")
     positions = np.asarray(positions, dtype=float)
@@ -316,6 +337,7 @@ def weight_table(equilibrium, forces):
     Parameters
     ----------
     equilibrium : bouncing_ball.EquilibriumBase
+        In the paper's units (gravity = noise = 1, the defaults): ValueError otherwise.
     forces : array_like
         F > 0, finite.
 
@@ -332,6 +354,7 @@ def weight_table(equilibrium, forces):
          F         w     log_w
     0  1.0  0.153341 -1.875093
     """
+    equilibrium = _in_paper_units(equilibrium)
 
     equilibrium._check_distribution("weight_table")
     return weight_frame(equilibrium.weight_function, _positive(forces, "forces"))
@@ -345,6 +368,7 @@ def flight_time_table(equilibrium, times):
     Parameters
     ----------
     equilibrium : bouncing_ball.EquilibriumBase
+        In the paper's units (gravity = noise = 1, the defaults): ValueError otherwise.
     times : array_like
         Flight times, T > 0 and at least the bounds of ``flight_rate_density`` and
         ``flight_time_density`` (every value of the table is finite).  The pipeline writes
@@ -368,6 +392,7 @@ def flight_time_table(equilibrium, times):
     >>> flight_time_table(Equilibrium("1/2"), [1.0])["density"].round(6).tolist()
     [0.196832]
     """
+    equilibrium = _in_paper_units(equilibrium)
     from .. import flight_time
 
     times = _positive(times, "times")
@@ -384,6 +409,7 @@ def return_speed_table(equilibrium, speed_bins):
     Parameters
     ----------
     equilibrium : bouncing_ball.EquilibriumBase
+        In the paper's units (gravity = noise = 1, the defaults): ValueError otherwise.
     speed_bins : bins.LogBins
         The bins of the outgoing and return speeds (``settings.ShardSettings.speed_bins``).
 
@@ -401,6 +427,7 @@ def return_speed_table(equilibrium, speed_bins):
     >>> table.groupby("u_lo")["probability"].sum().round(12).tolist()
     [1.0, 1.0]
     """
+    equilibrium = _in_paper_units(equilibrium)
     from .. import flight_time
 
     return flight_time.return_speed_table(equilibrium.solution, speed_bins)
