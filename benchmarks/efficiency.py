@@ -3,10 +3,10 @@
 For each r of ``RESTITUTIONS`` and each of two estimators,
   * ``paper``: the paper's c = 5 and plain tallies (time averages, counts over time);
   * ``default``: the default config's c and the variance reductions independent of the theory
-    (the martingale-controlled estimate of ``histograms`` where a table has one: the summary's
+    (the martingale-controlled estimate of ``estimators`` where a table has one: the summary's
     moments, P(0, v), P(x), <v^2>_x),
 ``SHARDS`` shards run in two processes and each observable's relative standard error is
-measured from their scatter (the jackknife of ``histograms``), times the CPU seconds of the
+measured from their scatter (the jackknife of ``estimators``), times the CPU seconds of the
 shards: the CPU it takes to reach a relative error of 1 (lower is better).  For P(0, v),
 P(x), <v^2>_x and P(x, v) it is the median over the bins inside ``SPEEDS`` and
 ``POSITIONS``.  The gain is paper / default.

@@ -151,7 +151,7 @@ SHARDS_PER_CONTROL = 3
 #: ``EARLY_FRACTION`` x shard_time.
 EARLY_FRACTION = 0.125
 #: The time, collisions, int x dt and int x^2 dt over the early part of the recording
-#: (``EARLY_FRACTION``): the shard's own evidence of equilibration (``equilibration``).
+#: (``EARLY_FRACTION``): the shard's own evidence of equilibration (``simulation.equilibration``).
 EARLY_SUMS = ("early_time", "early_collisions", "early_int_x", "early_int_x2")
 #: The scalars of a shard, in their order in its table and in the array a compiled shard loop
 #: fills: the totals, then ``CONTROL_VARIATE_SUMS``, ``EARLY_SUMS`` and ``MOMENT_CONTROL_SUMS``.

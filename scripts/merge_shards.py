@@ -3,7 +3,7 @@ flight-time density, the return speeds, and the summary (<x>, Delta x, I, the fl
 moments), the bounce chain's autocorrelation and decay rate ->
 results/simulation/r{r}/{p0v,position,distribution,flight_time,return_speed,summary,
 bounce_chain}.parquet.  Refused where the shards' early parts disagree with the rest beyond doubt
-(``equilibration``), a warning where they disagree less; the check goes into the provenance."""
+(``simulation.equilibration``), a warning where they disagree less; the check goes into the provenance."""
 
 import logging
 

@@ -119,7 +119,7 @@ def _summary_scalar(column):
 @dataclass(frozen=True, eq=False)
 class SimulationResult:
     """What ``simulate`` returns: the shards' tallies, their merged tables and the observables
-    with their delete-one jackknife errors over the shards (``histograms``).
+    with their delete-one jackknife errors over the shards (``estimators``).
 
     The raw data are the shards' tallies with the settings, the seed and r: ``save`` writes
     them to a Parquet file and ``bouncing_ball.load`` reads them back to an equal result.
