@@ -14,6 +14,10 @@ from ..restitution import (
 from ..units import PhysicalUnits
 from .checks import _PAPER_UNITS, _broadcast, _checked, _heights, _in_units, _out
 
+__all__ = [
+    "EquilibriumBase",
+]
+
 # ---------------------------------------------------------------------------------------------
 # what both classes share
 

@@ -7,6 +7,14 @@ import numpy as np
 
 from ..units import PhysicalUnits
 
+__all__ = [
+    "EXACT_ACCURACY",
+    "SPEED_PANEL",
+    "QUADRATURE_STEP_RANGE",
+    "WEIGHT_PANEL_NODES_RANGE",
+    "check_solver_settings",
+]
+
 #: The solver's trapezoidal step h in s = ln v + v^(1/2) that ``Equilibrium`` and rule solve
 #: accept (the config's ``solver.quadrature_step``), bounds included.  Up to 0.3 P(0, v)
 #: (``Equilibrium.accuracy``) and P(x) (``Equilibrium.position_accuracy``) meet the 1e-8 target

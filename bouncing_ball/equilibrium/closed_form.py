@@ -14,6 +14,10 @@ from ..restitution import (
 from .base import EquilibriumBase
 from .checks import EXACT_ACCURACY
 
+__all__ = [
+    "ExactEquilibrium",
+]
+
 # ---------------------------------------------------------------------------------------------
 # r = 1/2 and 1/3: the paper's exact solutions
 

@@ -18,6 +18,11 @@ from ..restitution import (
 from .base import EquilibriumBase
 from .checks import SPEED_PANEL, check_solver_settings
 
+__all__ = [
+    "Equilibrium",
+    "KEPT_SOLVES",
+]
+
 # ---------------------------------------------------------------------------------------------
 # any r: the solver
 

@@ -13,6 +13,12 @@ from ..tallies import (
 )
 from .jackknife import jackknife
 
+__all__ = [
+    "RESOLVED_CORRELATION",
+    "bounce_autocorrelation",
+    "bounce_chain_decay",
+]
+
 RESOLVED_CORRELATION = 5.0
 
 

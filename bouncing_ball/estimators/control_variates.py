@@ -14,6 +14,16 @@ from ..tallies import (
 )
 from .jackknife import jackknife
 
+__all__ = [
+    "shard_controls",
+    "moment_controls",
+    "RETURN_LAW_POINTS",
+    "return_law_prediction",
+    "flight_law_prediction",
+    "control_variate_rate",
+    "control_variate_adjusted",
+]
+
 
 def shard_controls(shards, names):
     """The control sums ``names`` of each shard, if the shards are enough to fit their slopes.

@@ -19,6 +19,15 @@ from .control_variates import (
 )
 from .jackknife import jackknife
 
+__all__ = [
+    "outgoing_speed_density",
+    "outgoing_speed_histogram",
+    "position_histogram",
+    "distribution_histogram",
+    "flight_time_histogram",
+    "return_speed_table",
+]
+
 
 def outgoing_speed_density(counts, time, lower, upper):
     """P(0, v) averaged over a bin of outgoing speed, from the rate of collisions in it.

@@ -2,6 +2,11 @@
 
 import numpy as np
 
+__all__ = [
+    "jackknife",
+    "deviations_from_mean",
+]
+
 
 def jackknife(estimator, *per_shard):
     """Value and delete-one jackknife standard error of a function of summed tallies.

@@ -16,6 +16,11 @@ from .control_variates import (
 )
 from .jackknife import jackknife
 
+__all__ = [
+    "CONTROLLED_MOMENTS",
+    "position_moments_summary",
+]
+
 
 def _mean_x(int_x, time):
     return int_x / time

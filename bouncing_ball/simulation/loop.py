@@ -162,6 +162,15 @@ from .step_tallies import (
     floor_stratum_end,
 )
 
+__all__ = [
+    "shard_seed_sequence",
+    "simulate_shard",
+    "ShardStop",
+    "ShardStopped",
+    "STOP_CHECK_STEPS",
+    "COLLAPSED_STEP",
+]
+
 # indices into the scalar tally array of the compiled loop (its layout: tallies.SCALARS)
 _TIME = SCALAR_INDEX["time"]
 _COLLISIONS = SCALAR_INDEX["collisions"]

@@ -12,6 +12,14 @@ from ..settings import ShardSettings
 from ..units import PhysicalUnits
 from .seeds import _seed_from_record, _seed_record, _seed_text
 
+__all__ = [
+    "SimulationResult",
+    "load",
+    "SCALARS",
+    "COLUMN_DIMENSIONS",
+    "RESULT_KIND",
+]
+
 SCALARS = {
     "collision_rate": ("I", "collisions per unit time, eq. (collrate)"),
     "mean_x": ("<x>", "the mean height, eq. (xandDeltax)"),

@@ -15,6 +15,14 @@ from ..units import PhysicalUnits
 from .result import SimulationResult
 from .seeds import _root_seed
 
+__all__ = [
+    "simulate",
+    "SimulationInterrupted",
+    "DEFAULT_SETTINGS",
+    "PARENT_CHECK_INTERVAL",
+    "WAIT_INTERVAL",
+]
+
 # the shard settings ``simulate`` uses where it is not told otherwise (the default config's
 # ``simulation`` section holds the workflow's); every bin set is ``ShardSettings``' default,
 # and equilibration_time follows from the relaxation time at r

@@ -19,6 +19,17 @@ from ..free_flight import (
 from ..jit import njit
 from ..pcg64 import standard_normal
 
+__all__ = [
+    "MEAN_PATH_INTEGRALS",
+    "POSITION",
+    "JOINT",
+    "FLIGHTS",
+    "CONTROL_VARIATES",
+    "EVERY_TALLY",
+    "FLOOR_STRATUM_HEIGHT",
+    "floor_stratum_end",
+]
+
 
 @njit(cache=True)
 def _bin_index(value, log_lo, per_ln, n, edges):

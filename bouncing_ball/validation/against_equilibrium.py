@@ -8,6 +8,12 @@ import pandas as pd
 from .checks import POSITION_RANGE, _shard_deviations
 from .sign_flip import order_free_mean, shard_ratios, sign_flip_test
 
+__all__ = [
+    "compare",
+    "COMPARED_SCALARS",
+    "COMPARE_COLUMNS",
+]
+
 # exact, fits and histograms (scipy, numba) are imported by the functions that use them: the
 # moments and position tables need none of them
 

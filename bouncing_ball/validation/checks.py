@@ -11,6 +11,21 @@ from ..tallies import RATE_CONTROLS, SHARDS_PER_CONTROL
 from .moments import _number, value_with_error
 from .sign_flip import SIGN_FLIPS, order_free_mean, ratio_deviations, sign_flip_test
 
+__all__ = [
+    "outgoing_speed_residuals",
+    "exact_outgoing_speed_residuals",
+    "outgoing_speed_checks",
+    "position_checks",
+    "fit_checks",
+    "validation_rows",
+    "validation_table",
+    "validation_markdown",
+    "POSITION_RANGE",
+    "QUALITY_SPEEDS",
+    "VALIDATION_CHECKS",
+    "VALIDATION_COLUMNS",
+]
+
 # exact, fits and histograms (scipy, numba) are imported by the functions that use them: the
 # moments and position tables need none of them
 

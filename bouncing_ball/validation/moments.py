@@ -6,6 +6,20 @@ from fractions import Fraction
 import numpy as np
 import pandas as pd
 
+__all__ = [
+    "moment_rows",
+    "moments_table",
+    "moments_markdown",
+    "value_with_error",
+    "independent_estimate",
+    "kernel3_estimate",
+    "INDEPENDENT_ESTIMATOR",
+    "MOMENT_COLUMNS",
+    "PAPER_VALUES",
+    "QUANTITIES",
+    "SYMBOLS",
+]
+
 # exact, fits and histograms (scipy, numba) are imported by the functions that use them: the
 # moments and position tables need none of them
 

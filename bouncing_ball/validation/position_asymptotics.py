@@ -2,6 +2,12 @@
 
 import pandas as pd
 
+__all__ = [
+    "position_asymptotics_table",
+    "position_asymptotics_markdown",
+    "POSITION_EXPONENTS",
+]
+
 # exact, fits and histograms (scipy, numba) are imported by the functions that use them: the
 # moments and position tables need none of them
 

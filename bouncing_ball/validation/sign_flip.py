@@ -5,6 +5,15 @@ import numbers
 
 import numpy as np
 
+__all__ = [
+    "sign_flip_test",
+    "order_free_mean",
+    "ratio_deviations",
+    "shard_ratios",
+    "SIGN_FLIPS",
+    "SIGN_FLIP_SEED",
+]
+
 # exact, fits and histograms (scipy, numba) are imported by the functions that use them: the
 # moments and position tables need none of them
 
