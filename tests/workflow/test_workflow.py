@@ -502,7 +502,7 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
                 "validation_table": 1,  # the exact bin averages
             },
         ),
-        # comparison uses fits
+        # the validation uses fits
         (
             "fits",
             {
@@ -516,7 +516,7 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
         ),
         ("asymptotics", {**solved_and_merged, "theory": 1, "fig1": 1, "fig2": 1}),
         (
-            "comparison",
+            "validation/moments",
             {"fig7": 1, "moments_table": 1, "validation_table": 1, "position_asymptotics": 1},
         ),
     ):
