@@ -57,52 +57,31 @@ from pathlib import Path
 from .breakdown import breakdown
 from .efficiency import efficiency_benchmark
 from .report import REFERENCE_TARGET, SOLVER_TARGET_MS, machine_info, markdown_report
+from .shards import PAPER_CRITERION_C, SHARD_SETTINGS, run_shard
 
 SINGLE_THREAD = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 SOLVER_RESTITUTIONS = (0.05, 0.1, 0.25, 1.0 / 3.0, 0.5, 0.75, 0.9, 0.95, 0.99)
 
 REPOSITORY = Path(__file__).resolve().parents[1]
-PAPER_CRITERION_C = 5.0
 
 
-def _default_shard_settings():
-    """The default config's shard settings (c, the delta rule, the bins), with a short
-    equilibration and no step budget to speak of."""
-    from bouncing_ball.workflow.config import read_config, shard_settings
-
-    config = read_config(REPOSITORY / "config" / "config.yaml")
-    return shard_settings(config, "0.5").replace(equilibration_time=100.0, max_steps=10**13)
-
-
-SHARD_SETTINGS = _default_shard_settings()
 # simulated time per throughput shard: long enough for a steady rate (the report gives the
 # simulated time per CPU second at each r, so the CPU of a shard)
 THROUGHPUT_TIMES = {0.25: 6.0e5, 0.5: 2.0e6, 0.75: 6.0e6}
 
 
-def _shard(r, recorded_time, shard=0, seed=1, loop=None, **changes):
-    """One shard of r with the default settings, ``changes`` applied (``loop``: another
-    implementation of ``simulation.simulate_shard``, e.g. the C reference)."""
-    from bouncing_ball.restitution import restitution_label
-    from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
-
-    settings = SHARD_SETTINGS.replace(shard_time=recorded_time, **changes)
-    stream = shard_seed_sequence(seed, restitution_label(r), shard)
-    return (loop or simulate_shard)(r, stream, settings)
-
-
 def simulation_benchmark():
     """Throughput on one core with the default config's c and delta rule, and with the paper's c = 5
     (same code, same streams): the CPU the default c saves per simulated time."""
-    _shard(0.5, 10.0)  # warm-up: compile or load the cache
+    run_shard(0.5, 10.0)  # warm-up: compile or load the cache
     rows = []
     for r, recorded_time in THROUGHPUT_TIMES.items():
         for criterion_c in (SHARD_SETTINGS.criterion_c, PAPER_CRITERION_C):
             seconds = float("inf")
             for _ in range(2):  # the better of two: a one-off stall of the machine does not count
                 started = time.process_time()
-                tallies = _shard(r, recorded_time, criterion_c=criterion_c)
+                tallies = run_shard(r, recorded_time, criterion_c=criterion_c)
                 seconds = min(seconds, time.process_time() - started)
             rows.append(
                 {
@@ -136,7 +115,7 @@ def reference_benchmark(r=0.5, recorded_time=2.0e6, repeats=3):
 
     loops = {"numba": simulate_shard, "c": reference_loop.reference_shard}
     for loop in loops.values():
-        _shard(r, 10.0, loop=loop, equilibration_time=0.0)  # compile, build or load
+        run_shard(r, 10.0, loop=loop, equilibration_time=0.0)  # compile, build or load
     rows = []
     for case, recorded, equilibration in (
         ("with tallies", recorded_time, 100.0),
@@ -147,7 +126,7 @@ def reference_benchmark(r=0.5, recorded_time=2.0e6, repeats=3):
         for _ in range(repeats):  # interleaved, so a change of machine load hits both
             for name, loop in loops.items():
                 started = time.process_time()
-                results[name] = _shard(r, recorded, loop=loop, equilibration_time=equilibration)
+                results[name] = run_shard(r, recorded, loop=loop, equilibration_time=equilibration)
                 best[name] = min(best[name], time.process_time() - started)
         same = not reference_loop.differing_tallies(results["numba"], results["c"])
         rows.append(
@@ -373,6 +352,7 @@ def distribution_benchmark():
     return-speed tables (bouncing_ball.flight_time)."""
     from bouncing_ball import distribution, flight_time, solver
     from bouncing_ball.bins import linear_grid, log_bins, log_grid
+    from bouncing_ball.workflow import solver_tables
     from bouncing_ball.workflow.config import read_config
 
     config = read_config(REPOSITORY / "config" / "config.yaml")
@@ -384,10 +364,10 @@ def distribution_benchmark():
         far = distribution.outgoing_speed_solution(r)
         weight = distribution.interpolated_weight_function(far)
         built = time.perf_counter()
-        distribution.position_table(weight, log_grid(grids["position_grid"]))
-        distribution.weight_table(weight, log_grid(grids["forces"]))
+        solver_tables.position_frame(weight, log_grid(grids["position_grid"]))
+        solver_tables.weight_frame(weight, log_grid(grids["forces"]))
         tabulated = time.perf_counter()
-        distribution.distribution_table(
+        solver_tables.distribution_frame(
             weight, far, grids["positions"], linear_grid(grids["speeds"])
         )
         joint = time.perf_counter()

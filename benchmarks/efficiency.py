@@ -3,10 +3,10 @@
 For each r of ``RESTITUTIONS`` and each of two estimators,
   * ``paper``: the paper's c = 5 and plain tallies (time averages, counts over time);
   * ``default``: the default config's c and the variance reductions independent of the theory
-    (the martingale-controlled estimate of ``histograms`` where a table has one: the summary's
+    (the martingale-controlled estimate of ``estimators`` where a table has one: the summary's
     moments, P(0, v), P(x), <v^2>_x),
 ``SHARDS`` shards run in two processes and each observable's relative standard error is
-measured from their scatter (the jackknife of ``histograms``), times the CPU seconds of the
+measured from their scatter (the jackknife of ``estimators``), times the CPU seconds of the
 shards: the CPU it takes to reach a relative error of 1 (lower is better).  For P(0, v),
 P(x), <v^2>_x and P(x, v) it is the median over the bins inside ``SPEEDS`` and
 ``POSITIONS``.  The gain is paper / default.
@@ -28,7 +28,7 @@ ESTIMATORS = ("paper", "default")
 SHARDS = 64
 # Near r = 1 (0.95, 0.99) a shard spans hundreds of relaxation times (``Equilibrium(r).
 # relaxation_time``), and every shard discards the default equilibration time at its r
-# (``equilibration.default_equilibration_time``), counted in its CPU seconds.
+# (``simulation.equilibration.default_equilibration_time``), counted in its CPU seconds.
 SHARD_TIMES = {0.25: 4.0e4, 0.5: 1.0e5, 0.75: 4.0e5, 0.95: 1.0e6, 0.99: 1.0e7}
 # the bins over which the median is taken
 SPEEDS = (0.01, 5.0)
@@ -47,8 +47,8 @@ OBSERVABLES = (*MOMENTS, *DISTRIBUTIONS)
 def moment_relative_squared_errors(shards, r, controlled):
     """{observable: (relative standard error)^2} of the moments of ``MOMENTS`` from ``shards``:
     plain, or (``controlled``) the summary's estimate that the moments table shows, the
-    martingale-controlled ``*_martingale`` (``comparison.independent_estimate``)."""
-    from bouncing_ball.histograms import position_moments_summary
+    martingale-controlled ``*_martingale`` (``validation.independent_estimate``)."""
+    from bouncing_ball.estimators import position_moments_summary
 
     summary = position_moments_summary(shards, r).iloc[0]
     values = {}
@@ -80,14 +80,21 @@ def distribution_relative_squared_errors(shards, controlled, r=None, return_law=
     error)^2} of P(0, v), P(x), <v^2>_x and P(x, v) (v within +-SPEEDS[1] for P(x, v)):
     plain, or (``controlled``) the tables' ``*_controlled`` estimates where they have one,
     P(0, v)'s with the return-law control of r (``return_law``: the shards' prediction,
-    ``histograms.return_law_prediction``, if at hand)."""
-    from bouncing_ball.histograms import (
+    ``estimators.return_law_prediction``, if at hand)."""
+    from bouncing_ball.estimators import (
         distribution_histogram,
         outgoing_speed_histogram,
         position_histogram,
     )
 
-    speeds = outgoing_speed_histogram(shards, r if controlled else None, return_law)
+    theory = None  # the solver's P(0, u), for the return-law control
+    if controlled and return_law is None:
+        from bouncing_ball.solver import solved_outgoing_density
+
+        theory = solved_outgoing_density(r)
+    speeds = outgoing_speed_histogram(
+        shards, r if controlled else None, theory, return_law=return_law
+    )
     positions = position_histogram(shards)
     cells = distribution_histogram(shards)
     in_speeds = (speeds.v_lo >= SPEEDS[0]) & (speeds.v_hi <= SPEEDS[1])
@@ -119,7 +126,7 @@ def relative_squared_errors(shards, r, controlled, return_law=None):
 def with_error_of_error(shards, r, controlled):
     """{observable: (relative squared error, its delete-one jackknife standard error)}: the
     estimate of ``relative_squared_errors`` from all shards, and repeated without each."""
-    from bouncing_ball.histograms import return_law_prediction
+    from bouncing_ball.estimators import return_law_prediction
     from bouncing_ball.solver import solve_outgoing_speed_density
 
     law = None
@@ -170,11 +177,11 @@ def efficiency_rows(measurements):
 
 
 def _timed_shard(arguments):
-    from .benchmark import _shard
+    from .shards import run_shard
 
     r, recorded_time, equilibration_time, shard, criterion_c = arguments
     started = time.process_time()
-    tallies = _shard(
+    tallies = run_shard(
         r,
         recorded_time,
         shard=shard,
@@ -190,13 +197,13 @@ def efficiency_benchmark(shards=SHARDS, shard_times=None):
     (``efficiency_rows``) with what was run."""
     from concurrent.futures import ProcessPoolExecutor
 
-    from bouncing_ball.equilibration import default_equilibration_time
+    from bouncing_ball.simulation.equilibration import default_equilibration_time
 
-    from .benchmark import PAPER_CRITERION_C, SHARD_SETTINGS, _shard
+    from .shards import PAPER_CRITERION_C, SHARD_SETTINGS, run_shard
 
     shard_times = shard_times or SHARD_TIMES
     criteria = {"paper": PAPER_CRITERION_C, "default": SHARD_SETTINGS.criterion_c}
-    _shard(0.5, 10.0)  # compile or load the cache here before the pool forks
+    run_shard(0.5, 10.0)  # compile or load the cache here before the pool forks
     measurements = {}
     with ProcessPoolExecutor(2) as pool:
         for r, recorded_time in shard_times.items():

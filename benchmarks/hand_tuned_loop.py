@@ -9,7 +9,7 @@ measures the shard loop's collisions per CPU second against it, in the same run
 (``breakdown``).  It is outside the package, like ``reference_loop``: the workflow never
 runs it.
 
-How it differs from ``simulation._run`` (and from its line-by-line translation
+How it differs from ``simulation.loop._run`` (and from its line-by-line translation
 ``reference/shard_loop.c``):
   * it tallies only collisions, time, steps, int x dt, int x^2 dt and the outgoing speeds:
     no P(x), <v^2>_x, P(x, v), flight-time or return-speed tallies;

@@ -1,6 +1,6 @@
 """A plain C reference of the shard loop: build it, run one shard with it.
 
-``reference/shard_loop.c`` translates the compiled loop ``simulation._run``
+``reference/shard_loop.c`` translates the compiled loop ``simulation.loop._run``
 and the free-flight functions it calls, operation for operation, and draws its
 normals with numpy's own C ziggurat (``random_standard_normal`` of
 libnpyrandom.a) from the same PCG64 stream as ``simulate_shard``; so on the

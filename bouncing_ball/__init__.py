@@ -42,11 +42,11 @@ _LAZY = {
     "EquilibriumBase": "equilibrium",
     "Equilibrium": "equilibrium",
     "ExactEquilibrium": "equilibrium",
-    "simulate": "monte_carlo",
-    "SimulationResult": "monte_carlo",
-    "SimulationInterrupted": "monte_carlo",
-    "load": "monte_carlo",
-    "compare": "comparison",
+    "simulate": "simulation",
+    "SimulationResult": "simulation",
+    "SimulationInterrupted": "simulation",
+    "load": "simulation",
+    "compare": "validation",
 }
 
 

@@ -42,7 +42,7 @@ from scipy.interpolate import CubicSpline
 
 from .asymptotics import large_speed_decay_rate, large_speed_exponent, small_speed_exponent
 from .bins import outgoing_speed_bin_average
-from .histograms import outgoing_speed_density
+from .estimators import outgoing_speed_density
 
 __all__ = [
     "SMALL_SPEED",

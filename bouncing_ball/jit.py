@@ -423,7 +423,8 @@ COMPILED = (
     "jit",
     "kernel",
     "pcg64",
-    "simulation",
+    "simulation.loop",
+    "simulation.step_tallies",
     "solver",
     "tallies",
 )

@@ -65,7 +65,7 @@ import numpy as np
 from scipy import linalg, optimize
 
 from .asymptotics import CRITICAL_RESTITUTION, small_speed_exponent
-from .restitution import SOLVER_RESTITUTION_RANGE, in_range, parse_restitution
+from .restitution import SOLVER_RESTITUTION_RANGE, check_solver_range
 from .solver import DEFAULT_STEP, _jacobian, _scaled_operator
 
 __all__ = [
@@ -92,14 +92,7 @@ RELAXATION_COLUMNS = (
 
 def _chain_restitution(restitution) -> float:
     """r as a float, refused outside the solver's range and at or below r_c."""
-    exact = parse_restitution(restitution, "restitution")
-    low, high = SOLVER_RESTITUTION_RANGE
-    if not in_range(exact, SOLVER_RESTITUTION_RANGE):
-        raise ValueError(
-            f"restitution {restitution} is outside the solver's range {low} <= r <= {high}, "
-            "whose matrix the relaxation of the bounce chain is computed from"
-        )
-    r = float(exact)
+    r = float(check_solver_range(restitution, "restitution"))
     if r <= CRITICAL_RESTITUTION:
         raise ValueError(
             f"restitution {r:.6g} is at or below r_c = {CRITICAL_RESTITUTION:.6f} "
@@ -107,7 +100,7 @@ def _chain_restitution(restitution) -> float:
             "drifts down, I is infinite and u P(0, u) is not a normalisable law of the chain), "
             "so the bounce chain has no relaxation eigenvalue, correlation length or relaxation "
             "time; they are defined for r_c < r <= "
-            f"{high}"
+            f"{SOLVER_RESTITUTION_RANGE[1]}"
         )
     return r
 

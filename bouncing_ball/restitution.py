@@ -17,7 +17,8 @@ __all__ = [
     "DISTRIBUTION_RESTITUTION_RANGE",
     "in_range",
     "parse_restitution",
-    "check_solver_restitution",
+    "check_solver_range",
+    "check_distribution_range",
     "restitution_value",
     "restitution_label",
     "restitution_grid",
@@ -144,11 +145,18 @@ def _exact_number(value, where: str) -> Fraction:
         raise ValueError(f"{where}: {value!r} is not a number; {advice}") from None
 
 
-def check_solver_restitution(value, where: str = "restitution") -> Fraction:
-    """r parsed (``parse_restitution``), if rule solve answers it to its accuracy target.
+def _range_text(bounds) -> str:
+    low, high = bounds
+    return f"{low} <= r <= {high}"
 
-    The target is met for P(0, v) and the whole distribution in
-    ``DISTRIBUTION_RESTITUTION_RANGE``.
+
+def check_solver_range(value, where: str = "restitution") -> Fraction:
+    """r parsed (``parse_restitution``), if it lies in the solver's range of r.
+
+    The solver's range, ``SOLVER_RESTITUTION_RANGE``, is where P(0, v) of eq. (inteq), the time
+    averages, the flight times and the bounce chain's relaxation meet the 1e-8 accuracy target
+    (``bouncing_ball.solver``).  The one check of it: every entry point that solves eq. (inteq)
+    calls it.
 
     Parameters
     ----------
@@ -165,28 +173,91 @@ def check_solver_restitution(value, where: str = "restitution") -> Fraction:
     Raises
     ------
     ValueError
-        If ``value`` is not an r (``parse_restitution``) or is outside
-        ``DISTRIBUTION_RESTITUTION_RANGE``; the message names ``where`` and the range.
+        If ``value`` is not an r (``parse_restitution``), or lies outside
+        ``SOLVER_RESTITUTION_RANGE``; the message names ``where``, "the solver's range of r" and
+        its bounds either way.
 
     Examples
     --------
-    >>> from bouncing_ball.restitution import check_solver_restitution
-    >>> check_solver_restitution("1/2")
-    Fraction(1, 2)
-    >>> check_solver_restitution(0.001, "r")
+    >>> from bouncing_ball.restitution import check_solver_range
+    >>> check_solver_range("1/50")
+    Fraction(1, 50)
+    >>> check_solver_range(0.99995, "r")
     Traceback (most recent call last):
     ...
-    ValueError: r: r = 0.001 is outside the solver's range ...
+    ValueError: r: r = 0.99995 is outside the solver's range of r, 0.02 <= r <= 0.9999, ...
     """
-    exact = parse_restitution(value, where)
-    low, high = DISTRIBUTION_RESTITUTION_RANGE
-    if not in_range(exact, DISTRIBUTION_RESTITUTION_RANGE):
-        solver_low, solver_high = SOLVER_RESTITUTION_RANGE
+    try:
+        exact = parse_restitution(value, where)
+    except ValueError as error:
         raise ValueError(
-            f"{where}: r = {value!r} is outside the solver's range {low} <= r <= {high}, "
-            "where its P(0, v), P(x) and P(x, v) meet the 1e-8 accuracy target "
-            f"(P(0, v) alone, solver.restitution_grid: {solver_low} <= r <= {solver_high}; "
-            "docs/distribution.md#where-it-degrades)"
+            f"{error}; the solver's range of r is {_range_text(SOLVER_RESTITUTION_RANGE)}"
+        ) from None
+    if not in_range(exact, SOLVER_RESTITUTION_RANGE):
+        why = (
+            "below it P(0, v) ~ exp(-v / (2r)) leaves the range of doubles"
+            if exact < Fraction(str(SOLVER_RESTITUTION_RANGE[0]))
+            else "above it the solver's dense grid of ~(1 - r)^(-1/2) nodes outgrows a job"
+        )
+        raise ValueError(
+            f"{where}: r = {value!r} is outside the solver's range of r, "
+            f"{_range_text(SOLVER_RESTITUTION_RANGE)}, where P(0, v) of eq. (inteq) meets its "
+            f"1e-8 accuracy target (restitution.SOLVER_RESTITUTION_RANGE): {why}"
+        )
+    return exact
+
+
+def check_distribution_range(value, where: str = "restitution") -> Fraction:
+    """r parsed (``parse_restitution``), if it lies in the range of r where P(x, v) is verified.
+
+    That range, ``DISTRIBUTION_RESTITUTION_RANGE``, is where the whole distribution from
+    P(0, v) (w(F), P(x), <v^2>_x, P(x, v): ``bouncing_ball.distribution``) meets the 1e-8
+    accuracy target, and so every table of rule solve: the r of a run.  The one check of it:
+    every entry point that builds w(F) calls it.
+
+    Parameters
+    ----------
+    value : float, int, str or fractions.Fraction
+        r as a decimal, a fraction string or a ``Fraction``.
+    where : str, optional
+        What ``value`` is, named in errors.
+
+    Returns
+    -------
+    fractions.Fraction
+        r.
+
+    Raises
+    ------
+    ValueError
+        If ``value`` is not an r (``parse_restitution``), or lies outside
+        ``DISTRIBUTION_RESTITUTION_RANGE``; the message names ``where``, "the range of r where
+        P(x, v) is verified", its bounds and the solver's range of r (P(0, v) alone).
+
+    Examples
+    --------
+    >>> from bouncing_ball.restitution import check_distribution_range
+    >>> check_distribution_range("1/2")
+    Fraction(1, 2)
+    >>> check_distribution_range(0.9995, "r")
+    Traceback (most recent call last):
+    ...
+    ValueError: r: r = 0.9995 is outside the range of r where P(x, v) is verified, ...
+    """
+    try:
+        exact = parse_restitution(value, where)
+    except ValueError as error:
+        raise ValueError(
+            f"{error}; the range of r where P(x, v) is verified is "
+            f"{_range_text(DISTRIBUTION_RESTITUTION_RANGE)}"
+        ) from None
+    if not in_range(exact, DISTRIBUTION_RESTITUTION_RANGE):
+        raise ValueError(
+            f"{where}: r = {value!r} is outside the range of r where P(x, v) is verified, "
+            f"{_range_text(DISTRIBUTION_RESTITUTION_RANGE)}, where w(F), P(x) and P(x, v) meet "
+            "the 1e-8 accuracy target (restitution.DISTRIBUTION_RESTITUTION_RANGE, "
+            "docs/distribution.md#where-it-degrades); P(0, v) alone is solved over the solver's "
+            f"range of r, {_range_text(SOLVER_RESTITUTION_RANGE)}"
         )
     return exact
 

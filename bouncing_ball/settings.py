@@ -21,6 +21,7 @@ __all__ = [
     "MAX_MIN_STEP_FLOOR",
     "MAX_SHARDS",
     "real_number",
+    "whole_number",
     "DEFAULT_SPEED_BINS",
     "DEFAULT_POSITION_BINS",
     "DEFAULT_VELOCITY_BINS",
@@ -58,7 +59,7 @@ DEFAULT_VELOCITY_BINS = LinearBins(-24.0, 20.0, 0.25)
 DEFAULT_FLIGHT_TIME_BINS = LogBins(1.0e-12, 1.0e3, 5)
 #: Outgoing speeds again, 1e-10 to 1000 at 100 bins per decade: fine enough that the
 #: return-speed law of eq. (kernel3) hardly varies within a bin, for the return-law control
-#: of P(0, v) (``histograms.return_law_prediction``).  Not a setting: every shard records it.
+#: of P(0, v) (``estimators.return_law_prediction``).  Not a setting: every shard records it.
 RETURN_LAW_SPEED_BINS = LogBins(1.0e-10, 1.0e3, 100)
 
 
@@ -227,6 +228,46 @@ class ShardSettings:
         ShardSettings
         """
         return replace(self, **changes)
+
+
+def whole_number(value, name: str, least: int, most: int | None = None) -> int:
+    """``value`` as an int, if it is a whole number in [``least``, ``most``].
+
+    A Python or numpy integer; a bool is not one.
+
+    Parameters
+    ----------
+    value : object
+        The value given.
+    name : str
+        The argument's name, for the message.
+    least, most : int
+        The bounds, both included (``most`` None: no upper bound).
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    TypeError
+        Naming ``name``, for anything but an integer (a bool, a float, a string, None).
+    ValueError
+        Naming ``name`` and the bound it is outside.
+
+    Examples
+    --------
+    >>> from bouncing_ball.settings import whole_number
+    >>> whole_number(3, "shards", 2)
+    3
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be a whole number, got {value!r}")
+    if value < least:
+        raise ValueError(f"{name} must be >= {least}, got {value}")
+    if most is not None and value > most:
+        raise ValueError(f"{name} must be <= {most}, got {value}")
+    return int(value)
 
 
 def real_number(value, name: str) -> float:

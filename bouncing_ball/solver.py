@@ -89,7 +89,7 @@ from .kernel import (
     kernel_small_u_limit,
     return_speed_kernel_matrix,
 )
-from .restitution import SOLVER_RESTITUTION_RANGE, in_range, parse_restitution
+from .restitution import SOLVER_RESTITUTION_RANGE, check_solver_range, in_range
 
 __all__ = [
     "DEFAULT_STEP",
@@ -103,6 +103,7 @@ __all__ = [
     "default_highest_speed",
     "OutgoingSpeedSolution",
     "solve_outgoing_speed_density",
+    "solved_outgoing_density",
     "momentum_balance_residual",
     "energy_balance_residual",
     "time_averages",
@@ -476,19 +477,7 @@ def _scaled_operator(restitution, step, lowest_speed, highest_speed):
     tuple
         (r, beta, speeds u_j, log of the scale S, the scaled matrix).
     """
-    exact = parse_restitution(restitution, "restitution")
-    r = float(exact)
-    low, high = SOLVER_RESTITUTION_RANGE
-    if not in_range(exact, (0.0, high)):
-        raise ValueError(
-            f"restitution {restitution} is too close to 1 for the solver: its dense grid grows like "
-            f"(1 - r)^(-1/2) nodes; {low} <= r <= {high} is supported"
-        )
-    if not in_range(exact, (low, 1.0)):
-        raise ValueError(
-            f"restitution {restitution} is too small for the solver: P(0, v) ~ exp(-v / (2r)) "
-            f"leaves the range of doubles; {low} <= r <= {high} is supported"
-        )
+    r = float(check_solver_range(restitution, "restitution"))
     if not 0.0 < step <= LARGEST_STEP:
         raise ValueError(
             f"step = {step}: the quadrature step must lie in (0, {LARGEST_STEP}] (the error grows "
@@ -575,6 +564,39 @@ def solve_outgoing_speed_density(
     unnormalised = OutgoingSpeedSolution(r, beta, step, speeds, density, eigenvalue)
     norm = (r / (1.0 + r)) / unnormalised.moment(2)
     return OutgoingSpeedSolution(r, beta, step, speeds, density * norm, eigenvalue)
+
+
+@functools.lru_cache(maxsize=8)
+def solved_outgoing_density(restitution):
+    """The solver's P(0, u) of eq. (inteq) at r as a function of u, or None out of range.
+
+    What the estimators' return-law and flight-law controls are built from
+    (``estimators.outgoing_speed_histogram``, ``estimators.position_moments_summary``); None
+    outside the solver's range of r.
+
+    Solved once per process and r (``solve_outgoing_speed_density`` at ``DEFAULT_STEP``).
+
+    Parameters
+    ----------
+    restitution : fractions.Fraction or float
+        r as parsed (``restitution.parse_restitution``).
+
+    Returns
+    -------
+    callable or None
+        ``OutgoingSpeedSolution.outgoing_speed_density`` (the Nystrom formula, any u >= 0), or
+        None where r lies outside ``restitution.SOLVER_RESTITUTION_RANGE``.
+
+    Examples
+    --------
+    >>> from fractions import Fraction
+    >>> from bouncing_ball.solver import solved_outgoing_density
+    >>> print(solved_outgoing_density(Fraction(1, 100)))
+    None
+    """
+    if not in_range(restitution, SOLVER_RESTITUTION_RANGE):
+        return None
+    return solve_outgoing_speed_density(restitution).outgoing_speed_density
 
 
 def momentum_balance_residual(solution) -> float:

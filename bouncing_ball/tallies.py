@@ -120,7 +120,7 @@ HISTOGRAMS_2D = {
 #: step's start state; in every set of control variates (``RATE_CONTROLS``, ``MOMENT_CONTROLS``).
 CONTROL_VARIATE_SUMS = ("noise_sum", "noise_v_sum", "noise_scaled_sum", "normal_sum")
 #: More such sums, with weights polynomial in the step's start state, that correct the moments
-#: of x and the flights (``histograms.position_moments_summary``); xi_n = sqrt(2 dt_n) normal_r,
+#: of x and the flights (``estimators.position_moments_summary``); xi_n = sqrt(2 dt_n) normal_r,
 #: q_n = xi_n^2 - 2 dt_n and eta_n = dt_n^(3/2) normal_s, the noises of eqs. (xstep), (vstep).
 MOMENT_CONTROL_SUMS = (
     "noise_x_sum",
@@ -139,19 +139,19 @@ MOMENT_CONTROL_SUMS = (
     "position_noise_x_sum",
 )
 #: The control variates of the summary's moments (I, <x>, Delta x, the flights' moments):
-#: all the sums of mean 0 (``histograms.moment_controls``).
+#: all the sums of mean 0 (``estimators.moment_controls``).
 MOMENT_CONTROLS = (*CONTROL_VARIATE_SUMS, *MOMENT_CONTROL_SUMS)
 #: The fewer control variates of the summary's moments with few shards, and those of the bins
 #: of P(0, v), P(x) and <v^2>_x.
 RATE_CONTROLS = (*CONTROL_VARIATE_SUMS, "noise_squared_sum")
 #: The shards per control variate that a correction needs: with fewer, the jackknife error
-#: of the corrected estimate scatters so much that z has heavy tails (``histograms.shard_controls``).
+#: of the corrected estimate scatters so much that z has heavy tails (``estimators.shard_controls``).
 SHARDS_PER_CONTROL = 3
 #: The fraction of the recording whose steps ``EARLY_SUMS`` sum over: those that start before
 #: ``EARLY_FRACTION`` x shard_time.
 EARLY_FRACTION = 0.125
 #: The time, collisions, int x dt and int x^2 dt over the early part of the recording
-#: (``EARLY_FRACTION``): the shard's own evidence of equilibration (``equilibration``).
+#: (``EARLY_FRACTION``): the shard's own evidence of equilibration (``simulation.equilibration``).
 EARLY_SUMS = ("early_time", "early_collisions", "early_int_x", "early_int_x2")
 #: The scalars of a shard, in their order in its table and in the array a compiled shard loop
 #: fills: the totals, then ``CONTROL_VARIATE_SUMS``, ``EARLY_SUMS`` and ``MOMENT_CONTROL_SUMS``.
@@ -278,11 +278,11 @@ class ShardTallies:
         overflow bins.
     return_law_speed_counts : numpy.ndarray of int64
         Collisions by outgoing speed on the fine ``settings.RETURN_LAW_SPEED_BINS``, for the
-        return-law control of P(0, v) (``histograms.return_law_prediction``).
+        return-law control of P(0, v) (``estimators.return_law_prediction``).
     bounce_lag_sums : numpy.ndarray
         Shape (len(BOUNCE_LAG_SUMS), BOUNCE_LAGS + 1): for each sum of ``BOUNCE_LAG_SUMS``
         (a row) and lag k = 0 .. BOUNCE_LAGS (a column), the sum over the pairs of bounces k
-        apart; the autocorrelations of the bounce chain (``histograms.bounce_autocorrelation``).
+        apart; the autocorrelations of the bounce chain (``estimators.bounce_autocorrelation``).
     position_time, position_v2_time : numpy.ndarray
         Time spent in each height bin (P(x)) and int v^2 dt over it (<v^2>_x, eq. (moment2)).
     position_velocity_time : numpy.ndarray

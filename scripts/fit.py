@@ -6,7 +6,7 @@ import logging
 import numpy as np
 
 from bouncing_ball import fits
-from bouncing_ball.histograms import outgoing_speed_histogram
+from bouncing_ball.estimators import outgoing_speed_histogram
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 from bouncing_ball.workflow.io import SOLVER_P0V, UnreadableFileError, read_table, write_table
 from bouncing_ball.workflow.jobs import job_log

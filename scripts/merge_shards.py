@@ -3,17 +3,11 @@ flight-time density, the return speeds, and the summary (<x>, Delta x, I, the fl
 moments), the bounce chain's autocorrelation and decay rate ->
 results/simulation/r{r}/{p0v,position,distribution,flight_time,return_speed,summary,
 bounce_chain}.parquet.  Refused where the shards' early parts disagree with the rest beyond doubt
-(``equilibration``), a warning where they disagree less; the check goes into the provenance."""
+(``simulation.equilibration``), a warning where they disagree less; the check goes into the provenance."""
 
 import logging
 
-from bouncing_ball.equilibration import (
-    early_check,
-    early_check_message,
-    early_check_record,
-    relaxation_record,
-)
-from bouncing_ball.histograms import (
+from bouncing_ball.estimators import (
     bounce_autocorrelation,
     bounce_chain_decay,
     distribution_histogram,
@@ -25,6 +19,13 @@ from bouncing_ball.histograms import (
 )
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
 from bouncing_ball.settings import ShardSettings
+from bouncing_ball.simulation.equilibration import (
+    early_check,
+    early_check_message,
+    early_check_record,
+    relaxation_record,
+)
+from bouncing_ball.solver import solved_outgoing_density
 from bouncing_ball.workflow.io import write_tables
 from bouncing_ball.workflow.jobs import job_log
 from bouncing_ball.workflow.shards import read_shards
@@ -65,10 +66,12 @@ with job_log(snakemake.log[0], exit_when_done=True):
         logging.warning(message)
     else:
         logging.info(early_check_message(equilibration, label))
-    summary = position_moments_summary(shards, float(exact))
+    # the solver's P(0, u), which the controlled estimates lean on (the estimators never solve)
+    theory = solved_outgoing_density(exact)
+    summary = position_moments_summary(shards, exact, theory)
     write_tables(
         {
-            snakemake.output.p0v: outgoing_speed_histogram(shards, exact),
+            snakemake.output.p0v: outgoing_speed_histogram(shards, exact, theory),
             snakemake.output.position: position_histogram(shards),
             snakemake.output.distribution: distribution_histogram(shards),
             snakemake.output.flight_time: flight_time_histogram(shards),

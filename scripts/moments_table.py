@@ -5,8 +5,8 @@ there is none) -> results/tables/moments.csv (one row per r and quantity) and mo
 
 import logging
 
-from bouncing_ball.comparison import moment_rows, moments_markdown, moments_table
 from bouncing_ball.restitution import parse_restitution
+from bouncing_ball.validation import moment_rows, moments_markdown, moments_table
 from bouncing_ball.workflow.io import (
     EXACT_SUMMARY,
     SIMULATED_SUMMARY,

@@ -2,7 +2,7 @@
 measured from the solver's P(x) (eq. (P(x)1)) against their predictions ->
 results/tables/position_asymptotics.{csv,md}."""
 
-from bouncing_ball.comparison import position_asymptotics_markdown, position_asymptotics_table
+from bouncing_ball.validation import position_asymptotics_markdown, position_asymptotics_table
 from bouncing_ball.workflow.io import SOLVER_SUMMARY, read_table, write_csv_and_markdown
 from bouncing_ball.workflow.jobs import job_log
 

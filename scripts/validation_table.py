@@ -7,13 +7,13 @@ validation.md.  The shards' batch files give the chi^2/n rows their sign-flip p-
 import logging
 from pathlib import Path
 
-from bouncing_ball.comparison import (
+from bouncing_ball.restitution import parse_restitution
+from bouncing_ball.validation import (
     shard_ratios,
     validation_markdown,
     validation_rows,
     validation_table,
 )
-from bouncing_ball.restitution import parse_restitution
 from bouncing_ball.workflow.io import (
     FITS,
     SIMULATED_P0V,

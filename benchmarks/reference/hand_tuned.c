@@ -403,7 +403,7 @@ static void mean_path_integrals(double a0, double a1, double a2, double a3, doub
     *int_x2 = int_m2 + int_var;
 }
 
-/* simulation._bin_index: 0 underflow, n + 1 overflow, edges[0..n] */
+/* simulation.step_tallies._bin_index: 0 underflow, n + 1 overflow, edges[0..n] */
 static int64_t bin_index(double value, double log_lo, double per_ln, int64_t n, const double *edges)
 {
     if (value < edges[0])

@@ -11,9 +11,10 @@
  *       level_time_one_step, level_time, cubic_level_time, slope_zeros,
  *       monotone_piece_end, first_crossing_time, bridge_sample,
  *       bridge_speed_squared_given_position
- *   bouncing_ball/simulation.py: _bin_index, _log_bin_index, _linear_bin_index, _walked_bin_index,
- *       _tally_position, _tally_step, _bridge_correction, floor_stratum_end,
- *       _tally_second_bridge_point, _run
+ *   bouncing_ball/simulation/step_tallies.py: _bin_index, _log_bin_index, _linear_bin_index,
+ *       _walked_bin_index, _tally_position, _tally_step, _bridge_correction, floor_stratum_end,
+ *       _tally_second_bridge_point
+ *   bouncing_ball/simulation/loop.py: _run
  *
  * (translated from the committed versions of those files).  Every floating-point
  * operation is the same as in the Python source and in the same order (same
@@ -84,7 +85,7 @@
 #define SMALLEST_NORMAL DBL_MIN /* np.finfo(np.float64).tiny */
 #define ROOT_TOLERANCE 2.0e-3
 
-/* simulation.py */
+/* simulation/loop.py, simulation/step_tallies.py */
 #define COLLAPSED_STEP 1.0e-80
 #define FLOOR_STRATUM_HEIGHT 0.1
 /* the layout of the scalars (bouncing_ball.tallies.SCALARS, its one definition):
@@ -456,7 +457,7 @@ static inline double bridge_speed_squared_given_position(double a1, double a2, d
     return mean * mean + 0.5 * dt * w;
 }
 
-/* ---------------------------------------------------------------- simulation.py */
+/* ------------------------------------------- simulation/step_tallies.py, simulation/loop.py */
 
 static inline int64_t linear_bin_index(double value, double lo, double per_unit, int64_t n,
                                        const double *edges)

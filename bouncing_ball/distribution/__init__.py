@@ -13,7 +13,7 @@ with phi of eq. (phi) at s = 1/4.  The modules, in the order they build on each 
 - ``ray_density``: P(0, v) on a ray arg v = RAY_ANGLE, solved from eq. (inteq) on that ray, for
   r near 1;
 - ``outgoing_density``: P(0, v) as w(F) needs it, on the real axis and in the wedge
-  0 <= arg v <= THETA_MAX (``outgoing_speed_solution``, ``check_restitution``);
+  0 <= arg v <= THETA_MAX (``outgoing_speed_solution``);
 - ``weight_function``: w(F) by contour integrals of h(v) (``log_weight_function``), its
   small-F law w ~ F^gamma e^(-S/F) (``small_force_decay``, ``small_force_power``);
 - ``interpolated_weight``: w(F) interpolated in ln F (``WeightFunction``), and an exact w(F) in
@@ -22,8 +22,10 @@ with phi of eq. (phi) at s = 1/4.  The modules, in the order they build on each 
   averages of P(x) in closed form under the F integral;
 - ``phase_space``: P(x, v) by eq. (fpsol) (x > 0), and at x = 0 from P(0, v) and eq. (bc); its
   cell averages;
-- ``exponents``: the asymptotic exponents of P(x), predicted and measured;
-- ``tables``: the tables of the pipeline's rule solve and their checks.
+- ``exponents``: the asymptotic exponents of P(x), predicted and measured.
+
+The tables of the pipeline's rule solve and their checks are the workflow's
+(``bouncing_ball.workflow.solver_tables``).
 
 Every name is importable from ``bouncing_ball.distribution`` itself.
 
@@ -112,11 +114,11 @@ from .outgoing_density import (
     _outgoing_density,
     _OutgoingDensity,
     _panels,
-    check_restitution,
     outgoing_speed_solution,
 )
 from .phase_space import (
     CELL_SPEED_NODES,
+    DISTRIBUTION_NOISE,
     FORCE_CHECK_NODES,
     FORCE_CHECK_PHASE,
     FORCE_RULE_GRID,
@@ -177,16 +179,6 @@ from .ray_density import (
     _w,
     _x,
 )
-from .tables import (
-    DISTRIBUTION_NOISE,
-    EXPONENT_TOLERANCES,
-    _non_finite_defects,
-    check_solve_tables,
-    distribution_table,
-    position_table,
-    solve_table_defects,
-    weight_table,
-)
 from .weight_function import (
     _KERNEL_TRANSFORMS,
     _RAY_PANEL_W,
@@ -235,9 +227,7 @@ __all__ = [
     "PANEL_CHEBYSHEV_NODES",
     "NOISE_TOLERANCE",
     "CELL_SPEED_NODES",
-    "EXPONENT_TOLERANCES",
     "DISTRIBUTION_NOISE",
-    "check_restitution",
     "outgoing_speed_solution",
     "small_force_decay",
     "small_force_power",
@@ -258,12 +248,7 @@ __all__ = [
     "distribution_cell_average",
     "distribution_with_error",
     "distribution",
-    "weight_table",
-    "position_table",
-    "distribution_table",
     "predicted_exponents",
     "measured_exponents",
     "exponents_table",
-    "solve_table_defects",
-    "check_solve_tables",
 ]

@@ -17,7 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .outgoing_density import _outgoing_density, check_restitution
+from ..restitution import check_distribution_range
+from .outgoing_density import _outgoing_density
 from .weight_function import (
     _log_weight_with_noise,
     log_weight_function,
@@ -305,7 +306,7 @@ def interpolated_weight_function(solution, panel_nodes=PANEL_CHEBYSHEV_NODES) ->
     >>> print(weight([0.1, 1.0]).round(8))  # doctest: +SKIP
     [0.22905337 0.15334074]
     """
-    check_restitution(solution.restitution)
+    check_distribution_range(solution.restitution, "solution.restitution")
     density = _outgoing_density(solution)
     decay = small_force_decay(solution.restitution)
     # below (S + 1/12)/200, F^(-1/2) w e^(-1/(12F)) < e^-200 of its largest values

@@ -1,8 +1,8 @@
 """P(0, v) as w(F) of eq. (weightfunc) needs it: on the real axis and at complex v.
 
 ``outgoing_speed_solution`` solves eq. (inteq) out to where P(0, v) falls to e^-690 (w(F) at
-small F needs P(0, v) far out), and ``check_restitution`` holds r to the range where w(F), P(x)
-and P(x, v) are computed to the solver's accuracy.  ``_outgoing_density`` turns a solution into
+small F needs P(0, v) far out), and ``restitution.check_distribution_range`` holds r to the range where
+w(F), P(x) and P(x, v) are verified.  ``_outgoing_density`` turns a solution into
 ``_OutgoingDensity``: ln P(0, v) on the real axis by Chebyshev panels in s = ln v + v^(1/2), and
 P(0, v) e^(q v) at complex v by the Nystrom formula of ``complex_kernel`` on a u grid REFINE
 times finer than the solver's (the trapezoidal rule in ln u loses accuracy as
@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..asymptotics import large_speed_decay_rate
-from ..restitution import DISTRIBUTION_RESTITUTION_RANGE, in_range, parse_restitution
+from ..restitution import check_distribution_range
 from ..solver import (
     DEFAULT_STEP,
     TAIL_EFOLDS,
@@ -44,7 +44,6 @@ from .ray_density import RAY_RESTITUTION, _ray_density
 __all__ = [
     "THETA_MAX",
     "WEDGE_CLEAN",
-    "check_restitution",
     "outgoing_speed_solution",
 ]
 
@@ -117,46 +116,6 @@ _WEDGE_ANGLES = (
 )
 
 
-def check_restitution(restitution) -> float:
-    """r as a float, if w(F), P(x) and P(x, v) are computed to the solver's accuracy there.
-
-    Parameters
-    ----------
-    restitution : float or str
-        r, a float or an exact fraction string ("1/3").
-
-    Returns
-    -------
-    float
-        r, if it lies in ``restitution.DISTRIBUTION_RESTITUTION_RANGE``.
-
-    Raises
-    ------
-    ValueError
-        Naming r and the range, if r lies outside it (P(0, v) alone, ``bouncing_ball.solver``,
-        reaches further).
-
-    Examples
-    --------
-    >>> from bouncing_ball.distribution import check_restitution
-    >>> print(check_restitution("1/3"), check_restitution(0.6))
-    0.3333333333333333 0.6
-    >>> check_restitution(0.9995)
-    Traceback (most recent call last):
-    ...
-    ValueError: restitution 0.9995: w(F), P(x) and P(x, v) are computed to 1e-8 only for ...
-    """
-    exact = parse_restitution(restitution, "restitution")
-    if not in_range(exact, DISTRIBUTION_RESTITUTION_RANGE):
-        low, high = DISTRIBUTION_RESTITUTION_RANGE
-        raise ValueError(
-            f"restitution {restitution}: w(F), P(x) and P(x, v) are computed to 1e-8 only for "
-            f"{low} <= r <= {high} (docs/distribution.md#where-it-degrades); P(0, v) alone "
-            "(bouncing_ball.solver) reaches r = 0.9999"
-        )
-    return float(exact)
-
-
 def outgoing_speed_solution(restitution, step=DEFAULT_STEP):
     """P(0, v) of eq. (inteq), solved out to where it falls to exp(-690), as w(F) needs it.
 
@@ -168,7 +127,7 @@ def outgoing_speed_solution(restitution, step=DEFAULT_STEP):
     ----------
     restitution : float or str
         r, a float or a fraction string ("1/3"), in ``DISTRIBUTION_RESTITUTION_RANGE``
-        (``check_restitution``).
+        (``restitution.check_distribution_range``).
     step : float, optional
         The solver's quadrature step in s = ln u + u^(1/2) (``solver.DEFAULT_STEP``).
 
@@ -194,7 +153,7 @@ def outgoing_speed_solution(restitution, step=DEFAULT_STEP):
     >>> print(solution.outgoing_speed_density([0.5, 1.0]).round(8))  # doctest: +SKIP
     [0.40435377 0.12262648]
     """
-    r = check_restitution(restitution)
+    r = float(check_distribution_range(restitution, "restitution"))
     q = large_speed_decay_rate(r)
     return solve_outgoing_speed_density(r, step=step, highest_speed=0.985 * UNDERFLOW_EFOLDS / q)
 

@@ -22,12 +22,21 @@ from ..airy import (
 from .position import _total_decay
 
 __all__ = [
+    "DISTRIBUTION_NOISE",
     "CELL_SPEED_NODES",
     "distribution_by_force_integral",
     "distribution_cell_average",
     "distribution_with_error",
     "distribution",
 ]
+
+
+#: P(x, v) at x > 0 by the F integral of eq. (fpsol) is accurate to about this fraction of its
+#: largest value at that x (w(F) is known to ~1e-10 relative, and the oscillating Airy factor
+#: cancels): far-tail values below it are noise of either sign (at r = 0.05, x = 0.0126,
+#: v = 2.3 to 6: +-9e-11 where the peak is 3.4; the quadrature's own error estimate does not
+#: see it).
+DISTRIBUTION_NOISE = 1e-10
 
 
 def _distribution_integrand(log_force, x, v, weight, width=0.0):

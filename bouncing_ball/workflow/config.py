@@ -24,9 +24,9 @@ from ..equilibrium import check_solver_settings
 from ..restitution import (
     EXACT_RESTITUTIONS,
     SOLVER_RESTITUTION_RANGE,
-    check_solver_restitution,
+    check_distribution_range,
+    check_solver_range,
     exact_string,
-    in_range,
     parse_restitution,
     restitution_grid,
     restitution_label,
@@ -191,14 +191,9 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
             f"got min = {solver_grid['min']}, max = {solver_grid['max']}"
         )
     for index, value in enumerate(config["restitution"]):
-        check_solver_restitution(value, f"restitution[{index}]")  # every r of the run is solved
+        check_distribution_range(value, f"restitution[{index}]")  # every r of the run is solved
     for index, value in enumerate(config["figures"]["fig13"]):  # P(0, v) alone
-        where = f"figures.fig13[{index}]"
-        if not in_range(parse_restitution(value, where), SOLVER_RESTITUTION_RANGE):
-            raise ValueError(
-                f"{where}: r = {value!r} is outside the solver's range {low} <= r <= {high} "
-                "for P(0, v) (solver.restitution_grid)"
-            )
+        check_solver_range(value, f"figures.fig13[{index}]")
     known = {**figure_restitutions(config, grid), **grid}
     for side in ("small_speed_window", "large_speed_window"):
         window = config["fits"][side]
@@ -421,7 +416,7 @@ def figure_restitutions(config: dict, grid: dict | None = None) -> dict[str, Fra
                     f"{where}: r = {values[index]!r} has no exact solution (only 1/2 and 1/3)"
                 )
             if figure != "fig5":  # drawn with the solver's answers
-                check_solver_restitution(values[index], where)
+                check_distribution_range(values[index], where)
             for other in (grid, shown):
                 if label in other and other[label] != value:
                     raise ValueError(shared_label_message(where, value, other[label]))
@@ -436,15 +431,15 @@ def known_restitutions(config: dict) -> dict[str, Fraction]:
 
 
 #: ``simulation.equilibration_time`` (or an override's) that follows from the relaxation time
-#: at each r: ``equilibration.default_equilibration_time``
+#: at each r: ``simulation.equilibration.default_equilibration_time``
 AUTO_EQUILIBRATION = "auto"
 
 
 def simulation_settings(config: dict, label: str) -> dict:
     """The simulation parameters of one r: the defaults with its overrides applied, and
-    ``equilibration_time: auto`` replaced by ``equilibration.default_equilibration_time`` at
+    ``equilibration_time: auto`` replaced by ``simulation.equilibration.default_equilibration_time`` at
     that r (the r of ``restitution`` or the figures with that label; for the label "", which
-    no r has, by ``equilibration.MIN_EQUILIBRATION_TIME``)."""
+    no r has, by ``simulation.equilibration.MIN_EQUILIBRATION_TIME``)."""
     simulation = config["simulation"]
     settings = {"min_step_floor": 0.0}  # optional key: the paper's rule alone
     settings.update({k: v for k, v in simulation.items() if k != "per_restitution"})
@@ -454,7 +449,7 @@ def simulation_settings(config: dict, label: str) -> dict:
     if settings["equilibration_time"] == AUTO_EQUILIBRATION:
         # imported here: the relaxation time needs the solver (scipy, numba), which importing
         # this module does not load
-        from ..equilibration import MIN_EQUILIBRATION_TIME, default_equilibration_time
+        from ..simulation.equilibration import MIN_EQUILIBRATION_TIME, default_equilibration_time
 
         settings["equilibration_time"] = (
             default_equilibration_time(_restitution_of_label(config, label))
@@ -483,8 +478,8 @@ def _restitution_of_label(config: dict, label: str) -> Fraction:
 def check_equilibration(config: dict) -> None:
     """Refuse, naming r, the relaxation time and the key, a simulated r whose shards
     (``simulation_settings``) are too short for the relaxation time there
-    (``equilibration.equilibration_problems``), before any job runs."""
-    from ..equilibration import equilibration_problems
+    (``simulation.equilibration.equilibration_problems``), before any job runs."""
+    from ..simulation.equilibration import equilibration_problems
 
     for label, exact in known_restitutions(config).items():
         settings = simulation_settings(config, label)

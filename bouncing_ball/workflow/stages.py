@@ -17,18 +17,19 @@ SIMULATION = (
     "pcg64",
     "restitution",
     "settings",
-    "simulation",
+    "simulation.loop",
+    "simulation.step_tallies",
     "tallies",
 )
 # reading a job's batch files back and merging their shards (workflow.shards checks each file's
 # provenance against the config with workflow.audit); the return-law and flight-law controls of
-# histograms read the return-speed law and the flight times (flight_time, kernel) and the
+# the estimators read the return-speed law and the flight times (flight_time, kernel) and the
 # solver's P(0, v) (solver, asymptotics, jit)
 READ_SHARDS = (
     "asymptotics",
     "bins",
+    "estimators",
     "flight_time",
-    "histograms",
     "jit",
     "kernel",
     "solver",
@@ -41,7 +42,7 @@ READ_SHARDS = (
     "workflow.io",
     "workflow.shards",
 )
-MERGE = (*READ_SHARDS, "equilibration")
+MERGE = (*READ_SHARDS, "simulation.equilibration")
 SOLVER = (
     "airy",
     "asymptotics",
@@ -60,18 +61,18 @@ EXACT = ("airy", "bins", "exact")
 THEORY = ("asymptotics", "bins")
 FITS = (*READ_SHARDS, "asymptotics", "fits")
 PLOTTING = ("parquet", "workflow.io", "workflow.plotting", "restitution")
-COMPARISON = ("comparison", "fits", "parquet", "workflow.io", "restitution")
+COMPARISON = ("validation", "fits", "parquet", "workflow.io", "restitution")
 # the studies' reports (workflow/rules/studies.smk); their shards are SIMULATION's; the
 # exact moments of the coverage report are ExactEquilibrium's (equilibrium)
 STUDIES = (
     *READ_SHARDS,
     "airy",
-    "comparison",
     "equilibrium",
     "exact",
     "fits",
+    "validation",
     "workflow.studies",
 )
 # results/tables/validation: the comparison, the exact bin averages, the solver curve's bin
 # averages, and the shards read back for the sign-flip p-values
-VALIDATION = (*READ_SHARDS, "airy", "comparison", "exact", "fits")
+VALIDATION = (*READ_SHARDS, "airy", "exact", "fits", "validation")

@@ -6,8 +6,8 @@ and P(0, v)), with what a run cost.  r075: runs at r = 3/4 against the solver, a
 pooled, and how far their jackknife errors can be trusted: per-shard spread, errors from
 batches of shards, groups of shards, and the shape of the per-shard distribution.
 
-Every estimate is the one of the merge stage (``histograms.position_moments_summary`` and
-``histograms.outgoing_speed_histogram``, jackknife errors), applied to all the shards of a
+Every estimate is the one of the merge stage (``estimators.position_moments_summary`` and
+``estimators.outgoing_speed_histogram``, jackknife errors), applied to all the shards of a
 run, to a batch or group of them, or to one shard.
 
 coverage: many independent runs of n shards at r = 1/2 and 1/3 against the exact results;
@@ -23,9 +23,9 @@ import pandas as pd
 from scipy import special, stats
 
 from .. import exact
-from ..comparison import QUANTITIES, SYMBOLS, exact_outgoing_speed_residuals, value_with_error
-from ..histograms import outgoing_speed_histogram, position_moments_summary
+from ..estimators import outgoing_speed_histogram, position_moments_summary
 from ..restitution import parse_restitution
+from ..validation import QUANTITIES, SYMBOLS, exact_outgoing_speed_residuals, value_with_error
 from .shards import read_shards
 
 
@@ -177,7 +177,7 @@ def shape(values) -> tuple[float, float]:
 
 def outgoing_speed_check(shards, restitution, minimum_count: int) -> dict:
     """The simulated P(0, v) (bin averages, jackknife errors) against the exact one
-    (``comparison.exact_outgoing_speed_residuals``) over the finite bins with at least
+    (``validation.exact_outgoing_speed_residuals``) over the finite bins with at least
     ``minimum_count`` collisions: their number, chi^2 / n of their z and the largest ``abs(z)``."""
     table = outgoing_speed_histogram(shards)
     z = exact_outgoing_speed_residuals(table[table["count"] >= minimum_count], restitution).residual

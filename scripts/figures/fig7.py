@@ -3,8 +3,8 @@ one row per simulated r; the solver enters as its average over each bin."""
 
 import logging
 
-from bouncing_ball.comparison import outgoing_speed_residuals
 from bouncing_ball.restitution import parse_restitution
+from bouncing_ball.validation import outgoing_speed_residuals
 from bouncing_ball.workflow import plotting
 from bouncing_ball.workflow.io import SIMULATED_P0V, SOLVER_P0V, read_tables_of_one_restitution
 from bouncing_ball.workflow.jobs import job_log

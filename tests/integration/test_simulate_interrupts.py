@@ -15,10 +15,12 @@ import numpy as np
 import pytest
 
 import bouncing_ball as bb
-from bouncing_ball.monte_carlo import SimulationResult
+from bouncing_ball.simulation import SimulationResult
 
 # shards of a few relaxation times: what is tested is how runs stop, not their errors
-pytestmark = pytest.mark.filterwarnings("ignore::bouncing_ball.equilibration.EquilibrationWarning")
+pytestmark = pytest.mark.filterwarnings(
+    "ignore::bouncing_ball.simulation.equilibration.EquilibrationWarning"
+)
 
 # a child that interrupts itself (SIGINT, as a terminal or a notebook kernel gets it) `delay`
 # seconds after `after` shards have finished, and reports what simulate raised and how long it
@@ -26,25 +28,25 @@ pytestmark = pytest.mark.filterwarnings("ignore::bouncing_ball.equilibration.Equ
 _INTERRUPTED_CHILD = """
 import os, signal, sys, threading, time
 import bouncing_ball as bb
-from bouncing_ball import monte_carlo
+from bouncing_ball.simulation import run
 
 def interrupt():
-    monte_carlo.sent = time.perf_counter()
+    run.sent = time.perf_counter()
     os.killpg(0, signal.SIGINT) if {group} else os.kill(os.getpid(), signal.SIGINT)
 
 def interrupt_after(self, done):
-    if done == {after} and not hasattr(monte_carlo, "scheduled"):
-        monte_carlo.scheduled = True
+    if done == {after} and not hasattr(run, "scheduled"):
+        run.scheduled = True
         threading.Timer({delay}, interrupt).start() if {delay} else interrupt()
 
-monte_carlo._Progress.show = interrupt_after
+run._Progress.show = interrupt_after
 if __name__ == "__main__":
     try:
         bb.simulate(0.6, shards={shards}, shard_time={shard_time}, seed=1, processes={processes},
                     settings={{"equilibration_time": 10.0}}, progress=False)
         print("RETURNED")
     except KeyboardInterrupt as error:
-        stopped = time.perf_counter() - monte_carlo.sent
+        stopped = time.perf_counter() - run.sent
         result = error.result
         if result is None:
             print(type(error).__name__, f"{{stopped:.3f}}", len(error.finished), error)

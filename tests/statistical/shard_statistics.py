@@ -5,7 +5,7 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 from default_settings import DEFAULT_SETTINGS as DEFAULT_CONFIG_SETTINGS
 
-from bouncing_ball.histograms import outgoing_speed_density, outgoing_speed_histogram
+from bouncing_ball.estimators import outgoing_speed_density, outgoing_speed_histogram
 from bouncing_ball.restitution import restitution_label
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 

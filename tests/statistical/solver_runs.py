@@ -10,7 +10,7 @@ import numpy as np
 from shard_statistics import simulate_shards
 
 from bouncing_ball.bins import LinearBins
-from bouncing_ball.comparison import sign_flip_test
+from bouncing_ball.validation import sign_flip_test
 
 SHARDS = 16
 SEED = 20061123
@@ -41,7 +41,7 @@ def times(run):
 
 def assert_agrees(per_shard, expected):
     """Shard-level values (shards x bins) agree with ``expected``: chi^2 and the worst bin
-    against the sign-flip null (``comparison.sign_flip_test``), p > 1e-3 each."""
+    against the sign-flip null (``validation.sign_flip_test``), p > 1e-3 each."""
     chi2_per_dof, p_chi2, p_worst = sign_flip_test(per_shard - expected)
     error = per_shard.std(axis=0, ddof=1) / np.sqrt(SHARDS)
     z = (per_shard.mean(axis=0) - expected) / error

@@ -15,8 +15,8 @@ from shard_statistics import outgoing_speed_bins, simulate_shards
 from bouncing_ball import solver
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION, small_speed_exponent
 from bouncing_ball.bins import outgoing_speed_bin_average
-from bouncing_ball.comparison import sign_flip_test
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
+from bouncing_ball.validation import sign_flip_test
 
 R = 0.05
 FLOOR = 1.0e-12  # noise (2 delta)^(1/2) = 1.4e-6, 70 times below the lowest bin compared

@@ -15,8 +15,9 @@ from shard_statistics import simulate_shards
 
 from bouncing_ball import exact
 from bouncing_ball.bins import LinearBins
-from bouncing_ball.comparison import sign_flip_test
-from bouncing_ball.histograms import position_moments_summary
+from bouncing_ball.estimators import position_moments_summary
+from bouncing_ball.solver import solved_outgoing_density
+from bouncing_ball.validation import sign_flip_test
 
 R = Fraction(1, 2)
 SHARDS = 16
@@ -82,7 +83,7 @@ def test_distribution_matches_the_exact_solution_cell_by_cell(shards):
 def test_mean_flight_time_is_one_over_the_collision_rate(shards):
     """Within 3 standard errors.  Smallest error rejected: 2% (relative error below 0.5%,
     asserted; z = 4)."""
-    summary = position_moments_summary(shards, float(R)).iloc[0]
+    summary = position_moments_summary(shards, R, solved_outgoing_density(R)).iloc[0]
     expected = 1.0 / exact.position_moments(R)["collision_rate"]  # 3
     value, error = summary.mean_flight_time, summary.mean_flight_time_err
     assert error / expected <= 0.005, "run too short for a sharp test"

@@ -15,7 +15,7 @@ from distribution_support import build
 from solver_runs import MINIMUM_TIME_FRACTION, SHARDS, assert_agrees, shards, times
 
 from bouncing_ball import distribution
-from bouncing_ball.comparison import sign_flip_test
+from bouncing_ball.validation import sign_flip_test
 
 RESTITUTIONS = [0.25, 0.75]
 # v bins of the simulation joined per cell, per r

@@ -6,7 +6,7 @@ import pytest
 from fit_support import CASES, SHARDS, _bins, synthetic_shards
 
 from bouncing_ball import fits
-from bouncing_ball.histograms import jackknife, outgoing_speed_density
+from bouncing_ball.estimators import jackknife, outgoing_speed_density
 
 
 @pytest.mark.parametrize("side", list(CASES))

@@ -27,8 +27,9 @@ import pytest
 from solver_runs import MINIMUM_COUNT, SHARDS, assert_agrees, shards
 
 from bouncing_ball import flight_time, solver
-from bouncing_ball.comparison import sign_flip_test
-from bouncing_ball.histograms import position_moments_summary
+from bouncing_ball.estimators import position_moments_summary
+from bouncing_ball.solver import solved_outgoing_density
+from bouncing_ball.validation import sign_flip_test
 
 RESTITUTIONS = [0.25, Fraction(1, 3), Fraction(1, 2), 0.75]
 
@@ -130,7 +131,7 @@ MOMENTS = {
 def _moment_z(r, quantity, scale=1.0):
     """z of the simulated moment against the theory's scaled by ``scale``, and the
     relative error."""
-    summary = position_moments_summary(shards(r), float(r)).iloc[0]
+    summary = position_moments_summary(shards(r), r, solved_outgoing_density(r)).iloc[0]
     value, error = summary[quantity], summary[f"{quantity}_err"]
     expected = scale * MOMENTS[quantity](_solution(r))
     return (value - expected) / error, error / expected

@@ -26,10 +26,11 @@ import pytest
 from exact_results import TIME_AVERAGES
 from shard_statistics import DEFAULT_SETTINGS
 
-from bouncing_ball.comparison import outgoing_speed_checks, shard_ratios
-from bouncing_ball.histograms import outgoing_speed_histogram, position_moments_summary
+from bouncing_ball.estimators import outgoing_speed_histogram, position_moments_summary
 from bouncing_ball.settings import MIN_CRITERION_C
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
+from bouncing_ball.solver import solved_outgoing_density
+from bouncing_ball.validation import outgoing_speed_checks, shard_ratios
 
 HALF = Fraction(1, 2)
 SHARDS = 64  # as the default run: all of MOMENT_CONTROLS and the flight-law controls
@@ -57,7 +58,11 @@ def wrong(request):
         shards = list(
             pool.map(_shard, [(restitution, criterion_c, shard_time, k) for k in range(SHARDS)])
         )
-    return request.param, shards, position_moments_summary(shards, HALF).iloc[0]
+    return (
+        request.param,
+        shards,
+        position_moments_summary(shards, HALF, solved_outgoing_density(HALF)).iloc[0],
+    )
 
 
 def _z(summary, quantity, suffix):
@@ -85,7 +90,7 @@ def test_the_plain_p0v_rejects_the_wrong_simulation(wrong):
     rows = {
         row["check"]: row
         for row in outgoing_speed_checks(
-            outgoing_speed_histogram(shards, HALF),
+            outgoing_speed_histogram(shards, HALF, solved_outgoing_density(HALF)),
             HALF,
             len(shards),
             per_shard=shard_ratios(shards),

@@ -1,5 +1,5 @@
 """The control variates of the moments at r = 1/2 (tallies.MOMENT_CONTROL_SUMS, corrected
-by histograms.position_moments_summary): every sum has mean 0 under the simulated process,
+by estimators.position_moments_summary): every sum has mean 0 under the simulated process,
 and the corrected <x>, Delta x, I and <T> agree with the exact values of eq. (xandDeltax)
 (<T> = 1 / I), <T^2> with the solver's, each with a smaller error than the plain estimate.
 
@@ -15,7 +15,8 @@ from exact_results import TIME_AVERAGES
 from shard_statistics import simulate_shards
 
 from bouncing_ball import flight_time, solver
-from bouncing_ball.histograms import position_moments_summary
+from bouncing_ball.estimators import position_moments_summary
+from bouncing_ball.solver import solved_outgoing_density
 from bouncing_ball.tallies import MOMENT_CONTROL_SUMS, MOMENT_CONTROLS, SHARDS_PER_CONTROL
 
 R = Fraction(1, 2)
@@ -67,7 +68,7 @@ def test_corrected_moments_match_exact_values(shards, quantity):
     """Each corrected moment within 3 of its errors of the exact value, and its error below
     the plain estimate's.  Smallest error rejected (z = 4, relative errors below
     MAX_RELATIVE_ERROR, asserted): 0.32% in <x>, I, <T> and <T^2>, 1.4% in Delta x."""
-    summary = position_moments_summary(shards, float(R)).iloc[0]
+    summary = position_moments_summary(shards, R, solved_outgoing_density(R)).iloc[0]
     value, error = summary[f"{quantity}_controlled"], summary[f"{quantity}_controlled_err"]
     expected = _expected(quantity)
     assert error / expected <= MAX_RELATIVE_ERROR[quantity], "run too short for a sharp test"

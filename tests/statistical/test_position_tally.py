@@ -30,7 +30,7 @@ from bouncing_ball.free_flight import (
     quintic_antiderivative_value,
     speed_squared_coefficients,
 )
-from bouncing_ball.simulation import (
+from bouncing_ball.simulation.step_tallies import (
     _bin_index,
     _bridge_correction,
     _tally_step,

@@ -2,7 +2,7 @@
 
 The ball is simulated (``shard_statistics.simulate_shards``, the default config's settings)
 and each shard tallies the lagged sums of (ln u_n, u_n) over its bounces
-(``tallies.BOUNCE_LAG_SUMS``).  ``histograms.bounce_chain_decay`` fits the decay rate
+(``tallies.BOUNCE_LAG_SUMS``).  ``estimators.bounce_chain_decay`` fits the decay rate
 gamma = -ln lambda of their principal correlation, with a delete-one jackknife error over the
 independent shards; the theory's is -ln lambda_2 of eq. (inteq)'s operator
 (``Equilibrium.relaxation_eigenvalue``, the solver's matrix).  The z-score
@@ -25,7 +25,7 @@ import pytest
 from shard_statistics import simulate_shards
 
 from bouncing_ball.equilibrium import Equilibrium
-from bouncing_ball.histograms import bounce_chain_decay
+from bouncing_ball.estimators import bounce_chain_decay
 
 SHARDS = 32
 SEED = 41

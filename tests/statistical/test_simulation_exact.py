@@ -14,12 +14,13 @@ from exact_results import TIME_AVERAGES
 from shard_statistics import CRITERION_C, outgoing_speed_bins, simulate_shards
 
 from bouncing_ball import exact
-from bouncing_ball.comparison import sign_flip_test
-from bouncing_ball.histograms import (
+from bouncing_ball.estimators import (
     outgoing_speed_histogram,
     position_histogram,
     position_moments_summary,
 )
+from bouncing_ball.solver import solved_outgoing_density
+from bouncing_ball.validation import sign_flip_test
 
 SHARDS = 16
 SHARD_TIME = {Fraction(1, 2): 4.0e5, Fraction(1, 3): 7.0e5}
@@ -45,7 +46,7 @@ def shards(request):
 def test_moments_match_exact_values(shards, r, quantity):
     """<x>, Delta x and I of eq. (xandDeltax) within 3 standard errors.  Smallest error
     rejected: 4 times MAX_RELATIVE_ERROR (asserted), 2.4% in <x>, 4% in Delta x, 1% in I."""
-    summary = position_moments_summary(shards[r], float(r)).iloc[0]
+    summary = position_moments_summary(shards[r], r, solved_outgoing_density(r)).iloc[0]
     value, error = summary[quantity], summary[f"{quantity}_err"]
     expected = TIME_AVERAGES[r][quantity]
     assert error / expected <= MAX_RELATIVE_ERROR[quantity], "run too short for a sharp test"
@@ -56,10 +57,10 @@ def test_moments_match_exact_values(shards, r, quantity):
 @pytest.mark.parametrize("r", list(TIME_AVERAGES), ids=str)
 def test_collision_rate_with_control_variates_matches_exact_value(shards, r):
     """I corrected by the martingale control variates (the summary's
-    collision_rate_controlled, histograms.control_variate_rate): the exact value within 3
+    collision_rate_controlled, estimators.control_variate_rate): the exact value within 3
     errors, an error smaller than the plain estimator's, at each c.  Smallest error rejected:
     0.6% (relative error at most 0.15%, asserted; z = 4)."""
-    summary = position_moments_summary(shards[r], float(r)).iloc[0]
+    summary = position_moments_summary(shards[r], r, solved_outgoing_density(r)).iloc[0]
     value, error = summary["collision_rate_controlled"], summary["collision_rate_controlled_err"]
     expected = TIME_AVERAGES[r]["collision_rate"]
     assert error / expected <= 0.0015, "run too short for a sharp test"
@@ -106,13 +107,13 @@ def test_outgoing_speed_density_rejects_a_small_error(shards, r):
 @pytest.mark.parametrize("r", list(TIME_AVERAGES), ids=str)
 def test_outgoing_speed_density_with_the_return_law_control(shards, r):
     """P(0, v) corrected by its return-law control (``p0v_controlled``,
-    histograms.return_law_prediction, which uses eq. (kernel3) and the solver's P(0, u) only
+    estimators.return_law_prediction, which uses eq. (kernel3) and the solver's P(0, u) only
     to weigh u inside a fine bin) against eq. (P(0,v)) in every bin with 0.01 <= v <= 5:
     every |z| < 5 (with 16 shards z is t-distributed with 15 degrees of freedom: a false
     alarm in about 0.5% of runs over 27 bins), and the worst relative error at most half
     the plain estimator's.  Smallest error rejected: 5 times the largest relative error
     (asserted at most 1%), 5%."""
-    table = outgoing_speed_histogram(shards[r], r)
+    table = outgoing_speed_histogram(shards[r], r, solved_outgoing_density(r))
     band = table[(table.v >= 0.01) & (table.v <= 5.0)]
     truth = exact.outgoing_speed_bin_average(band.v_lo.to_numpy(), band.v_hi.to_numpy(), r)
     relative = (band.p0v_controlled_err / band.p0v_controlled).to_numpy()

@@ -11,8 +11,9 @@ from shard_statistics import outgoing_speed_bins, simulate_shards
 
 from bouncing_ball import fits, solver
 from bouncing_ball.bins import outgoing_speed_bin_average
-from bouncing_ball.comparison import sign_flip_test
-from bouncing_ball.histograms import outgoing_speed_histogram, position_moments_summary
+from bouncing_ball.estimators import outgoing_speed_histogram, position_moments_summary
+from bouncing_ball.solver import solved_outgoing_density
+from bouncing_ball.validation import sign_flip_test
 
 SHARDS = 16
 SHARD_TIME = {0.25: 3.0e5, 0.75: 3.0e6}
@@ -41,7 +42,7 @@ def solutions():
 def test_time_averages_agree(shards, solutions, r, quantity):
     """<x>, Delta x and I against the solver's, within 3 standard errors.  Smallest error
     rejected: 4 times MAX_RELATIVE_ERROR (asserted), 2% in <x>, 4% in Delta x, 1% in I."""
-    summary = position_moments_summary(shards[r], r).iloc[0]
+    summary = position_moments_summary(shards[r], r, solved_outgoing_density(r)).iloc[0]
     value, error = summary[quantity], summary[f"{quantity}_err"]
     expected = solver.time_averages(solutions[r])[quantity]
     assert error / expected <= MAX_RELATIVE_ERROR[quantity], "run too short for a sharp test"
@@ -71,7 +72,7 @@ def test_outgoing_speed_density_with_the_return_law_control(shards, solutions, r
     t with 15 degrees of freedom, a false alarm in about 0.5% of runs over 27 bins) and the
     worst relative error at most half the plain estimator's.  Smallest error rejected: 5
     times the largest relative error (asserted at most 2%), 10%."""
-    table = outgoing_speed_histogram(shards[r], r)
+    table = outgoing_speed_histogram(shards[r], r, solved_outgoing_density(r))
     band = table[(table.v >= 0.01) & (table.v <= 5.0)]
     predicted = outgoing_speed_bin_average(
         solutions[r].outgoing_speed_density, band.v_lo.to_numpy(), band.v_hi.to_numpy()

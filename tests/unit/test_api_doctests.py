@@ -15,7 +15,7 @@ import bouncing_ball
 # the public API's modules, and the physics modules (every other module at the top level, found
 # so that a new one is held to the same standard), whose public names (their __all__) are
 # documented in numpydoc style
-API_MODULES = ["bouncing_ball.equilibrium", "bouncing_ball.monte_carlo"]
+API_MODULES = ["bouncing_ball.equilibrium", "bouncing_ball.simulation"]
 DOCUMENTED = sorted(
     f"bouncing_ball.{module.name}"
     for module in pkgutil.iter_modules(bouncing_ball.__path__)

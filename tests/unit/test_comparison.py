@@ -10,7 +10,9 @@ from scipy import stats
 
 from bouncing_ball import exact
 from bouncing_ball.bins import LogBins
-from bouncing_ball.comparison import (
+from bouncing_ball.estimators import outgoing_speed_histogram, position_histogram
+from bouncing_ball.tallies import RATE_CONTROLS
+from bouncing_ball.validation import (
     PAPER_VALUES,
     SIGN_FLIP_SEED,
     VALIDATION_CHECKS,
@@ -28,8 +30,6 @@ from bouncing_ball.comparison import (
     validation_table,
     value_with_error,
 )
-from bouncing_ball.histograms import outgoing_speed_histogram, position_histogram
-from bouncing_ball.tallies import RATE_CONTROLS
 
 
 @pytest.mark.parametrize("restitution", exact.EXACT_RESTITUTIONS)
@@ -515,13 +515,13 @@ def test_sign_flip_test_counts_every_pattern_that_ties_with_the_observed_statist
 def test_sign_flip_test_is_the_same_however_the_blas_blocks_the_sums(monkeypatch):
     """The flips in blocks of 1000, 7 and 1 (a matrix product or a vector product, other
     BLAS kernels and roundings): the same statistic and p-values to the last bit."""
-    from bouncing_ball import comparison
+    from bouncing_ball.validation import sign_flip
 
     rng = np.random.default_rng(27)
     deviations = _correlated_deviations(rng, 8, 12) + 100.0
     results = set()
     for block in (1000, 7, 1):
-        monkeypatch.setattr(comparison, "_FLIPS_PER_BLOCK", block)
+        monkeypatch.setattr(sign_flip, "_FLIPS_PER_BLOCK", block)
         results.add(sign_flip_test(deviations, flips=300))
     assert len(results) == 1
 
@@ -531,7 +531,7 @@ def test_sign_flip_sums_over_shards_are_exact():
     signs (here every one of the 2^10 patterns) is the exact integer sum, in any order."""
     from itertools import product
 
-    from bouncing_ball.comparison import _integer_deviations
+    from bouncing_ball.validation.sign_flip import _integer_deviations
 
     rng = np.random.default_rng(28)
     deviations = rng.standard_normal((10, 5)) * np.array([1e-300, 1e-8, 1.0, 1e8, 1e300])
@@ -728,7 +728,7 @@ def test_validation_numbers_do_not_depend_on_the_order_of_the_bins_nor_the_blas_
             sys.executable,
             "-c",
             "import pickle, sys\n"
-            "from bouncing_ball.comparison import validation_rows\n"
+            "from bouncing_ball.validation import validation_rows\n"
             f"arguments = pickle.loads(open({str(arguments)!r}, 'rb').read())\n"
             "sys.stdout.buffer.write(pickle.dumps(validation_rows(*arguments)))\n",
         ],

@@ -170,11 +170,15 @@ def test_an_override_applies_only_to_its_own_r():
 def test_an_r_outside_the_solvers_range_is_refused_before_any_job(value):
     config = _default_config()
     config["restitution"] = [0.5, value]
-    with pytest.raises(ValueError, match=r"restitution\[1\]: .*outside the solver's range"):
+    with pytest.raises(
+        ValueError, match=r"restitution\[1\]: .*outside the range of r where P\(x, v\) is verified"
+    ):
         check_config(config)
     config["restitution"] = [0.5]
     config["figures"]["fig4"] = [value]
-    with pytest.raises(ValueError, match=r"figures.fig4\[0\]: .*outside the solver's range"):
+    with pytest.raises(
+        ValueError, match=r"figures.fig4\[0\]: .*outside the range of r where P\(x, v\) is verified"
+    ):
         check_config(config)
 
 

@@ -1,4 +1,4 @@
-"""The martingale control-variate estimator of a rate (histograms.control_variate_rate), on
+"""The martingale control-variate estimator of a rate (estimators.control_variate_rate), on
 synthetic shards: exact where the control explains everything, the plain estimator where it
 explains nothing, and unbiased where an in-sample slope is not."""
 
@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from bouncing_ball.histograms import (
+from bouncing_ball.estimators import (
     control_variate_adjusted,
     control_variate_rate,
     jackknife,

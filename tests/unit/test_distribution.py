@@ -11,6 +11,7 @@ from distribution_support import build
 from scipy import integrate
 
 from bouncing_ball import airy, distribution, exact
+from bouncing_ball.workflow import solver_tables
 
 EXACT = [Fraction(1, 2), Fraction(1, 3)]
 # the checks at any r (0.15, 0.25, 0.6, 0.75, 0.9) are in test_distribution_any_r.py: each r
@@ -78,13 +79,13 @@ def test_distribution_matches_the_exact_one(r, built):
 
 def test_tables(built):
     solution, weight = built(Fraction(1, 2))
-    positions = distribution.position_table(weight, np.geomspace(1e-3, 1e3, 7))
+    positions = solver_tables.position_frame(weight, np.geomspace(1e-3, 1e3, 7))
     assert list(positions.columns) == ["x", "px", "v2_given_x"]
     assert np.all(np.diff(positions["px"]) < 0.0)
-    forces = distribution.weight_table(weight, np.geomspace(1e-4, 1e6, 5))
+    forces = solver_tables.weight_frame(weight, np.geomspace(1e-4, 1e6, 5))
     assert list(forces.columns) == ["F", "w", "log_w"]
     assert np.all(np.isfinite(forces["log_w"]))
-    table, worst = distribution.distribution_table(weight, solution, [0.0, 1.0], [-1.0, 1.0])
+    table, worst = solver_tables.distribution_frame(weight, solution, [0.0, 1.0], [-1.0, 1.0])
     assert len(table) == 4 and worst < 1e-8
 
 
@@ -146,7 +147,7 @@ def test_distribution_table_matches_the_exact_one(r, built):
     within DISTRIBUTION_NOISE (1e-10) of its largest value at that x, and the quadrature's own
     error estimate within 1e-12 of it (the rest is w's)."""
     solution, weight = built(r)
-    table, _ = distribution.distribution_table(weight, solution, RULE_POSITIONS, RULE_SPEEDS)
+    table, _ = solver_tables.distribution_frame(weight, solution, RULE_POSITIONS, RULE_SPEEDS)
     ours = table["pxv"].to_numpy().reshape(len(RULE_POSITIONS), -1)
     x, v = np.meshgrid(RULE_POSITIONS, RULE_SPEEDS, indexing="ij")
     theirs = exact.distribution(x, v, r)

@@ -1,4 +1,4 @@
-"""The shards' own evidence of equilibration (bouncing_ball.equilibration) and the per-r
+"""The shards' own evidence of equilibration (bouncing_ball.simulation.equilibration) and the per-r
 equilibration time that answers it."""
 
 from dataclasses import replace
@@ -11,7 +11,7 @@ from workflow_support import REPOSITORY
 
 from bouncing_ball import Equilibrium, simulate
 from bouncing_ball.bins import LinearBins, LogBins
-from bouncing_ball.equilibration import (
+from bouncing_ball.simulation.equilibration import (
     EQUILIBRATION_RELAXATION_TIMES,
     MIN_EQUILIBRATION_TIME,
     QUANTITIES,
@@ -236,7 +236,7 @@ def test_the_relaxation_time_bound_lies_above_the_relaxation_time_at_every_r():
     least equilibration time up to r = 0.75, so that the default config's r below 0.95 and
     the studies' need no solve."""
     from bouncing_ball.asymptotics import CRITICAL_RESTITUTION
-    from bouncing_ball.equilibration import (
+    from bouncing_ball.simulation.equilibration import (
         RELAXATION_BOUND_MARGIN,
         equilibration_relaxation_time,
         relaxation_time_bound,

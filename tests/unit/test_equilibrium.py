@@ -323,7 +323,7 @@ def test_simulate_defaults_are_the_default_config():
     """simulate's settings, where not given, are the default config's simulation section."""
     from workflow_support import REPOSITORY
 
-    from bouncing_ball.monte_carlo import DEFAULT_SETTINGS, _shard_settings
+    from bouncing_ball.simulation.run import DEFAULT_SETTINGS, _shard_settings
 
     config = read_config(REPOSITORY / "config" / "config.yaml")
     default = shard_settings(config, "0.5").replace(shard_time=1.0)

@@ -18,12 +18,13 @@ import yaml
 from workflow_support import REPOSITORY
 
 import bouncing_ball as bb
-from bouncing_ball import distribution, equilibrium, solver
+from bouncing_ball import distribution, solver
 from bouncing_ball.equilibrium import (
     KEPT_SOLVES,
     QUADRATURE_STEP_RANGE,
     WEIGHT_PANEL_NODES_RANGE,
     check_solver_settings,
+    solved,
 )
 from bouncing_ball.workflow import solver_tables
 
@@ -65,7 +66,7 @@ def _no_rebuilding(monkeypatch):
     def refuse(*args, **kwargs):
         raise AssertionError("rebuilt what the copy carries")
 
-    monkeypatch.setattr(equilibrium, "_solution", refuse)
+    monkeypatch.setattr(solved, "_solution", refuse)
     monkeypatch.setattr(solver, "accuracy_estimate", refuse)
     monkeypatch.setattr(distribution, "interpolated_weight_function", refuse)
 
@@ -128,10 +129,10 @@ def counted_builds(monkeypatch, half):
         counts["weight functions"] += 1
         return object()
 
-    monkeypatch.setattr(equilibrium, "_solution", solution)
+    monkeypatch.setattr(solved, "_solution", solution)
     monkeypatch.setattr(distribution, "interpolated_weight_function", weight_function)
-    monkeypatch.setattr(equilibrium, "_LIVE_SOLVES", weakref.WeakValueDictionary(), raising=False)
-    monkeypatch.setattr(equilibrium, "_RECENT_SOLVES", collections.OrderedDict(), raising=False)
+    monkeypatch.setattr(solved, "_LIVE_SOLVES", weakref.WeakValueDictionary(), raising=False)
+    monkeypatch.setattr(solved, "_RECENT_SOLVES", collections.OrderedDict(), raising=False)
     return counts
 
 

@@ -8,7 +8,7 @@ from fit_support import CASES, _bins, synthetic_shards
 
 from bouncing_ball import fits
 from bouncing_ball.bins import outgoing_speed_bin_average
-from bouncing_ball.histograms import jackknife, outgoing_speed_density
+from bouncing_ball.estimators import jackknife, outgoing_speed_density
 
 
 @pytest.mark.parametrize("side", list(CASES))

@@ -14,7 +14,7 @@ import pytest
 from default_settings import DEFAULT_SETTINGS
 from numba import njit
 
-from bouncing_ball import simulation, tallies
+from bouncing_ball import tallies
 from bouncing_ball.bins import LinearBins, LogBins
 from bouncing_ball.free_flight import (
     bridge_covariance,
@@ -26,7 +26,7 @@ from bouncing_ball.free_flight import (
     hermite_cubic,
     largest_safe_step,
 )
-from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
+from bouncing_ball.simulation import loop, shard_seed_sequence, simulate_shard, step_tallies
 
 SETTINGS = DEFAULT_SETTINGS.replace(
     shard_time=300.0,
@@ -210,7 +210,7 @@ def test_bridge_points_leave_the_trajectory_and_the_other_tallies_alone(monkeypa
     first = simulate_shard(0.75, stream, settings)
     # another stream for the P(x, v) draws only
     monkeypatch.setattr(
-        simulation,
+        loop,
         "tally_seed_sequence",
         lambda s: np.random.SeedSequence(entropy=s.entropy, spawn_key=(*s.spawn_key, 9)),
     )
@@ -234,5 +234,5 @@ def test_linear_bin_index_agrees_with_the_edges():
     )
     for value in values:
         expected = int(np.searchsorted(edges, value, side="right"))
-        assert simulation._linear_bin_index(value, edges[0], per_unit, bins.n, edges) == expected
+        assert step_tallies._linear_bin_index(value, edges[0], per_unit, bins.n, edges) == expected
     assert np.isneginf(bins.lower[0]) and np.isposinf(bins.upper[-1])

@@ -21,7 +21,8 @@ def loaded(module, heavy):
 @pytest.mark.parametrize(
     "module",
     [
-        "bouncing_ball.comparison",  # the moments and position tables, Fig. 7
+        "bouncing_ball.validation",  # the moments and position tables, Fig. 7
+        "bouncing_ball.simulation",  # its names load on first use (bb.load, bb.simulate)
         "bouncing_ball.workflow.plotting",  # every figure
         "bouncing_ball.asymptotics",  # r_c for Figs. 1 and 6
         "bouncing_ball.workflow.config",  # the config check at every start of the workflow

@@ -127,7 +127,7 @@ write_table(batch_to_table({{0: shard}}), {str(tmp_path / "batch.parquet")!r}, {
 def test_a_merge_job_does_not_import_scipy_stats():
     # the modules scripts/merge_shards.py imports
     code = (
-        "import bouncing_ball.equilibration, bouncing_ball.histograms, "
+        "import bouncing_ball.simulation.equilibration, bouncing_ball.estimators, "
         "bouncing_ball.workflow.shards, bouncing_ball.workflow.io"
     )
     modules = _modules_after(code)

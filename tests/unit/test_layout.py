@@ -23,9 +23,6 @@ PHYSICS_FILES = sorted(
 #: The most lines a module of the package may hold: a module past it is split along its seams
 #: into a subpackage (as distribution/ and flight_time/ are).
 LARGEST_MODULE = 1100
-#: The modules still past LARGEST_MODULE: each is to be split along its seams, as
-#: distribution/ and flight_time/ are, and then leaves the list.
-TO_SPLIT = {"equilibrium.py", "comparison.py", "histograms.py", "simulation.py", "monte_carlo.py"}
 
 
 def _dotted(file: str) -> str:
@@ -92,6 +89,19 @@ def test_imports_the_workflow_sees_every_form_in_a_subpackage(source, expected):
     assert imports_the_workflow(source, depth=1) is expected
 
 
+@pytest.mark.parametrize(
+    "source, expected",
+    [
+        ("from ...workflow.io import read_table", True),
+        ("from ... import workflow", True),
+        ("from ..workflow import io", False),  # a sibling subpackage's own workflow module
+        ("from ...solver import DEFAULT_STEP", False),
+    ],
+)
+def test_imports_the_workflow_sees_every_form_two_subpackages_deep(source, expected):
+    assert imports_the_workflow(source, depth=2) is expected
+
+
 @pytest.mark.parametrize("file", PHYSICS_FILES)
 def test_the_library_does_not_import_the_workflow(file):
     source = (bouncing_ball.PACKAGE / file).read_text()
@@ -101,19 +111,114 @@ def test_the_library_does_not_import_the_workflow(file):
 
 def test_no_module_is_past_the_largest_size():
     """Every module of the package (the workflow's and the subpackages' included) holds at most
-    LARGEST_MODULE lines, but those of TO_SPLIT; a module of TO_SPLIT is still past it."""
+    LARGEST_MODULE lines."""
     lines = {
         path.relative_to(bouncing_ball.PACKAGE).as_posix(): len(path.read_text().splitlines())
         for path in bouncing_ball.PACKAGE.rglob("*.py")
     }
-    too_large = {
-        file: count
-        for file, count in lines.items()
-        if count > LARGEST_MODULE and file not in TO_SPLIT
-    }
+    too_large = {file: count for file, count in lines.items() if count > LARGEST_MODULE}
     assert not too_large, f"split these along their seams (at most {LARGEST_MODULE}): {too_large}"
-    done = {file for file in TO_SPLIT if lines.get(file, 0) <= LARGEST_MODULE}
-    assert not done, f"split or small enough: drop {sorted(done)} from TO_SPLIT"
+
+
+#: What the estimators must not import: the theory they are held against (the simulation is the
+#: independent check of it); its P(0, u) comes in as an argument (``outgoing_density``).
+THEORY = {"solver", "distribution", "equilibrium", "relaxation", "exact", "quasi_elastic"}
+
+
+def _imported_modules(source: str, depth: int) -> set[str]:
+    """The package's modules a source imports (relative or absolute, at any level of the
+    file, inside functions too), by their first dotted part below bouncing_ball."""
+    found = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.ImportFrom):
+            if node.level == depth + 1:
+                names = [node.module] if node.module else [alias.name for alias in node.names]
+                found |= {name.split(".")[0] for name in names}
+            elif node.level == 0 and (node.module or "").startswith("bouncing_ball."):
+                found.add(node.module.split(".")[1])
+            elif node.level == 0 and node.module == "bouncing_ball":
+                found |= {alias.name for alias in node.names}
+        elif isinstance(node, ast.Import):
+            found |= {
+                alias.name.split(".")[1]
+                for alias in node.names
+                if alias.name.startswith("bouncing_ball.")
+            }
+    return found
+
+
+@pytest.mark.parametrize("file", [file for file in PHYSICS_FILES if file.startswith("estimators/")])
+def test_the_estimators_do_not_import_the_theory(file):
+    source = (bouncing_ball.PACKAGE / file).read_text()
+    assert not _imported_modules(source, file.count("/")) & THEORY, file
+
+
+def test_imported_modules_sees_every_form():
+    source = (
+        "from ..solver import x\nfrom .. import distribution\n"
+        "def f():\n    from bouncing_ball.exact import y\n    import bouncing_ball.relaxation\n"
+        "from .jackknife import jackknife"
+    )
+    assert _imported_modules(source, 1) == {"solver", "distribution", "exact", "relaxation"}
+
+
+BENCHMARKS = bouncing_ball.PACKAGE.parent / "benchmarks"
+
+
+def benchmark_imports(source: str) -> set[str]:
+    """The modules of ``benchmarks`` a module of it imports (relatively or as
+    ``benchmarks.x``, at its top or inside a function)."""
+    found = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.ImportFrom):
+            if node.level == 1:
+                names = [node.module] if node.module else [alias.name for alias in node.names]
+                found |= {name.split(".")[0] for name in names}
+            elif node.level == 0 and (node.module or "").startswith("benchmarks."):
+                found.add(node.module.split(".")[1])
+            elif node.level == 0 and node.module == "benchmarks":
+                found |= {alias.name for alias in node.names}
+        elif isinstance(node, ast.Import):
+            found |= {
+                alias.name.split(".")[1]
+                for alias in node.names
+                if alias.name.startswith("benchmarks.")
+            }
+    return found
+
+
+def import_cycle(graph: dict[str, set[str]]) -> list[str]:
+    """A cycle of ``graph`` (module: the modules it imports), as the modules along it, or []."""
+    state = {}  # 1: on the current path, 2: done
+
+    def visit(module, path):
+        state[module] = 1
+        for imported in sorted(graph.get(module, ())):
+            if state.get(imported) == 1:
+                return [*path[path.index(imported) :], imported]
+            if imported not in state and (cycle := visit(imported, [*path, imported])):
+                return cycle
+        state[module] = 2
+        return []
+
+    for module in sorted(graph):
+        if module not in state and (cycle := visit(module, [module])):
+            return cycle
+    return []
+
+
+def test_import_cycle_finds_a_cycle():
+    assert import_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+    assert import_cycle({"a": {"b", "c"}, "b": {"c"}, "c": set()}) == []
+    source = "from .efficiency import x\ndef f():\n    from .benchmark import _shard\n"
+    assert benchmark_imports(source) == {"efficiency", "benchmark"}
+
+
+def test_the_benchmarks_import_each_other_without_a_cycle():
+    """Each shared piece of the benchmarks has one home that the others import (a function
+    reaching back into the module that imports it is a cycle too)."""
+    graph = {path.stem: benchmark_imports(path.read_text()) for path in BENCHMARKS.glob("*.py")}
+    assert not import_cycle(graph), f"benchmarks import each other: {import_cycle(graph)}"
 
 
 def test_public_api_is_the_top_level():
@@ -126,18 +231,21 @@ def test_public_api_is_the_top_level():
 
 def test_the_simulation_stage_names_every_module_the_shard_loop_compiles():
     """An edit of any module numba compiles for the shard loop must re-run the shards: the
-    simulation stage's sources hold simulation.py and every compiled module it imports."""
+    simulation stage's sources hold the loop (simulation/loop.py) and every compiled module it
+    imports, of the simulation subpackage and of the package."""
     from bouncing_ball import jit
     from bouncing_ball.workflow import stages
 
-    tree = ast.parse((bouncing_ball.PACKAGE / "simulation.py").read_text())
-    imported = {
-        node.module.split(".")[0]
-        for node in ast.walk(tree)
-        if isinstance(node, ast.ImportFrom) and node.level == 1 and node.module
-    }
-    loop = ({"simulation"} | imported) & set(jit.COMPILED)
-    assert {"free_flight", "pcg64", "simulation", "tallies"} <= loop
+    tree = ast.parse((bouncing_ball.PACKAGE / "simulation" / "loop.py").read_text())
+    imported = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module:
+            if node.level == 1:
+                imported.add(f"simulation.{node.module}")
+            elif node.level == 2:
+                imported.add(node.module)
+    loop = ({"simulation.loop"} | imported) & set(jit.COMPILED)
+    assert {"free_flight", "pcg64", "simulation.loop", "simulation.step_tallies", "tallies"} <= loop
     assert loop <= set(stages.SIMULATION)
 
 

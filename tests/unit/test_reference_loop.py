@@ -4,7 +4,7 @@ It translates the numba loop operation for operation, is compiled without
 FMA contraction and draws its normals with numpy's C ziggurat from the same
 PCG64 stream, so on the same seed sequence it must give bit-identical
 tallies: any difference means the two codes no longer do the same arithmetic
-(e.g. simulation.py or free_flight.py was changed and shard_loop.c was not).
+(e.g. simulation/loop.py or free_flight.py was changed and shard_loop.c was not).
 """
 
 import shutil

@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 from test_solver_range import _passing_tables
 
-from bouncing_ball import Equilibrium, ExactEquilibrium, distribution, relaxation, solver
+from bouncing_ball import Equilibrium, ExactEquilibrium, relaxation, solver
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION, small_speed_exponent
 from bouncing_ball.flight_time import mean_flight_time_given_speed
+from bouncing_ball.workflow import solver_tables
 from bouncing_ball.workflow.solver_tables import _relaxation_columns
 
 TARGET = solver.ACCURACY_TARGET
@@ -140,10 +141,10 @@ def test_equilibrium_refuses_the_relaxation_below_r_c():
 def test_the_summary_relaxation_columns_may_be_nan_only_below_r_c():
     summary, tables = _passing_tables()
     summary.update(dict.fromkeys(relaxation.RELAXATION_COLUMNS, math.nan))
-    defects = distribution.solve_table_defects(summary, tables)
+    defects = solver_tables.solve_table_defects(summary, tables)
     assert defects == [f"summary: {key} is NaN" for key in relaxation.RELAXATION_COLUMNS]
     summary["collision_rate"] = math.inf
-    assert distribution.solve_table_defects(summary, tables) == []
+    assert solver_tables.solve_table_defects(summary, tables) == []
 
 
 def test_the_summary_has_the_relaxation_columns_and_nan_below_r_c():

@@ -1,4 +1,4 @@
-"""The return-law prediction of P(0, v) (``histograms.return_law_prediction``) against the
+"""The return-law prediction of P(0, v) (``estimators.return_law_prediction``) against the
 exact solutions: fed the exact equilibrium's outgoing speeds, it gives back the exact
 collisions per speed bin, eq. (inteq) being the balance it rests on."""
 
@@ -10,7 +10,7 @@ import pytest
 from scipy import integrate
 
 from bouncing_ball import exact
-from bouncing_ball.histograms import return_law_prediction
+from bouncing_ball.estimators import return_law_prediction
 from bouncing_ball.settings import RETURN_LAW_SPEED_BINS, ShardSettings
 from bouncing_ball.tallies import ShardTallies
 
@@ -88,7 +88,7 @@ def test_equilibrium_outgoing_speeds_predict_the_flight_moments(r):
     time between collisions 1 / I of eq. (xandDeltax) (3 at r = 1/2, 4/3 at r = 1/3) and
     the solver's <T^2>, per flight, to 1e-6 (a wrong E[T | u] is off by percents)."""
     from bouncing_ball import flight_time, solver
-    from bouncing_ball.histograms import flight_law_prediction
+    from bouncing_ball.estimators import flight_law_prediction
 
     def density(u):
         return exact.outgoing_speed_density(u, r)
@@ -100,3 +100,47 @@ def test_equilibrium_outgoing_speeds_predict_the_flight_moments(r):
     assert mean == pytest.approx(1.0 / rate, rel=1e-6)
     solution = solver.solve_outgoing_speed_density(r)
     assert second == pytest.approx(flight_time.flight_time_second_moment(solution), rel=1e-6)
+
+
+def _shards_with_speeds(density, scales):
+    """Shards of unit time whose outgoing speeds (fine and coarse bins) are the equilibrium's
+    expected counts times ``scales`` (one shard each), rounded."""
+    from bouncing_ball.tallies import SCALAR_INDEX
+
+    fine, coarse = RETURN_LAW_SPEED_BINS, SETTINGS.speed_bins
+    shards = []
+    for scale in scales:
+        arrays = ShardTallies.loop_arrays(SETTINGS)
+        arrays["scalars"][SCALAR_INDEX["time"]] = 1.0
+        arrays["speed_counts"][:] = np.round(
+            scale * 1e6 * _collision_rate(density, coarse.lower, coarse.upper)
+        )
+        shard = ShardTallies.from_loop(SETTINGS, arrays)
+        fine_counts = np.round(scale * 1e6 * _collision_rate(density, fine.lower, fine.upper))
+        shards.append(dataclasses.replace(shard, return_law_speed_counts=fine_counts))
+    return shards
+
+
+def test_the_return_law_control_uses_the_density_the_caller_passes():
+    """outgoing_speed_histogram solves nothing: its controlled column is the return-law control
+    of the P(0, u) passed in (here the exact one of r = 1/2), NaN without it, and r must come
+    parsed."""
+    from bouncing_ball.estimators import outgoing_speed_histogram
+
+    half = Fraction(1, 2)
+
+    def density(u):
+        return exact.outgoing_speed_density(u, half)
+
+    shards = _shards_with_speeds(density, [1.0, 1.01, 0.99, 1.02, 0.98])
+    given = outgoing_speed_histogram(shards, half, density)
+    by_hand = outgoing_speed_histogram(
+        shards, return_law=return_law_prediction(shards, 0.5, density)
+    )
+    np.testing.assert_array_equal(given.p0v_controlled, by_hand.p0v_controlled)
+    assert np.isfinite(given.p0v_controlled[given["count"] > 0]).all()
+    assert np.isnan(outgoing_speed_histogram(shards, half).p0v_controlled).all()
+    with pytest.raises(TypeError, match="restitution: give r as parsed"):
+        outgoing_speed_histogram(shards, "1/2", density)
+    with pytest.raises(ValueError, match="restitution"):
+        outgoing_speed_histogram(shards, None, density)

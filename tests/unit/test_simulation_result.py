@@ -12,13 +12,13 @@ import pyarrow.parquet as pq
 import pytest
 
 import bouncing_ball as bb
-from bouncing_ball import monte_carlo
-from bouncing_ball.monte_carlo import SCALARS, SimulationResult
 from bouncing_ball.parquet import UnreadableFileError, write_table
-from bouncing_ball.simulation import shard_seed_sequence
+from bouncing_ball.simulation import SCALARS, SimulationResult, run, seeds, shard_seed_sequence
 
 # short shards: what is tested is the API, not the physics of the estimates
-pytestmark = pytest.mark.filterwarnings("ignore::bouncing_ball.equilibration.EquilibrationWarning")
+pytestmark = pytest.mark.filterwarnings(
+    "ignore::bouncing_ball.simulation.equilibration.EquilibrationWarning"
+)
 
 RUN = {"shard_time": 100.0, "settings": {"equilibration_time": 10.0}, "progress": False}
 
@@ -106,8 +106,8 @@ def test_the_progress_bar_shows_on_a_terminal_and_in_a_notebook_only(
     """Outside a kernel tqdm.auto is tqdm's text bar, so the notebook case is seen on stderr."""
     stream = stderr()
     monkeypatch.setattr("sys.stderr", stream)
-    monkeypatch.setattr(monte_carlo, "_in_notebook", lambda: notebook)
-    bar = monte_carlo._Progress("0.5", 3, progress)
+    monkeypatch.setattr(run, "_in_notebook", lambda: notebook)
+    bar = run._Progress("0.5", 3, progress)
     for done in range(4):
         bar.show(done)
     bar.close()
@@ -200,7 +200,7 @@ def _same(one, other):
         one.shard_indices,
         one.requested_shards,
     )
-    assert monte_carlo._seed_record(other.seed) == monte_carlo._seed_record(one.seed)
+    assert seeds._seed_record(other.seed) == seeds._seed_record(one.seed)
     assert other.batch_frame().equals(one.batch_frame())
     assert other.summary_table.equals(one.summary_table)
     assert other.observables().equals(one.observables())

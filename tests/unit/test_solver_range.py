@@ -12,9 +12,10 @@ from bouncing_ball import distribution, exact, kernel, solver
 from bouncing_ball.restitution import (
     DISTRIBUTION_RESTITUTION_RANGE,
     SOLVER_RESTITUTION_RANGE,
-    check_solver_restitution,
+    check_distribution_range,
     in_range,
 )
+from bouncing_ball.workflow import solver_tables
 
 LOW, HIGH = DISTRIBUTION_RESTITUTION_RANGE
 
@@ -28,14 +29,14 @@ def test_the_bounds_of_a_range_are_exact_decimals():
     assert in_range(Fraction(1, 50), SOLVER_RESTITUTION_RANGE)
     assert not in_range(Fraction(1, 50) - Fraction(1, 10**12), SOLVER_RESTITUTION_RANGE)
     for bound in ("1/50", "9/10", 0.02, LOW, HIGH):
-        assert check_solver_restitution(bound) == Fraction(str(bound))
+        assert check_distribution_range(bound) == Fraction(str(bound))
 
 
 @pytest.mark.parametrize("r", [0.91, 0.95, 0.99, "199/200", 0.998, 0.999, "999/1000"])
 def test_a_run_near_one_inside_the_range_of_the_whole_distribution_is_accepted(r):
     """Up to r = 0.999 w(F) is taken along the ray of P(0, v) (bouncing_ball.distribution), and
     P(x), P(x, v) meet 1e-8 (tests/numerical/test_distribution_any_r.py)."""
-    assert check_solver_restitution(r, "restitution[0]") == Fraction(str(r))
+    assert check_distribution_range(r, "restitution[0]") == Fraction(str(r))
 
 
 @pytest.mark.parametrize("r", [0.015, "1/100", 0.9991, "1999/2000", 0.9999])
@@ -43,7 +44,7 @@ def test_a_run_outside_the_range_of_the_whole_distribution_is_refused(r):
     """Every r of a run is solved by rule solve, whose P(x) and P(x, v) hold to 1e-8 only in
     DISTRIBUTION_RESTITUTION_RANGE: outside, the refusal names the key, both ranges and why."""
     with pytest.raises(ValueError, match=rf"restitution\[0\]: r = .* {LOW} <= r <= {HIGH}.*0.9999"):
-        check_solver_restitution(r, "restitution[0]")
+        check_distribution_range(r, "restitution[0]")
 
 
 @pytest.mark.parametrize("r", [0.9995, 0.9999, 0.015])
@@ -180,8 +181,8 @@ def _passing_tables():
 def test_tables_that_hold_pass():
     """P(0, 0) (NaN, undefined) and the log correction at r = 1/2 are no defects."""
     summary, tables = _passing_tables()
-    assert distribution.solve_table_defects(summary, tables) == []
-    distribution.check_solve_tables("0.5", summary, tables)
+    assert solver_tables.solve_table_defects(summary, tables) == []
+    solver_tables.check_solve_tables("0.5", summary, tables)
 
 
 def test_nan_in_a_table_is_an_error_naming_r_and_the_table():
@@ -190,7 +191,7 @@ def test_nan_in_a_table_is_an_error_naming_r_and_the_table():
     tables["position"]["px"] = np.nan
     summary["position_normalization"] = np.nan
     with pytest.raises(ValueError, match=r"r = 0.95: .*position: 2 of 2 px are NaN") as error:
-        distribution.check_solve_tables("0.95", summary, tables)
+        solver_tables.check_solve_tables("0.95", summary, tables)
     assert "summary: position_normalization is NaN" in str(error.value)
     assert "int P dx" in str(error.value)
 
@@ -198,11 +199,11 @@ def test_nan_in_a_table_is_an_error_naming_r_and_the_table():
 def test_the_flight_time_density_may_be_undefined_only_below_r_c():
     summary, tables = _passing_tables()
     tables["flight_time"]["density"] = np.nan
-    assert distribution.solve_table_defects(summary, tables) == [
+    assert solver_tables.solve_table_defects(summary, tables) == [
         "flight_time: 1 of 1 density are NaN"
     ]
     summary["collision_rate"] = np.inf
-    assert distribution.solve_table_defects(summary, tables) == []
+    assert solver_tables.solve_table_defects(summary, tables) == []
 
 
 @pytest.mark.parametrize(
@@ -222,7 +223,7 @@ def test_a_table_off_its_accuracy_is_an_error_naming_the_check(key, value, check
     summary, tables = _passing_tables()
     summary[key] = value
     with pytest.raises(ValueError, match="r = 0.5: ") as error:
-        distribution.check_solve_tables("0.5", summary, tables)
+        solver_tables.check_solve_tables("0.5", summary, tables)
     assert check in str(error.value)
 
 
@@ -230,10 +231,10 @@ def test_the_moments_are_held_to_the_target_whatever_the_accuracy_estimate():
     """A solve that estimates its own error above the target is not excused by it."""
     summary, tables = _passing_tables()
     summary["position_normalization"] = 1.0 + 3e-7
-    assert len(distribution.solve_table_defects(summary, tables)) == 1
+    assert len(solver_tables.solve_table_defects(summary, tables)) == 1
     summary["accuracy_estimate"] = 1e-6
     summary["weight_interpolation_error"] = 1e-6
-    assert len(distribution.solve_table_defects(summary, tables)) == 1
+    assert len(solver_tables.solve_table_defects(summary, tables)) == 1
 
 
 def test_the_large_x_power_is_checked_only_where_it_has_set_in():
@@ -245,9 +246,9 @@ def test_the_large_x_power_is_checked_only_where_it_has_set_in():
     for key, value in predicted.items():
         summary[f"{key}_measured"], summary[f"{key}_predicted"] = value, value
     summary["large_x_power_measured"] = predicted["large_x_power"] + 0.1
-    assert distribution.solve_table_defects(summary, tables) == []
+    assert solver_tables.solve_table_defects(summary, tables) == []
     summary["large_x_rate_measured"] = predicted["large_x_rate"] * 1.011
-    assert len(distribution.solve_table_defects(summary, tables)) == 1
+    assert len(solver_tables.solve_table_defects(summary, tables)) == 1
 
 
 def test_the_coordinate_of_the_grid_inverts_beyond_the_overflow_of_its_exponential():
@@ -270,9 +271,9 @@ def test_a_negative_density_beyond_the_noise_is_an_error():
     negative value below that (-0.418 came out at x = 1e-8) is an error, one within it noise."""
     summary, tables = _passing_tables()
     tables["distribution"].loc[3, "pxv"] = -1e-11
-    assert distribution.solve_table_defects(summary, tables) == []
+    assert solver_tables.solve_table_defects(summary, tables) == []
     tables["distribution"].loc[3, "pxv"] = -1e-3
-    assert distribution.solve_table_defects(summary, tables) == [
+    assert solver_tables.solve_table_defects(summary, tables) == [
         "distribution: 1 of 4 pxv are negative beyond 1e-10 of the largest at their x "
         "(down to -0.001)"
     ]
@@ -281,7 +282,7 @@ def test_a_negative_density_beyond_the_noise_is_an_error():
 def test_the_return_speed_law_may_be_undefined_only_above_the_highest_node():
     summary, tables = _passing_tables()
     summary["highest_speed"] = 75.0
-    assert distribution.solve_table_defects(summary, tables) == [
+    assert solver_tables.solve_table_defects(summary, tables) == [
         "return_speed: 1 of 2 probability are NaN"
     ]
 
@@ -291,8 +292,8 @@ def test_an_infinite_value_is_refused_and_an_overflow_bin_edge_is_not():
     tables["return_speed"] = pd.DataFrame(
         {"u_lo": [1.0], "u_hi": [2.0], "v_lo": [50.0], "v_hi": [np.inf], "probability": [0.01]}
     )
-    assert distribution.solve_table_defects(summary, tables) == []
+    assert solver_tables.solve_table_defects(summary, tables) == []
     tables["return_speed"].loc[0, "probability"] = np.inf
-    assert distribution.solve_table_defects(summary, tables) == [
+    assert solver_tables.solve_table_defects(summary, tables) == [
         "return_speed: 1 of 1 probability are infinite"
     ]

@@ -4,7 +4,7 @@ shards are grouped into jobs."""
 import numpy as np
 from default_settings import DEFAULT_SETTINGS
 
-from bouncing_ball.histograms import position_moments_summary
+from bouncing_ball.estimators import position_moments_summary
 from bouncing_ball.simulation import shard_seed_sequence, simulate_shard
 from bouncing_ball.tallies import tallies_to_frame
 from bouncing_ball.workflow.batches import batch_to_frame, simulate_batch

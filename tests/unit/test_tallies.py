@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 from benchmarks import reference_loop
 from bouncing_ball.bins import LinearBins, LogBins
-from bouncing_ball.histograms import (
+from bouncing_ball.estimators import (
     distribution_histogram,
     flight_time_histogram,
     jackknife,

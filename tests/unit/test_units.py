@@ -14,7 +14,9 @@ import pytest
 from scipy import integrate
 
 import bouncing_ball as bb
+from bouncing_ball.bins import LogBins
 from bouncing_ball.units import DIMENSIONS, PhysicalUnits
+from bouncing_ball.workflow import solver_tables
 
 GRAVITY, NOISE = 9.81, 0.05
 UNITS = PhysicalUnits(GRAVITY, NOISE)
@@ -328,3 +330,70 @@ def test_bounds_are_named_in_the_units_given():
     with pytest.raises(ValueError, match=re.escape(f"x <= {largest:g}")):
         eq.px(2.0 * largest)
     assert set(DIMENSIONS) >= {dimension for _, dimension in MEMBERS.values()}
+
+
+@pytest.mark.parametrize(
+    "table",
+    [
+        lambda eq: solver_tables.p0v_table(eq, [1.0]),
+        lambda eq: solver_tables.position_table(eq, [1.0]),
+        lambda eq: solver_tables.distribution_table(eq, [0.5], [1.0]),
+        lambda eq: solver_tables.weight_table(eq, [1.0]),
+        lambda eq: solver_tables.flight_time_table(eq, [1.0]),
+        lambda eq: solver_tables.return_speed_table(eq, LogBins(0.1, 10.0, 1)),
+        lambda eq: solver_tables.summary(eq),
+        lambda eq: solver_tables.check(eq, {}),
+    ],
+    ids=[
+        "p0v_table",
+        "position_table",
+        "distribution_table",
+        "weight_table",
+        "flight_time_table",
+        "return_speed_table",
+        "summary",
+        "check",
+    ],
+)
+def test_rule_solves_tables_refuse_an_equilibrium_in_physical_units(table):
+    """The tables of rule solve are in the paper's units: an equilibrium in metres and seconds
+    is refused, naming the argument and its units, before anything is computed."""
+    equilibrium = bb.Equilibrium("1/2", gravity=GRAVITY, noise=NOISE)
+    with pytest.raises(ValueError, match=r"^equilibrium: .*paper's units.*gravity = 9.81"):
+        table(equilibrium)
+
+
+def test_simulate_refuses_a_shard_time_quoting_it_as_given():
+    with pytest.raises(ValueError, match=r"shard_time must be positive and finite, got -0.5$"):
+        bb.simulate(0.5, shards=2, shard_time=-0.5, gravity=GRAVITY, noise=NOISE)
+
+
+def test_the_equilibration_warnings_quote_times_in_the_units_given():
+    """The same problems as in the paper's units, every time in those given (Lambda / g^2 s)."""
+    from bouncing_ball.simulation.equilibration import equilibration_problems
+
+    paper = equilibration_problems(0.95, 2e3, 50.0)
+    given = equilibration_problems(0.95, 2e3, 50.0, units=UNITS)
+    assert len(given) == len(paper) == 2
+    assert f"equilibration_time = {UNITS.to_physical(50.0, 'time'):g} is" in given[0]
+    assert f"shard_time = {UNITS.to_physical(2e3, 'time'):g} is" in given[1]
+    each = re.compile(r"\(([0-9.e+-]+) each\)")
+    for ours, theirs in zip(given, paper):
+        ratio = float(each.search(ours)[1]) / float(each.search(theirs)[1])
+        assert ratio == pytest.approx(UNITS.to_physical(1.0, "time"), rel=1e-5)  # 6 digits
+
+
+def test_simulate_warns_in_the_units_given(monkeypatch):
+    """simulate hands its units to the equilibration warnings (which quote its times in them)."""
+    from bouncing_ball.simulation import equilibration
+
+    class Warned(Exception):
+        pass
+
+    def warn(restitution, shard_time, equilibration_time, units=None):
+        raise Warned(units)
+
+    monkeypatch.setattr(equilibration, "warn_equilibration_problems", warn)
+    with pytest.raises(Warned) as warned:
+        bb.simulate(0.5, shards=2, shard_time=1.0, gravity=GRAVITY, noise=NOISE)
+    assert warned.value.args[0] == UNITS

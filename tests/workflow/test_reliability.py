@@ -219,7 +219,10 @@ def test_r_outside_the_solver_range_is_refused_before_any_job(tmp_path):
     for label in ("0.9995", "0.9999", "0.015"):
         result = snakemake(directory, f"results/solver/r{label}/summary.parquet")
         assert result.returncode != 0
-        assert "outside the solver's range 0.02 <= r <= 0.999" in result.stdout + result.stderr
+        assert (
+            "outside the range of r where P(x, v) is verified, 0.02 <= r <= 0.999"
+            in result.stdout + result.stderr
+        )
     assert not (directory / "results/solver").exists()
 
 

@@ -8,7 +8,7 @@ import pytest
 import yaml
 from workflow_support import SMALL, copy_repository, planned_jobs, snakemake
 
-from bouncing_ball.equilibration import default_equilibration_time
+from bouncing_ball.simulation.equilibration import default_equilibration_time
 from bouncing_ball.workflow.io import read_table
 
 # 2-4 shards per run of 1e3-2e3 time units; batches and groups of 2 shards so that every

@@ -23,7 +23,7 @@ from workflow_support import (
     snakemake,
 )
 
-from bouncing_ball.comparison import MOMENT_COLUMNS, VALIDATION_CHECKS, VALIDATION_COLUMNS
+from bouncing_ball.validation import MOMENT_COLUMNS, VALIDATION_CHECKS, VALIDATION_COLUMNS
 from bouncing_ball.workflow.config import check_config, read_yaml
 from bouncing_ball.workflow.io import read_table
 
@@ -447,7 +447,7 @@ def _packagecopy_repository(tmp_path):
 def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
     package, env = _packagecopy_repository(tmp_path)
     assert planned_jobs(finished_run, env) == {}
-    with open(package / "histograms.py", "a") as handle:
+    with open(package / "estimators" / "histograms.py", "a") as handle:
         handle.write("\n# an edit\n")
     # everything drawn from the simulation
     downstream = {"fig4": 1, "fig5": 1, "fig8": 1, "fig10": 1, "fig11": 1, **AGGREGATES}
@@ -502,7 +502,7 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
                 "validation_table": 1,  # the exact bin averages
             },
         ),
-        # comparison uses fits
+        # the validation uses fits
         (
             "fits",
             {
@@ -516,7 +516,7 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
         ),
         ("asymptotics", {**solved_and_merged, "theory": 1, "fig1": 1, "fig2": 1}),
         (
-            "comparison",
+            "validation/moments",
             {"fig7": 1, "moments_table": 1, "validation_table": 1, "position_asymptotics": 1},
         ),
     ):
@@ -569,12 +569,15 @@ def test_a_non_canonical_label_is_refused(finished_run):
 @pytest.mark.parametrize(
     "target, message",
     [
-        # outside the solver's range
+        # outside the range where rule solve's tables are verified
         (
             "results/solver/r0.001/summary.parquet",
-            "target results/solver/r0.001: r = '0.001' is outside the solver's range",
+            "target results/solver/r0.001: r = '0.001' is outside the range of r where P(x, v) is verified",
         ),
-        ("results/fits/r1e-07.parquet", "r = '1e-07' is outside the solver's range"),
+        (
+            "results/fits/r1e-07.parquet",
+            "r = '1e-07' is outside the range of r where P(x, v) is verified",
+        ),
         # a label that rounds to 1 (it would read back as r = 1)
         ("results/simulation/r0.9999999/p0v.parquet", "r = '0.9999999' rounds to 1"),
         # a batch of shards that is not one of the config's (its list of shards: no memory)
@@ -681,10 +684,16 @@ BAD = [
     # r the solver cannot answer to its accuracy, r whose label is not an r
     (
         _with(["restitution"], [0.99995]),
-        "restitution[0]: r = 0.99995 is outside the solver's range 0.02 <= r <= 0.9",
+        "restitution[0]: r = 0.99995 is outside the range of r where P(x, v) is verified, 0.02 <= r <= 0.999",
     ),
-    (_with(["restitution"], [0.001]), "restitution[0]: r = 0.001 is outside the solver's range"),
-    (_with(["figures", "fig4"], [0.01]), "figures.fig4[0]: r = 0.01 is outside the solver's range"),
+    (
+        _with(["restitution"], [0.001]),
+        "restitution[0]: r = 0.001 is outside the range of r where P(x, v) is verified",
+    ),
+    (
+        _with(["figures", "fig4"], [0.01]),
+        "figures.fig4[0]: r = 0.01 is outside the range of r where P(x, v) is verified",
+    ),
     (_with(["restitution"], [0.9999999]), "restitution[0]: r = 0.9999999 rounds to 1"),
     # different r with one label
     (

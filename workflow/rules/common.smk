@@ -18,7 +18,7 @@ from bouncing_ball.workflow.config import (
 from bouncing_ball.workflow.jobs import end_pending_timers
 from bouncing_ball.restitution import (
     EXACT_RESTITUTIONS,
-    check_solver_restitution,
+    check_distribution_range,
     exact_string,
     parse_restitution,
     restitution_grid,
@@ -78,9 +78,10 @@ def solve_priority(wildcards):
 
 
 def solver_restitution_value(wildcards):
-    """``restitution_value``, refused (before any job runs) outside the solver's range."""
+    """``restitution_value``, refused (before any job runs) outside the range of r where P(x, v)
+    is verified (rule solve writes the whole distribution)."""
     value = restitution_value(wildcards)
-    check_solver_restitution(wildcards.r, f"target results/solver/r{wildcards.r}")
+    check_distribution_range(wildcards.r, f"target results/solver/r{wildcards.r}")
     return value
 
 

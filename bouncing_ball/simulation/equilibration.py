@@ -5,7 +5,7 @@ Every shard starts at rest one unit above the floor and discards ``equilibration
 before it records.  Where the process relaxes more slowly than that (near r -> 1 the ball
 loses a fraction 1 - r^2 of its energy per bounce, and the collisions grow rare), every
 shard records part of the same transient: <x>, Delta x and I are biased alike in every
-shard, and the errors from their scatter (``histograms.jackknife``) do not see it.  Comparing
+shard, and the errors from their scatter (``estimators.jackknife``) do not see it.  Comparing
 the shards with each other, or batches of shards with the jackknife, cannot catch it either,
 since the shards are independent and share the bias.  What can see it is time within each
 shard: in equilibrium the early part of a recording (its first ``tallies.EARLY_FRACTION``,
@@ -58,8 +58,8 @@ import numpy as np
 import pandas as pd
 from scipy import special  # not scipy.stats, the slowest of scipy to import, in every merge
 
-from .histograms import deviations_from_mean
-from .tallies import EARLY_FRACTION, ShardTallies
+from ..estimators import deviations_from_mean
+from ..tallies import EARLY_FRACTION, ShardTallies
 
 __all__ = [
     "early_check",
@@ -131,7 +131,7 @@ def equilibration_relaxation_time(restitution) -> float | None:
 
     Examples
     --------
-    >>> from bouncing_ball.equilibration import equilibration_relaxation_time
+    >>> from bouncing_ball.simulation.equilibration import equilibration_relaxation_time
     >>> print(round(equilibration_relaxation_time("1/2"), 4))
     14.6093
     >>> print(equilibration_relaxation_time(0.1))
@@ -139,17 +139,17 @@ def equilibration_relaxation_time(restitution) -> float | None:
     >>> print(f"{equilibration_relaxation_time(0.99999):.4g}")
     2.667e+10
     """
-    from .asymptotics import CRITICAL_RESTITUTION
-    from .restitution import SOLVER_RESTITUTION_RANGE, parse_restitution
+    from ..asymptotics import CRITICAL_RESTITUTION
+    from ..restitution import SOLVER_RESTITUTION_RANGE, parse_restitution
 
     exact = parse_restitution(restitution, "r")
     if exact <= CRITICAL_RESTITUTION:
         return None
     if exact > SOLVER_RESTITUTION_RANGE[1]:
-        from .quasi_elastic import quasi_elastic_form
+        from ..quasi_elastic import quasi_elastic_form
 
         return quasi_elastic_form("bounce_chain_time", exact)
-    from .equilibrium import Equilibrium
+    from ..equilibrium import Equilibrium
 
     return float(Equilibrium(exact).relaxation_time)
 
@@ -183,12 +183,12 @@ def relaxation_time_bound(restitution) -> float:
 
     Examples
     --------
-    >>> from bouncing_ball.equilibration import relaxation_time_bound
+    >>> from bouncing_ball.simulation.equilibration import relaxation_time_bound
     >>> print(round(relaxation_time_bound("1/2"), 3))
     18.322
     """
-    from .asymptotics import CRITICAL_RESTITUTION
-    from .restitution import parse_restitution
+    from ..asymptotics import CRITICAL_RESTITUTION
+    from ..restitution import parse_restitution
 
     r = float(parse_restitution(restitution, "r"))
     if not r > CRITICAL_RESTITUTION:
@@ -197,8 +197,8 @@ def relaxation_time_bound(restitution) -> float:
 
 
 def _above_critical(restitution) -> bool:
-    from .asymptotics import CRITICAL_RESTITUTION
-    from .restitution import parse_restitution
+    from ..asymptotics import CRITICAL_RESTITUTION
+    from ..restitution import parse_restitution
 
     return parse_restitution(restitution, "r") > CRITICAL_RESTITUTION
 
@@ -221,7 +221,7 @@ def default_equilibration_time(restitution) -> float:
 
     Examples
     --------
-    >>> from bouncing_ball.equilibration import default_equilibration_time
+    >>> from bouncing_ball.simulation.equilibration import default_equilibration_time
     >>> default_equilibration_time("1/2"), default_equilibration_time(0.1)
     (1000.0, 1000.0)
     >>> default_equilibration_time(0.95), default_equilibration_time(0.99)
@@ -246,7 +246,7 @@ def _two_digits_up(time: float) -> float:
 
 
 def equilibration_problems(
-    restitution, shard_time: float, equilibration_time: float, where: str = ""
+    restitution, shard_time: float, equilibration_time: float, where: str = "", units=None
 ) -> list[str]:
     """What in a shard's times falls short of the relaxation time at r, one sentence each.
 
@@ -263,6 +263,9 @@ def equilibration_problems(
         The shard's settings, in the paper's time units.
     where : str, optional
         The prefix of the settings' names in the messages (e.g. ``"simulation."``).
+    units : units.PhysicalUnits, optional
+        The units the messages quote every time in (those the user gave ``simulate``); None:
+        the paper's.
 
     Returns
     -------
@@ -271,15 +274,23 @@ def equilibration_problems(
 
     Examples
     --------
-    >>> from bouncing_ball.equilibration import equilibration_problems
+    >>> from bouncing_ball.simulation.equilibration import equilibration_problems
     >>> equilibration_problems("1/2", 2e3, 1e3)
     []
     >>> for problem in equilibration_problems(0.95, 2e3, 50.0):
     ...     print(problem)  # doctest: +ELLIPSIS
     r = 0.95: equilibration_time = 50 is shorter than 20 relaxation times (1016.13 each): ...
     r = 0.95: shard_time = 2000 is shorter than 8 relaxation times (1016.13 each): ...
+
+    The same in seconds, for a ball under g = 9.81 and a noise strength Lambda = 0.05, whose
+    unit of time is Lambda / g^2 = 5.2e-4 s:
+
+    >>> from bouncing_ball.units import PhysicalUnits
+    >>> units = PhysicalUnits(gravity=9.81, noise=0.05)
+    >>> print(equilibration_problems(0.95, 2e3, 50.0, units=units)[0])  # doctest: +ELLIPSIS
+    r = 0.95: equilibration_time = 0.0259778 is shorter than 20 relaxation times (0.527935 each): ...
     """
-    from .restitution import parse_restitution, restitution_label
+    from ..restitution import parse_restitution, restitution_label
 
     if not _above_critical(restitution):
         return []
@@ -290,27 +301,32 @@ def equilibration_problems(
         return []  # the same answer, without solving eq. (inteq)
     relaxation = equilibration_relaxation_time(restitution)
     label = restitution_label(parse_restitution(restitution, "r"))
+
+    def shown(time):  # a time of the paper's units in those of the messages
+        return time if units is None else float(units.to_physical(time, "time"))
+
     problems = []
     needed = EQUILIBRATION_RELAXATION_TIMES * relaxation
     if equilibration_time < needed and needed > MIN_EQUILIBRATION_TIME:
         problems.append(
-            f"r = {label}: {where}equilibration_time = {equilibration_time:g} is shorter "
-            f"than {EQUILIBRATION_RELAXATION_TIMES} relaxation times ({relaxation:.6g} each): "
-            "the shards may record the start's transient; use the default (the workflow's "
-            f"equilibration_time: auto), {needed:.3g}"
+            f"r = {label}: {where}equilibration_time = {shown(equilibration_time):g} is "
+            f"shorter than {EQUILIBRATION_RELAXATION_TIMES} relaxation times "
+            f"({shown(relaxation):.6g} each): the shards may record the start's transient; use "
+            f"the default (the workflow's equilibration_time: auto), {shown(needed):.3g}"
         )
     shortest = SHARD_RELAXATION_TIMES * relaxation
     if shard_time < shortest:
         problems.append(
-            f"r = {label}: {where}shard_time = {shard_time:g} is shorter than "
-            f"{SHARD_RELAXATION_TIMES} relaxation times ({relaxation:.6g} each): the early "
-            "part of a recording, which the equilibration check compares with the rest, "
-            f"spans less than one, and the errors cannot be trusted; use at least {shortest:.3g}"
+            f"r = {label}: {where}shard_time = {shown(shard_time):g} is shorter than "
+            f"{SHARD_RELAXATION_TIMES} relaxation times ({shown(relaxation):.6g} each): the "
+            "early part of a recording, which the equilibration check compares with the rest, "
+            "spans less than one, and the errors cannot be trusted; use at least "
+            f"{shown(shortest):.3g}"
         )
     return problems
 
 
-def warn_equilibration_problems(restitution, shard_time, equilibration_time) -> None:
+def warn_equilibration_problems(restitution, shard_time, equilibration_time, units=None) -> None:
     """Warn of each of ``equilibration_problems`` (``simulate``).
 
     Parameters
@@ -318,14 +334,16 @@ def warn_equilibration_problems(restitution, shard_time, equilibration_time) -> 
     restitution : float, str or fractions.Fraction
         r, 0 < r < 1.
     shard_time, equilibration_time : float
-        The shard's settings.
+        The shard's settings, in the paper's time units.
+    units : units.PhysicalUnits, optional
+        The units the warnings quote every time in (None: the paper's).
 
     Returns
     -------
     None
         Each problem is an ``EquilibrationWarning``, attributed to the caller's caller.
     """
-    for problem in equilibration_problems(restitution, shard_time, equilibration_time):
+    for problem in equilibration_problems(restitution, shard_time, equilibration_time, units=units):
         warnings.warn(problem, EquilibrationWarning, stacklevel=3)
 
 
@@ -348,7 +366,7 @@ def relaxation_record(restitution, shard_time: float, equilibration_time: float)
 
     Examples
     --------
-    >>> from bouncing_ball.equilibration import relaxation_record
+    >>> from bouncing_ball.simulation.equilibration import relaxation_record
     >>> record = relaxation_record("1/2", 2e3, 1e3)
     >>> round(record["shard_relaxation_times"], 1), record["problems"]
     (136.9, [])
@@ -386,7 +404,7 @@ def window_estimates(shards: list[ShardTallies]) -> pd.DataFrame:
     Examples
     --------
     >>> from types import SimpleNamespace
-    >>> from bouncing_ball.equilibration import window_estimates
+    >>> from bouncing_ball.simulation.equilibration import window_estimates
     >>> shard = SimpleNamespace(
     ...     time=10.0, collisions=5, int_x=20.0, int_x2=80.0,
     ...     early_time=2.0, early_collisions=1, early_int_x=4.0, early_int_x2=16.0,
@@ -436,7 +454,7 @@ def early_check(
     Three shards whose early parts agree with the rest within their scatter:
 
     >>> from types import SimpleNamespace
-    >>> from bouncing_ball.equilibration import early_check
+    >>> from bouncing_ball.simulation.equilibration import early_check
     >>> def shard(early_x, rest_x):
     ...     return SimpleNamespace(
     ...         time=10.0, collisions=5, int_x=2.0 * early_x + 8.0 * rest_x, int_x2=80.0,
@@ -633,7 +651,7 @@ def early_check_power(
     it shifts that part by 10.4 standard errors, which biases the final estimate by 1.3,
     and refuses at 2.04:
 
-    >>> from bouncing_ball.equilibration import REFUSE_P, early_check_power
+    >>> from bouncing_ball.simulation.equilibration import REFUSE_P, early_check_power
     >>> warn, refuse = early_check_power(64), early_check_power(64, p=REFUSE_P)
     >>> print(round(warn["difference_error"], 3), round(warn["early_shift"], 1))
     3.024 10.4
@@ -699,7 +717,7 @@ def early_check_power_table(
 
     Examples
     --------
-    >>> from bouncing_ball.equilibration import early_check_power_table
+    >>> from bouncing_ball.simulation.equilibration import early_check_power_table
     >>> print(early_check_power_table(decays=(0.0, 1.0)).round(2).to_string(index=False))
      decay  warn_bias  refuse_bias
        0.0       1.30         2.04
