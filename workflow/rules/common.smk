@@ -118,6 +118,23 @@ def batch_shards(wildcards):
     return list(range(first, last + 1))
 
 
+def study_batch_shards(wildcards):
+    """The shards of a study's batch file, shards{first}-{last}: first to last, both
+    included; refused unless it is a batch of the run (``STUDY_BATCHES`` of studies.smk).
+    """
+    path = (
+        f"results/studies/{wildcards.study}/{wildcards.run}/"
+        f"shards{wildcards.first}-{wildcards.last}.parquet"
+    )
+    batches = STUDY_BATCHES[wildcards.study].get(wildcards.run)
+    if batches is None or path not in batches:
+        raise ValueError(
+            f"{path}: not a batch of a run of config/studies.yaml (simulation.shards_per_job "
+            "of the config)"
+        )
+    return list(range(int(wildcards.first), int(wildcards.last) + 1))
+
+
 def batch_provenance(label):
     """What the provenance of every batch file of r = ``label`` records (with its first_shard
     and last_shard): the seed, the simulation code and the shard settings."""

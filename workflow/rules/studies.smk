@@ -55,22 +55,6 @@ STUDY_TARGETS = expand(
 )
 
 
-def study_batch_shards(wildcards):
-    """The shards of a study's batch file, shards{first}-{last}: first to last, both
-    included; refused unless it is a batch of the run (``STUDY_BATCHES``)."""
-    path = (
-        f"results/studies/{wildcards.study}/{wildcards.run}/"
-        f"shards{wildcards.first}-{wildcards.last}.parquet"
-    )
-    batches = STUDY_BATCHES[wildcards.study].get(wildcards.run)
-    if batches is None or path not in batches:
-        raise ValueError(
-            f"{path}: not a batch of a run of config/studies.yaml (simulation.shards_per_job "
-            "of the config)"
-        )
-    return list(range(int(wildcards.first), int(wildcards.last) + 1))
-
-
 rule study_batch:
     output:
         "results/studies/{study}/{run}/shards{first}-{last}.parquet",
