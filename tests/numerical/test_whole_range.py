@@ -1,16 +1,20 @@
 """Numerical claims over the whole range of r that the unit tier's modules rely on, each a
 solve at many r or a large array against the direct computation (split from
-tests/unit/test_equilibration.py, test_flight_time.py and test_equilibrium_extremes.py: each
-costs seconds, not the unit tier's fractions of one)."""
+tests/unit/test_equilibration.py, test_flight_time.py, test_equilibrium_extremes.py and
+test_equilibrium.py: each costs seconds, not the unit tier's fractions of one; the solves near
+r = 1 are shared with test_quasi_elastic_limit.py and test_distribution_any_r.py)."""
+
+from fractions import Fraction
 
 import numpy as np
 import pytest
 from scipy import integrate
 
-from bouncing_ball import Equilibrium, distribution
+import bouncing_ball as bb
+from bouncing_ball import Equilibrium, distribution, solver
 from bouncing_ball import flight_time as ft
 from bouncing_ball.equilibration import EQUILIBRATION_RELAXATION_TIMES, MIN_EQUILIBRATION_TIME
-from bouncing_ball.restitution import DISTRIBUTION_RESTITUTION_RANGE
+from bouncing_ball.restitution import DISTRIBUTION_RESTITUTION_RANGE, SOLVER_RESTITUTION_RANGE
 from bouncing_ball.solver import solve_outgoing_speed_density
 
 
@@ -81,3 +85,18 @@ def test_pxv_is_zero_beyond_the_largest_velocity_at_every_r():
     r = DISTRIBUTION_RESTITUTION_RANGE[1]
     eq = Equilibrium(r)
     assert eq.p0v(r * distribution.LARGEST_VELOCITY) == 0.0
+
+
+def test_the_upper_end_of_the_solver_range_is_solved():
+    """r = 0.9999, the solver's upper bound (given as the exact fraction, and as the decimal):
+    the solution balances energy to the solver's target."""
+    eq = bb.Equilibrium("9999/10000")
+    assert eq.restitution == Fraction(9999, 10000) and not eq.distribution_available
+    assert bb.Equilibrium(0.9999).solution is eq.solution
+    assert abs(solver.energy_balance_residual(eq.solution)) < solver.ACCURACY_TARGET
+    assert np.isfinite(eq.mean_x) and np.isfinite(eq.mean_flight_time)
+    with pytest.raises(
+        ValueError,
+        match=rf"{SOLVER_RESTITUTION_RANGE[0]} <= r <= {DISTRIBUTION_RESTITUTION_RANGE[1]}",
+    ):
+        eq.px(1.0)

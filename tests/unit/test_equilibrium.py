@@ -377,18 +377,6 @@ def test_above_the_distribution_range_the_position_quantities_are_refused(near_o
         call(near_one)
 
 
-def test_the_upper_end_of_the_solver_range_is_solved():
-    """r = 0.9999, the solver's upper bound (given as the exact fraction, and as the decimal):
-    the solution balances energy to the solver's target."""
-    eq = bb.Equilibrium("9999/10000")
-    assert eq.restitution == Fraction(9999, 10000) and not eq.distribution_available
-    assert bb.Equilibrium(0.9999).solution is eq.solution
-    assert abs(solver.energy_balance_residual(eq.solution)) < solver.ACCURACY_TARGET
-    assert np.isfinite(eq.mean_x) and np.isfinite(eq.mean_flight_time)
-    with pytest.raises(ValueError, match=rf"{LOW} <= r <= {DISTRIBUTION_HIGH}"):
-        eq.px(1.0)
-
-
 # --- one public hierarchy: EquilibriumBase, implemented in full by both classes
 
 
