@@ -71,6 +71,9 @@ def _interrupted_run(processes, group, shards, shard_time, after=2, delay=0.0):
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,  # its own process group, for a terminal's Ctrl-C
+        # as in a terminal: under a background job of a non-interactive shell (a CI script,
+        # nohup ... &) SIGINT arrives ignored, and Python then never raises KeyboardInterrupt
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     try:
         stdout, stderr = child.communicate(timeout=120)

@@ -43,3 +43,22 @@ def test_the_table_holds_every_quantity_at_every_r():
     assert len(table) == quantities * len(RESTITUTIONS)
     assert set(table["r"]) == set(RESTITUTIONS)
     assert np.all(np.isfinite(table[["scaled", "limit", "c1_measured", "c1_predicted"]]))
+
+
+def test_scaled_speed_curves_approach_the_limit_with_the_first_correction():
+    """Fig. 13's table: at r = 0.999 the measured first coefficient is the predicted p1(w) up to
+    O(epsilon) c2 with |c2| below the p1's size at these w (the tests above bound it more
+    tightly at more r); the limit column is the limiting law, and bad w is refused."""
+    w = np.array([0.3, 1.0, 3.0])
+    curves = qe.scaled_speed_curves([0.999], w)
+    assert list(curves.columns) == [
+        "r", "epsilon", "w", "scaled_p0v", "limit", "c1_measured", "c1_predicted"
+    ]  # fmt: skip
+    assert np.allclose(curves.limit, qe.scaled_speed_density(w), rtol=1e-15)
+    epsilon = 1e-3
+    assert np.all(
+        np.abs(curves.c1_measured - curves.c1_predicted) < 2.0 * epsilon * (5 + 3 * w) ** 2
+    )
+    for bad in ([0.0, 1.0], [np.inf], [[1.0]], []):
+        with pytest.raises(ValueError, match="scaled_speeds"):
+            qe.scaled_speed_curves([0.999], bad)

@@ -3,9 +3,10 @@
 CI-sized runs (16 shards per r) that are still sharp: each test asserts the errors its
 power rests on before it compares, and names the smallest error it rejects.  Seeds are
 fixed, so the outcome is deterministic.  Run with the default config's criterion constant c
-and with the paper's c = 5.
+at both r, and with the paper's c = 5 at r = 1/2.
 """
 
+import functools
 from fractions import Fraction
 
 import numpy as np
@@ -32,20 +33,28 @@ MAX_RELATIVE_ERROR = {"mean_x": 0.006, "delta_x": 0.01, "collision_rate": 0.0025
 OUTGOING_SPEED_POWER = {Fraction(1, 2): 0.015, Fraction(1, 3): 0.01}
 
 
-# the default config's c, and the paper's c = 5 where that differs
-CRITERIA = sorted({CRITERION_C, 5.0})
+# the default config's c at both r, and the paper's c = 5 (where that differs) at r = 1/2: c
+# enters the step rule alone (eq. (criterion)), whose form does not depend on r, and r = 1/2
+# has every check (P(x) and <v^2>_x besides the moments and P(0, v)), so that a c = 5 run at
+# r = 1/3 (the longer shards) repeats the c = 3 run's claims there
+RESTITUTIONS_AT = {CRITERION_C: list(TIME_AVERAGES), 5.0: [Fraction(1, 2)]}
+CRITERIA = sorted(RESTITUTIONS_AT)
+CASES = [pytest.param(c, r, id=f"c={c:g}-{r}") for c in CRITERIA for r in RESTITUTIONS_AT[c]]
 
 
-@pytest.fixture(scope="module", params=CRITERIA, ids=lambda c: f"c={c:g}")
-def shards(request):
-    return simulate_shards(SHARD_TIME, SHARDS, SEED, criterion_c=request.param)
+@functools.cache
+def _runs(c):
+    """{r: shards} at criterion constant c, simulated once per session."""
+    times = {r: SHARD_TIME[r] for r in RESTITUTIONS_AT[c]}
+    return simulate_shards(times, SHARDS, SEED, criterion_c=c)
 
 
-@pytest.mark.parametrize("r", list(TIME_AVERAGES), ids=str)
+@pytest.mark.parametrize(("c", "r"), CASES)
 @pytest.mark.parametrize("quantity", ["mean_x", "delta_x", "collision_rate"])
-def test_moments_match_exact_values(shards, r, quantity):
+def test_moments_match_exact_values(c, r, quantity):
     """<x>, Delta x and I of eq. (xandDeltax) within 3 standard errors.  Smallest error
     rejected: 4 times MAX_RELATIVE_ERROR (asserted), 2.4% in <x>, 4% in Delta x, 1% in I."""
+    shards = _runs(c)
     summary = position_moments_summary(shards[r], r, solved_outgoing_density(r)).iloc[0]
     value, error = summary[quantity], summary[f"{quantity}_err"]
     expected = TIME_AVERAGES[r][quantity]
@@ -54,12 +63,13 @@ def test_moments_match_exact_values(shards, r, quantity):
     assert abs(z) < 3.0, f"{quantity} = {value} +- {error}, exact {expected}, z = {z:.2f}"
 
 
-@pytest.mark.parametrize("r", list(TIME_AVERAGES), ids=str)
-def test_collision_rate_with_control_variates_matches_exact_value(shards, r):
+@pytest.mark.parametrize(("c", "r"), CASES)
+def test_collision_rate_with_control_variates_matches_exact_value(c, r):
     """I corrected by the martingale control variates (the summary's
     collision_rate_controlled, estimators.control_variate_rate): the exact value within 3
     errors, an error smaller than the plain estimator's, at each c.  Smallest error rejected:
     0.6% (relative error at most 0.15%, asserted; z = 4)."""
+    shards = _runs(c)
     summary = position_moments_summary(shards[r], r, solved_outgoing_density(r)).iloc[0]
     value, error = summary["collision_rate_controlled"], summary["collision_rate_controlled_err"]
     expected = TIME_AVERAGES[r]["collision_rate"]
@@ -79,12 +89,13 @@ def test_exact_module_reproduces_paper_closed_forms(r):
         assert computed[quantity] == pytest.approx(expected, rel=1e-9)
 
 
-@pytest.mark.parametrize("r", list(TIME_AVERAGES), ids=str)
-def test_outgoing_speed_density_chi_square(shards, r):
+@pytest.mark.parametrize(("c", "r"), CASES)
+def test_outgoing_speed_density_chi_square(c, r):
     """eq. (P(0,v)) with eq. (constants), no free parameter, for every bin with
     at least 100 collisions: chi^2 per bin and the worst bin, each against its
     sign-flip null distribution, at the 1e-3 level.  Smallest error rejected: P(0, v)
     scaled by 1.01 at r = 1/3, by 1.015 at r = 1/2 (the power test below)."""
+    shards = _runs(c)
     lower, upper, per_shard = outgoing_speed_bins(shards[r])
     deviations = per_shard - exact.outgoing_speed_bin_average(lower, upper, r)
     assert len(lower) >= 30, "too few populated bins for a meaningful chi^2"
@@ -94,18 +105,19 @@ def test_outgoing_speed_density_chi_square(shards, r):
     )
 
 
-@pytest.mark.parametrize("r", list(TIME_AVERAGES), ids=str)
-def test_outgoing_speed_density_rejects_a_small_error(shards, r):
+@pytest.mark.parametrize(("c", "r"), CASES)
+def test_outgoing_speed_density_rejects_a_small_error(c, r):
     """The power of the chi^2 above, from the same run's shards: eq. (P(0,v)) scaled by
     1 + OUTGOING_SPEED_POWER (1% at r = 1/3, 1.5% at r = 1/2) is rejected, p < 1e-3."""
+    shards = _runs(c)
     lower, upper, per_shard = outgoing_speed_bins(shards[r])
     wrong = (1.0 + OUTGOING_SPEED_POWER[r]) * exact.outgoing_speed_bin_average(lower, upper, r)
     _, p_chi2, _ = sign_flip_test(per_shard - wrong)
     assert p_chi2 < 1e-3
 
 
-@pytest.mark.parametrize("r", list(TIME_AVERAGES), ids=str)
-def test_outgoing_speed_density_with_the_return_law_control(shards, r):
+@pytest.mark.parametrize(("c", "r"), CASES)
+def test_outgoing_speed_density_with_the_return_law_control(c, r):
     """P(0, v) corrected by its return-law control (``p0v_controlled``,
     estimators.return_law_prediction, which uses eq. (kernel3) and the solver's P(0, u) only
     to weigh u inside a fine bin) against eq. (P(0,v)) in every bin with 0.01 <= v <= 5:
@@ -113,6 +125,7 @@ def test_outgoing_speed_density_with_the_return_law_control(shards, r):
     alarm in about 0.5% of runs over 27 bins), and the worst relative error at most half
     the plain estimator's.  Smallest error rejected: 5 times the largest relative error
     (asserted at most 1%), 5%."""
+    shards = _runs(c)
     table = outgoing_speed_histogram(shards[r], r, solved_outgoing_density(r))
     band = table[(table.v >= 0.01) & (table.v <= 5.0)]
     truth = exact.outgoing_speed_bin_average(band.v_lo.to_numpy(), band.v_hi.to_numpy(), r)
@@ -138,10 +151,12 @@ def _assert_sharp(table, quantity):
     )
 
 
-def test_position_density_half(shards):
+@pytest.mark.parametrize("c", CRITERIA, ids=lambda c: f"c={c:g}")
+def test_position_density_half(c):
     """P(x) = (1/3) K0(sqrt(2x/3)) at r = 1/2, eq. (P(x)2), for x in [0.1, 50]: every bin
     within 3 standard errors.  Smallest error rejected (z = 4): 2% in any one bin below
     x = 10, 8% in one above (``_assert_sharp``)."""
+    shards = _runs(c)
     r = Fraction(1, 2)
     table = _position_bins_up_to_50(position_histogram(shards[r]))
     _assert_sharp(table, "px")
@@ -151,10 +166,12 @@ def test_position_density_half(shards):
     assert np.all(np.abs(z) < 3.0), f"z = {np.round(z.to_numpy(), 2)}"
 
 
-def test_speed_squared_given_position_half(shards):
+@pytest.mark.parametrize("c", CRITERIA, ids=lambda c: f"c={c:g}")
+def test_speed_squared_given_position_half(c):
     """<v^2>_x of eq. (moment2) at r = 1/2 for x in [0.1, 50]: the worst bin
     against its sign-flip null at the 1e-3 level.  Smallest error rejected (z = 4): 2% in
     any one bin below x = 10, 8% in one above (``_assert_sharp``)."""
+    shards = _runs(c)
     r = Fraction(1, 2)
     table = _position_bins_up_to_50(position_histogram(shards[r]))
     _assert_sharp(table, "v2_given_x")
@@ -171,14 +188,15 @@ FLOOR_REGION = 0.1
 FLOOR_REGION_POWER = 0.015
 
 
-@pytest.mark.parametrize("r", list(TIME_AVERAGES), ids=str)
+@pytest.mark.parametrize(("c", "r"), CASES)
 @pytest.mark.parametrize("quantity", ["px", "v2_given_x"])
-def test_position_near_the_floor_matches_exact_values(shards, r, quantity):
+def test_position_near_the_floor_matches_exact_values(c, r, quantity):
     """P(x) of eq. (P(x)2) and <v^2>_x of eq. (moment2) in the bins below x = 0.1, where a
     step that starts or ends at the floor puts its time: z = (simulation - exact) / error per
     bin, chi^2 per bin and the worst bin against their sign-flip null distributions at the
     1e-3 level.  Smallest error rejected: 1.5% in every bin (checked here on the same
     shards: p < 1e-3), or 2% in any one bin (relative errors below 0.5%, asserted; z = 4)."""
+    shards = _runs(c)
     table = position_histogram(shards[r])
     table = table[(table.x_lo > 0.0) & (table.x_hi <= FLOOR_REGION * (1.0 + 1e-9))]
     assert len(table) >= 8, "too few bins below x = 0.1"

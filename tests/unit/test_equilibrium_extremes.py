@@ -10,7 +10,6 @@ from workflow_support import REPOSITORY
 
 from bouncing_ball import Equilibrium, ExactEquilibrium, distribution, exact, solver
 from bouncing_ball.distribution import LARGEST_POSITION, SMALLEST_POSITION
-from bouncing_ball.restitution import DISTRIBUTION_RESTITUTION_RANGE
 from bouncing_ball.workflow.config import read_yaml
 
 EXACT = ("1/2", "1/3")
@@ -175,14 +174,6 @@ def test_pxv_is_zero_beyond_the_largest_velocity_and_refuses_heights_outside(pai
             np.testing.assert_array_equal(eq.pxv([0.0, 1.0, 0.0], [-huge, -huge, huge]), 0.0)
         with pytest.raises(ValueError, match=r"x = 1e\+20 is outside the heights computed"):
             eq.pxv(1e20, -1.0)
-
-
-def test_pxv_is_zero_beyond_the_largest_velocity_at_every_r():
-    """P(0, r v) at the upper end of DISTRIBUTION_RESTITUTION_RANGE (the smallest r q of the
-    range) underflows at v = LARGEST_VELOCITY."""
-    r = DISTRIBUTION_RESTITUTION_RANGE[1]
-    eq = Equilibrium(r)
-    assert eq.p0v(r * distribution.LARGEST_VELOCITY) == 0.0
 
 
 def test_bin_averages_never_depend_on_the_other_bins(pair):

@@ -260,17 +260,6 @@ def test_long_time_asymptote(r):
     assert np.all(np.diff(relative) < 0.0) and relative[-1] < 0.02
 
 
-def test_flight_time_bins_sum_to_one():
-    solution = solve_outgoing_speed_density(0.5)
-    edges = np.concatenate([[0.0], np.geomspace(1e-3, 50.0, 15)])
-    average = ft.flight_time_bin_average(solution, edges[:-1], edges[1:])
-    beyond, _ = integrate.quad(
-        lambda t: ft.flight_rate_density(solution, np.array([t]))[0], 50.0, 300.0, epsrel=1e-12
-    )
-    total = average @ np.diff(edges) + beyond / solution.moment(1)
-    assert total == pytest.approx(1.0, abs=1e-8)
-
-
 def test_return_speed_bins():
     solution = solve_outgoing_speed_density(0.5)
     u_edges = np.geomspace(1e-2, 10.0, 7)
@@ -290,32 +279,6 @@ def test_return_speed_bins():
         inner = integrate.simpson(v * return_speed_kernel(v[None, :], u[:, None]), x=v, axis=1)
         expected = integrate.simpson(flux * inner, x=u) / integrate.simpson(flux, x=u)
         assert cells[3, j] == pytest.approx(expected, rel=1e-6, abs=0.0)
-
-
-@pytest.mark.parametrize("restitution", [0.1, 0.5, 0.95])
-def test_interpolated_return_speed_law_is_the_direct_one_to_rounding(restitution):
-    # the return-law control's case: four points in each of the fine 2.3 % bins of the
-    # outgoing speeds, from 1e-10 to 1000, on a simulation's speed bins / r
-    fine = np.geomspace(1e-10, 1e3, 1301)
-    u, _ = ft._log_gauss(fine[:-1], fine[1:], 4)
-    speed_edges = np.geomspace(1e-4, 100.0, 61) / restitution
-    v_lower = np.concatenate([[0.0], speed_edges])
-    v_upper = np.concatenate([speed_edges, [np.inf]])
-    direct = ft.return_speed_bin_law(u.ravel(), v_lower, v_upper)
-    interpolated = ft.return_speed_bin_law(u.ravel(), v_lower, v_upper, interpolated=True)
-    np.testing.assert_allclose(direct.sum(axis=1), 1.0, rtol=0, atol=1e-14)
-    np.testing.assert_allclose(interpolated, direct, rtol=0, atol=1e-14)
-    # each point's value whatever the others asked for (fixed panels): a few points, every
-    # other point
-    np.testing.assert_array_equal(
-        ft.return_speed_bin_law(u.ravel()[::2], v_lower, v_upper, interpolated=True),
-        interpolated[::2],
-    )
-    few = u.ravel()[1000:1010]
-    np.testing.assert_array_equal(
-        ft.return_speed_bin_law(few, v_lower, v_upper, interpolated=True),
-        ft.return_speed_bin_law(few, v_lower, v_upper),
-    )
 
 
 def _simulated_flights(u, count, dt, seed):

@@ -15,7 +15,7 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 import yaml
-from workflow_support import SMALL, copy_repository, planned_jobs, snakemake
+from workflow_support import SMALL, copy_repository, planned_jobs, snakemake, two_at_a_time
 
 from bouncing_ball.workflow.io import read_table
 
@@ -215,15 +215,20 @@ def test_r_outside_the_solver_range_is_refused_before_any_job(tmp_path):
     """Above the range of the whole distribution (0.9995, 0.9999) and below the solver's
     (0.015): refused before any job, naming the target and the range (all-NaN P(x) in a job
     that succeeds, or a crashed solve job, otherwise)."""
-    directory = copy_repository(tmp_path, SMALL)
-    for label in ("0.9995", "0.9999", "0.015"):
-        result = snakemake(directory, f"results/solver/r{label}/summary.parquet")
+    labels = ("0.9995", "0.9999", "0.015")
+    # a copy for each, the starts two at a time
+    for label in labels:
+        (tmp_path / label).mkdir()
+    directories = [copy_repository(tmp_path / label, SMALL) for label in labels]
+    targets = [f"results/solver/r{label}/summary.parquet" for label in labels]
+    results = two_at_a_time(snakemake, zip(directories, targets))
+    for directory, result in zip(directories, results):
         assert result.returncode != 0
         assert (
             "outside the range of r where P(x, v) is verified, 0.02 <= r <= 0.999"
             in result.stdout + result.stderr
         )
-    assert not (directory / "results/solver").exists()
+        assert not (directory / "results/solver").exists()
 
 
 def test_every_reader_refuses_a_table_of_the_wrong_kind_or_r(finished_run, tmp_path):

@@ -6,55 +6,17 @@ import math
 import pandas as pd
 import pytest
 import yaml
-from workflow_support import SMALL, copy_repository, planned_jobs, snakemake
+from workflow_support import (
+    SMALL,
+    TINY,
+    copy_with_studies,
+    planned_jobs,
+    snakemake,
+    two_at_a_time,
+)
 
 from bouncing_ball.simulation.equilibration import default_equilibration_time
 from bouncing_ball.workflow.io import read_table
-
-# 2-4 shards per run of 1e3-2e3 time units; batches and groups of 2 shards so that every
-# column of the r075 report has a number for run c3 and the pooled runs; coverage: 2 runs of
-# 4 shards per r, too few shards for the control variates
-TINY = {
-    "criterion_bias": {
-        "restitution": ["1/2", "1/3"],
-        "criterion_c": [3.0, 5.0],
-        "seed": 7,
-        "shards": 2,
-        "shard_time": {"1/2": 2.0e3, "1/3": 1.0e3},
-        "minimum_count": 5,
-    },
-    "r075": {
-        "restitution": 0.75,
-        "shard_time": 2.0e3,
-        "batch_size": 2,
-        "group_size": 2,
-        "runs": {
-            "c3": {"criterion_c": 3.0, "seed": 1, "shards": 4},
-            "c5": {"criterion_c": 5.0, "seed": 2, "shards": 2},
-        },
-    },
-    "coverage": {
-        "restitution": ["1/2", "1/3"],
-        "seed": 3,
-        "runs": 2,
-        "shards": 4,
-        "shard_time": {"1/2": 1.0e3, "1/3": 1.0e3},
-    },
-}
-
-
-def copy_with_studies(directory, studies):
-    copy_repository(directory, SMALL)
-    (directory / "config" / "studies.yaml").write_text(yaml.safe_dump(studies))
-    return directory
-
-
-@pytest.fixture(scope="module")
-def studies_run(tmp_path_factory):
-    directory = copy_with_studies(tmp_path_factory.mktemp("studies"), TINY)
-    result = snakemake(directory, "studies")
-    assert result.returncode == 0, result.stderr[-3000:]
-    return directory
 
 
 def finite(table, columns):
@@ -153,25 +115,40 @@ def test_the_studies_are_not_part_of_the_default_target(tmp_path):
     assert not {"study_batch", "studies", *reports} & set(jobs)
 
 
-@pytest.mark.parametrize(
-    "change, message",
-    [
-        (("criterion_bias", "seeed", 7), "'seeed' was unexpected"),
-        (("r075", "batch_size", 0), "batch_size"),
-        (
-            ("r075", "runs", {"c3": {"criterion_c": 3.0, "seed": 1, "shard": 2}}),
-            "'shard' was unexpected",
-        ),
-        (("criterion_bias", "restitution", ["1/2", 0.25]), "r = 1/4 has no exact solution"),
-    ],
-    ids=["typo", "range", "typo-in-a-run", "beyond-the-schema"],
-)
-def test_a_bad_studies_file_is_refused_naming_the_key(tmp_path, change, message):
-    study, key, value = change
-    bad = yaml.safe_load(yaml.safe_dump(TINY))
-    bad[study][key] = value
-    directory = copy_with_studies(tmp_path, bad)
-    result = snakemake(directory, "--dry-run", "studies")
+# a bad studies file, and a part of the message that names what is wrong
+BAD_STUDIES = {
+    "typo": (("criterion_bias", "seeed", 7), "'seeed' was unexpected"),
+    "range": (("r075", "batch_size", 0), "batch_size"),
+    "typo-in-a-run": (
+        ("r075", "runs", {"c3": {"criterion_c": 3.0, "seed": 1, "shard": 2}}),
+        "'shard' was unexpected",
+    ),
+    "beyond-the-schema": (
+        ("criterion_bias", "restitution", ["1/2", 0.25]),
+        "r = 1/4 has no exact solution",
+    ),
+}
+
+
+@pytest.fixture(scope="module")
+def refused_studies(tmp_path_factory):
+    """{case: (directory, snakemake --dry-run studies)} for each of BAD_STUDIES, in a copy of
+    its own, the starts two at a time."""
+    directories = {}
+    for case, ((study, key, value), _) in BAD_STUDIES.items():
+        bad = yaml.safe_load(yaml.safe_dump(TINY))
+        bad[study][key] = value
+        directories[case] = copy_with_studies(tmp_path_factory.mktemp(case), bad)
+    results = two_at_a_time(
+        snakemake, [(directory, "--dry-run", "studies") for directory in directories.values()]
+    )
+    return {case: (directories[case], result) for case, result in zip(directories, results)}
+
+
+@pytest.mark.parametrize("case", list(BAD_STUDIES))
+def test_a_bad_studies_file_is_refused_naming_the_key(refused_studies, case):
+    directory, result = refused_studies[case]
+    message = BAD_STUDIES[case][1]
     assert result.returncode != 0
     output = result.stderr + result.stdout
     assert message in output and "config/studies.yaml" in output, output[-2000:]

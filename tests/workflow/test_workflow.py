@@ -21,6 +21,7 @@ from workflow_support import (
     copy_repository,
     planned_jobs,
     snakemake,
+    two_at_a_time,
 )
 
 from bouncing_ball.validation import MOMENT_COLUMNS, VALIDATION_CHECKS, VALIDATION_COLUMNS
@@ -224,8 +225,46 @@ def test_the_report_has_every_figure_and_table_with_its_caption(finished_run, tm
         assert phrase in text, phrase
 
 
-def test_second_run_has_nothing_to_do(finished_run):
-    result = snakemake(finished_run, "--dry-run")
+# the targets the workflow refuses before any job, with a part of the message naming the reason
+UNANSWERABLE = [
+    # outside the range where rule solve's tables are verified
+    (
+        "results/solver/r0.001/summary.parquet",
+        "target results/solver/r0.001: r = '0.001' is outside the range of r where P(x, v) is verified",
+    ),
+    (
+        "results/fits/r1e-07.parquet",
+        "r = '1e-07' is outside the range of r where P(x, v) is verified",
+    ),
+    # a label that rounds to 1 (it would read back as r = 1)
+    ("results/simulation/r0.9999999/p0v.parquet", "r = '0.9999999' rounds to 1"),
+    # a batch of shards that is not one of the config's (its list of shards: no memory)
+    (
+        "results/simulation/r0.5/shards0-99999999999.parquet",
+        "shards0-99999999999.parquet: not a batch of the config's shards of r = 0.5 "
+        "(simulation.shards and shards_per_job): shards0-1, shards2-2",
+    ),
+    ("results/simulation/r0.5/shards00-1.parquet", "not a batch of the config's shards"),
+    # a label that is not the canonical one of its r, an exact solution the paper has not
+    ("results/simulation/r0.50/summary.parquet", "use r0.5"),
+    (
+        "results/exact/r0.6/summary.parquet",
+        "exact solutions exist only for r0.5 (r = 1/2) and r0.333333 (r = 1/3)",
+    ),
+]
+
+
+@pytest.fixture(scope="module")
+def dry_runs(finished_run):
+    """{target: snakemake --dry-run target} in the finished run, for "all" and each of
+    UNANSWERABLE (dry runs take no lock: the starts run two at a time)."""
+    targets = ["all", *(target for target, _ in UNANSWERABLE)]
+    results = two_at_a_time(snakemake, [(finished_run, "--dry-run", target) for target in targets])
+    return dict(zip(targets, results))
+
+
+def test_second_run_has_nothing_to_do(dry_runs):
+    result = dry_runs["all"]
     assert result.returncode == 0
     assert "Nothing to be done" in result.stdout + result.stderr
 
@@ -242,15 +281,6 @@ def test_an_r_not_in_the_config_is_a_valid_target(finished_run, tmp_path):
     result = snakemake(finished_run, solved)
     assert result.returncode == 0, result.stderr[-3000:]
     assert pd.read_parquet(finished_run / solved).r.iloc[0] == pytest.approx(0.6)
-
-
-def test_exact_solutions_exist_only_for_one_half_and_one_third(finished_run):
-    result = snakemake(finished_run, "--dry-run", "results/exact/r0.6/summary.parquet")
-    assert result.returncode != 0
-    assert (
-        "exact solutions exist only for r0.5 (r = 1/2) and r0.333333 (r = 1/3)"
-        in result.stdout + result.stderr
-    )
 
 
 def test_exact_one_third_does_not_need_one_third_in_the_config(finished_run, tmp_path):
@@ -444,21 +474,30 @@ def _packagecopy_repository(tmp_path):
     return tmp_path / "lib" / "bouncing_ball", {**os.environ, "PYTHONPATH": str(tmp_path / "lib")}
 
 
+def _edited_library(tmp_path, *modules):
+    """A copy of the library (``_packagecopy_repository``) in a folder of its own under
+    ``tmp_path``, with an edit appended to each of ``modules`` (paths in the package), and the
+    environment that puts it first."""
+    folder = tmp_path / "-".join(("library", *modules))
+    package, env = _packagecopy_repository(folder)
+    for module in modules:
+        with open(package / module, "a") as handle:
+            handle.write("\n# an edit\n")
+    return env
+
+
 def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
-    package, env = _packagecopy_repository(tmp_path)
-    assert planned_jobs(finished_run, env) == {}
-    with open(package / "estimators" / "histograms.py", "a") as handle:
-        handle.write("\n# an edit\n")
     # everything drawn from the simulation
     downstream = {"fig4": 1, "fig5": 1, "fig8": 1, "fig10": 1, "fig11": 1, **AGGREGATES}
-    assert planned_jobs(finished_run, env) == {"merge_shards": 2, "fit": 2, **downstream}
-    with open(package / "free_flight.py", "a") as handle:
-        handle.write("\n# an edit\n")
-    assert planned_jobs(finished_run, env) == {
-        "simulate_shards": 3,
-        "merge_shards": 2,
-        "fit": 2,
-        **downstream,
+    expected_after = {
+        (): {},
+        ("estimators/histograms.py",): {"merge_shards": 2, "fit": 2, **downstream},
+        ("estimators/histograms.py", "free_flight.py"): {
+            "simulate_shards": 3,
+            "merge_shards": 2,
+            "fit": 2,
+            **downstream,
+        },
     }
     solved = {
         "solve": 2,
@@ -520,11 +559,14 @@ def test_editing_library_code_reruns_only_its_stage(finished_run, tmp_path):
             {"fig7": 1, "moments_table": 1, "validation_table": 1, "position_asymptotics": 1},
         ),
     ):
-        shutil.rmtree(package.parent)
-        package, env = _packagecopy_repository(tmp_path)
-        with open(package / f"{module}.py", "a") as handle:
-            handle.write("\n# an edit\n")
-        assert planned_jobs(finished_run, env) == {**expected, "all": 1}, module
+        expected_after[(f"{module}.py",)] = {**expected, "all": 1}
+    # each edit in a copy of its own: the dry runs (no lock) two at a time
+    edits = list(expected_after)
+    planned = two_at_a_time(
+        planned_jobs, [(finished_run, _edited_library(tmp_path, *modules)) for modules in edits]
+    )
+    for modules, jobs in zip(edits, planned):
+        assert jobs == expected_after[modules], modules
 
 
 def test_results_do_not_depend_on_cores_or_on_the_batching_of_shards(finished_run, tmp_path):
@@ -560,39 +602,9 @@ def test_results_do_not_depend_on_cores_or_on_the_batching_of_shards(finished_ru
         pd.testing.assert_frame_equal(one, two, check_exact=True)
 
 
-def test_a_non_canonical_label_is_refused(finished_run):
-    result = snakemake(finished_run, "--dry-run", "results/simulation/r0.50/summary.parquet")
-    assert result.returncode != 0
-    assert "use r0.5" in result.stdout + result.stderr
-
-
-@pytest.mark.parametrize(
-    "target, message",
-    [
-        # outside the range where rule solve's tables are verified
-        (
-            "results/solver/r0.001/summary.parquet",
-            "target results/solver/r0.001: r = '0.001' is outside the range of r where P(x, v) is verified",
-        ),
-        (
-            "results/fits/r1e-07.parquet",
-            "r = '1e-07' is outside the range of r where P(x, v) is verified",
-        ),
-        # a label that rounds to 1 (it would read back as r = 1)
-        ("results/simulation/r0.9999999/p0v.parquet", "r = '0.9999999' rounds to 1"),
-        # a batch of shards that is not one of the config's (its list of shards: no memory)
-        (
-            "results/simulation/r0.5/shards0-99999999999.parquet",
-            "shards0-99999999999.parquet: not a batch of the config's shards of r = 0.5 "
-            "(simulation.shards and shards_per_job): shards0-1, shards2-2",
-        ),
-        ("results/simulation/r0.5/shards00-1.parquet", "not a batch of the config's shards"),
-    ],
-)
-def test_a_target_the_workflow_cannot_answer_is_refused_before_any_job(
-    finished_run, target, message
-):
-    result = snakemake(finished_run, "--dry-run", target)
+@pytest.mark.parametrize("target, message", UNANSWERABLE)
+def test_a_target_the_workflow_cannot_answer_is_refused_before_any_job(dry_runs, target, message):
+    result = dry_runs[target]
     assert result.returncode != 0
     assert message in result.stdout + result.stderr
 
@@ -780,12 +792,20 @@ END_TO_END = [BAD[i] for i in (0, 5, 8, 19)] + [
 ]
 
 
-@pytest.mark.parametrize(
-    "config, key", END_TO_END, ids=[key.split(":")[0] for _, key in END_TO_END]
-)
-def test_bad_config_is_refused_before_any_job_runs(tmp_path, config, key):
-    directory = copy_repository(tmp_path, config)
-    result = snakemake(directory)
+@pytest.fixture(scope="module")
+def refused_end_to_end(tmp_path_factory):
+    """{key: (directory, snakemake's result)} for each config of END_TO_END, in a copy of its
+    own, the runs two at a time."""
+    directories = [
+        copy_repository(tmp_path_factory.mktemp("refused"), config) for config, _ in END_TO_END
+    ]
+    results = two_at_a_time(snakemake, [(directory,) for directory in directories])
+    return {key: run for (_, key), run in zip(END_TO_END, zip(directories, results))}
+
+
+@pytest.mark.parametrize("key", [key for _, key in END_TO_END], ids=lambda key: key.split(":")[0])
+def test_bad_config_is_refused_before_any_job_runs(refused_end_to_end, key):
+    directory, result = refused_end_to_end[key]
     assert result.returncode != 0
     assert key in result.stderr + result.stdout
     assert not (directory / "results").exists()
