@@ -13,8 +13,11 @@ from scipy import integrate
 import bouncing_ball as bb
 from bouncing_ball import Equilibrium, distribution, solver
 from bouncing_ball import flight_time as ft
-from bouncing_ball.simulation.equilibration import EQUILIBRATION_RELAXATION_TIMES, MIN_EQUILIBRATION_TIME
 from bouncing_ball.restitution import DISTRIBUTION_RESTITUTION_RANGE, SOLVER_RESTITUTION_RANGE
+from bouncing_ball.simulation.equilibration import (
+    EQUILIBRATION_RELAXATION_TIMES,
+    MIN_EQUILIBRATION_TIME,
+)
 from bouncing_ball.solver import solve_outgoing_speed_density
 
 
