@@ -3,9 +3,13 @@ eq. (P(x)1) against the solver's Ito time averages (moments of P(0, v) only), an
 identities eqs. (moment1), (moment2) of P(x, v) of eq. (fpsol).  Split from test_distribution.py
 because every r costs a build of w(F) (``python -m benchmarks`` times it)."""
 
+from fractions import Fraction
+
 import numpy as np
 import pytest
 from distribution_support import build, check_moment_identities, check_position_moments
+
+from bouncing_ball import distribution, exact
 
 # 0.15 < r_c: beta > 2; 0.75, 0.9 > sqrt(3) - 1: q < 1/2 (the contour continues the real-axis
 # integral of eq. (weightfunc), which diverges there); 0.95, 0.99, 0.999 > RAY_RESTITUTION: the
@@ -42,3 +46,23 @@ def test_weight_function_grows_where_q_is_below_one_half(built):
     assert weight.small_force_decay < 0.0
     assert np.all(weight.log(forces) > 10.0)
     assert np.all(np.abs(weight.log(forces) + weight.small_force_decay / forces) < 20.0)
+
+
+# the ray's solve checked where the exact solution continues to it (split from
+# tests/unit/test_distribution.py: it compiles and solves the ray's band, as 0.95 - 0.999 above do)
+def test_ray_density_matches_the_exact_one_at_one_half(built):
+    """P(0, v) solved from eq. (inteq) on the ray arg v = RAY_ANGLE (the sparse band of the ray's
+    operator, its LU, the rotated momentum balance) against eq. (P(0,v)) continued to the ray,
+    A e^(-v) / v: to 1e-12 from the lowest node u_0 up to the largest |v| used (the rule's error
+    exp(-2 pi^2 / (3 h)) is below rounding at the ray's step h = 0.125), and within 2 u_0 below
+    it, where the power law C v^-beta drops the next term of P(0, v), of relative order u_0."""
+    solution, _ = built(Fraction(1, 2))
+    density = distribution._ray_density(solution)
+    lowest = solution.speeds[0]
+    rho = np.geomspace(1e-3 * lowest, density.largest, 60)
+    v = rho * density.ray
+    expected = np.log(exact.normalization_constant("1/2")) - v - np.log(v)
+    deviation = np.abs(np.expm1(density.log_density(rho) - expected))
+    assert np.max(deviation[rho >= lowest]) < 1e-12
+    assert np.max(deviation[rho < lowest]) < 2.0 * lowest
+    assert abs(density.eigenvalue - 1.0) < 1e-12 and density.error < 1e-12

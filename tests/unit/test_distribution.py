@@ -97,24 +97,6 @@ def test_asymptotic_exponents_at_one_half(built):
     assert measured["large_x_power"] == pytest.approx(-0.25, abs=2e-3)
 
 
-def test_ray_density_matches_the_exact_one_at_one_half(built):
-    """P(0, v) solved from eq. (inteq) on the ray arg v = RAY_ANGLE (the sparse band of the ray's
-    operator, its LU, the rotated momentum balance) against eq. (P(0,v)) continued to the ray,
-    A e^(-v) / v: to 1e-12 from the lowest node u_0 up to the largest |v| used (the rule's error
-    exp(-2 pi^2 / (3 h)) is below rounding at the ray's step h = 0.125), and within 2 u_0 below
-    it, where the power law C v^-beta drops the next term of P(0, v), of relative order u_0."""
-    solution, _ = built(Fraction(1, 2))
-    density = distribution._ray_density(solution)
-    lowest = solution.speeds[0]
-    rho = np.geomspace(1e-3 * lowest, density.largest, 60)
-    v = rho * density.ray
-    expected = np.log(exact.normalization_constant("1/2")) - v - np.log(v)
-    deviation = np.abs(np.expm1(density.log_density(rho) - expected))
-    assert np.max(deviation[rho >= lowest]) < 1e-12
-    assert np.max(deviation[rho < lowest]) < 2.0 * lowest
-    assert abs(density.eigenvalue - 1.0) < 1e-12 and density.error < 1e-12
-
-
 # the default config's P(x, v) grid (config/config.yaml, solver: positions, speeds)
 RULE_POSITIONS = [0.012589, 0.12589, 1.2589]
 RULE_SPEEDS = np.linspace(-4.0, 6.0, 101)
