@@ -19,7 +19,7 @@ run) loads neither numba nor scipy.
 import hashlib
 from pathlib import Path
 
-__version__ = "0.3.0"
+__version__ = "0.4.0"
 
 PACKAGE = Path(__file__).parent
 
