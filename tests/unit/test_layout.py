@@ -287,3 +287,20 @@ def test_every_stage_names_modules_that_exist():
             for module in modules:
                 assert bouncing_ball._module_files(module), module
                 assert all(path.is_file() for path in bouncing_ball._module_files(module)), module
+
+
+def test_the_simulation_package_names_every_public_name_of_its_modules_where_it_lives():
+    """``bouncing_ball.simulation`` loads its names on first use from the module ``_HOMES``
+    names: each such name is that module's, and every module's ``__all__`` is reachable from
+    the package, so the lazy table and the modules cannot drift apart."""
+    import bouncing_ball.simulation as simulation
+
+    homes = simulation._HOMES
+    for name, home in homes.items():
+        module = importlib.import_module(f"bouncing_ball.simulation.{home}")
+        assert hasattr(module, name), f"{name} is not in simulation.{home}"
+    for info in pkgutil.iter_modules(simulation.__path__):
+        module = importlib.import_module(f"bouncing_ball.simulation.{info.name}")
+        missing = [name for name in getattr(module, "__all__", []) if homes.get(name) != info.name]
+        assert not missing, f"simulation._HOMES lacks {missing} of simulation.{info.name}"
+    assert set(simulation.__all__) <= set(homes)

@@ -5,6 +5,7 @@ from types import SimpleNamespace
 from bouncing_ball import source_digest
 from bouncing_ball.workflow import stages
 from bouncing_ball.workflow.config import (
+    batch_ranges,
     check_config,
     exact_settings,
     known_restitutions,
@@ -98,41 +99,51 @@ def batch_files(wildcards):
     ]
 
 
-def batch_shards(wildcards):
-    """The shards of a batch file, shards{first}-{last}: first to last, both included;
-    refused unless it is a batch of the config (``shard_batches``)."""
+def checked_batch(path, wildcards, batches, where):
+    """The shards of the batch file ``path``, shards{first}-{last}: first to last, both
+    included; refused unless (first, last), as written, is one of ``batches`` ((first,
+    last) pairs, ``batch_ranges``), with ``where`` saying whose batches they are."""
     first, last = int(wildcards.first), int(wildcards.last)
-    path = f"results/simulation/r{wildcards.r}/shards{wildcards.first}-{wildcards.last}.parquet"
     if last < first:
         raise ValueError(
             f"{path}: the last shard ({last}) comes before the first ({first})"
         )
-    batches = shard_batches(config, wildcards.r)
     if (first, last) not in batches or wildcards.first != str(first):
         raise ValueError(
-            f"{path}: not a batch of the config's shards of r = {wildcards.r} "
-            f"(simulation.shards and shards_per_job): "
+            f"{path}: not a batch of {where}: "
             + ", ".join(f"shards{a}-{b}" for a, b in batches[:8])
             + (", ..." if len(batches) > 8 else "")
         )
     return list(range(first, last + 1))
 
 
-def study_batch_shards(wildcards):
-    """The shards of a study's batch file, shards{first}-{last}: first to last, both
-    included; refused unless it is a batch of the run (``STUDY_BATCHES`` of studies.smk).
-    """
-    path = (
-        f"results/studies/{wildcards.study}/{wildcards.run}/"
-        f"shards{wildcards.first}-{wildcards.last}.parquet"
+def batch_shards(wildcards):
+    """The shards of a batch file of r (``checked_batch`` against ``shard_batches``)."""
+    return checked_batch(
+        f"results/simulation/r{wildcards.r}/shards{wildcards.first}-{wildcards.last}.parquet",
+        wildcards,
+        shard_batches(config, wildcards.r),
+        f"the config's shards of r = {wildcards.r} (simulation.shards and shards_per_job)",
     )
-    batches = STUDY_BATCHES[wildcards.study].get(wildcards.run)
-    if batches is None or path not in batches:
-        raise ValueError(
-            f"{path}: not a batch of a run of config/studies.yaml (simulation.shards_per_job "
-            "of the config)"
-        )
-    return list(range(int(wildcards.first), int(wildcards.last) + 1))
+
+
+def study_batch_shards(wildcards):
+    """The shards of a batch file of a study's run (``checked_batch`` against the run's
+    batches of simulation.shards_per_job shards; the runs: ``STUDY_RUNS`` of studies.smk).
+    """
+    run = STUDY_RUNS[wildcards.study].get(wildcards.run)
+    return checked_batch(
+        f"results/studies/{wildcards.study}/{wildcards.run}/"
+        f"shards{wildcards.first}-{wildcards.last}.parquet",
+        wildcards,
+        study_batch_ranges(run) if run is not None else [],
+        "a run of config/studies.yaml (simulation.shards_per_job of the config)",
+    )
+
+
+def study_batch_ranges(run):
+    """The batches of a study's run: its shards in batches of simulation.shards_per_job."""
+    return batch_ranges(run.shards, int(config["simulation"]["shards_per_job"]))
 
 
 def batch_provenance(label):

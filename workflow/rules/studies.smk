@@ -3,12 +3,7 @@
 # run with  snakemake --cores 2 studies
 from snakemake.exceptions import WorkflowError
 
-from bouncing_ball.workflow.config import (
-    batch_ranges,
-    check_types,
-    read_yaml,
-    study_runs,
-)
+from bouncing_ball.workflow.config import check_types, read_yaml, study_runs
 
 STUDIES_FILE = "config/studies.yaml"
 try:
@@ -30,21 +25,13 @@ R075_LABEL = restitution_label(parse_restitution(STUDIES["r075"]["restitution"])
 
 # per study: the batch files of every run, run by run (batches of simulation.shards_per_job
 # shards, as the pipeline's), and what its report is told about the runs, in the same order
-STUDY_BATCHES = {
-    study: {
-        name: [
-            f"results/studies/{study}/{name}/shards{first}-{last}.parquet"
-            for first, last in batch_ranges(
-                run.shards, int(config["simulation"]["shards_per_job"])
-            )
-        ]
-        for name, run in runs.items()
-    }
-    for study, runs in STUDY_RUNS.items()
-}
 STUDY_SHARDS = {
-    study: [path for paths in batches.values() for path in paths]
-    for study, batches in STUDY_BATCHES.items()
+    study: [
+        f"results/studies/{study}/{name}/shards{first}-{last}.parquet"
+        for name, run in runs.items()
+        for first, last in study_batch_ranges(run)
+    ]
+    for study, runs in STUDY_RUNS.items()
 }
 STUDY_RUN_TABLES = {
     study: [run.as_mapping() for run in runs.values()]
