@@ -5,7 +5,6 @@ for v -> infinity, eqs. (asym3)-(asym6).
 """
 
 import numpy as np
-import pandas as pd
 
 __all__ = [
     "CRITICAL_RESTITUTION",
@@ -179,6 +178,8 @@ def exponents_table(restitutions):
     0.50  1.00 1.0 1.0
     """
     r = np.asarray(restitutions, dtype=float)
+    import pandas as pd  # here: the jobs that need only the exponents do not load pandas
+
     return pd.DataFrame(
         {
             "r": r,

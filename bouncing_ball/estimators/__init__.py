@@ -78,6 +78,7 @@ from .histograms import (
     flight_time_histogram,
     outgoing_speed_density,
     outgoing_speed_histogram,
+    outside_fractions,
     position_histogram,
     return_speed_table,
 )
@@ -105,6 +106,7 @@ __all__ = [
     "distribution_histogram",
     "flight_time_histogram",
     "return_speed_table",
+    "outside_fractions",
     "position_moments_summary",
     "control_variate_rate",
     "control_variate_adjusted",

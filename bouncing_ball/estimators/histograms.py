@@ -26,7 +26,16 @@ __all__ = [
     "distribution_histogram",
     "flight_time_histogram",
     "return_speed_table",
+    "outside_fractions",
 ]
+
+#: What each table's histogram counts, for ``outside_fractions``: (table, tally field, what
+#: it counts).
+_COVERED = (
+    ("p0v", "speed_counts", "collisions"),
+    ("position", "position_time", "time"),
+    ("flight_time", "flight_time_counts", "flights"),
+)
 
 
 def outgoing_speed_density(counts, time, lower, upper):
@@ -370,3 +379,55 @@ def _bin_centres(lower, upper):
         centre = np.sqrt(lower * upper)
     centre[lower == 0.0] = 0.5 * upper[lower == 0.0]
     return centre
+
+
+def outside_fractions(shards: list[ShardTallies]) -> dict:
+    """How much of each histogram's distribution lies outside its finite bins.
+
+    The under- and overflow bins of the shards' tallies, over the whole: the collisions of
+    P(0, v), the time of P(x) (its underflow bin [0, x_lo) counts as outside: the table does not
+    resolve it), the flights of the flight-time density, and the time of P(x, v) outside its
+    finite cells (x or v beyond their bins).
+
+    Parameters
+    ----------
+    shards : list of ShardTallies
+        The shards, all on the same bins.
+
+    Returns
+    -------
+    dict
+        {table: {"below": fraction, "above": fraction, "outside": their sum, "counts": what
+        is counted}} for the tables ``p0v``, ``position``, ``flight_time`` and ``distribution``
+        (whose below and above are of v: its x overflow is in ``outside``); NaN where the
+        shards recorded nothing.
+
+    Examples
+    --------
+    See the module's example.
+    """
+    fractions = {}
+    for table, field, counted in _COVERED:
+        total = np.sum([getattr(s, field) for s in shards], axis=0).astype(float)
+        whole = total.sum()
+        below, above = (total[0] / whole, total[-1] / whole) if whole > 0 else (np.nan,) * 2
+        fractions[table] = {
+            "below": float(below),
+            "above": float(above),
+            "outside": float(below + above),
+            "counts": counted,
+        }
+    cells = np.sum([s.position_velocity_time for s in shards], axis=0)
+    whole = cells.sum()
+    if whole > 0:
+        v_below, v_above = cells[:, 0].sum() / whole, cells[:, -1].sum() / whole
+        inside = cells[1:-1, 1:-1].sum() / whole
+    else:
+        v_below = v_above = inside = np.nan
+    fractions["distribution"] = {
+        "below": float(v_below),
+        "above": float(v_above),
+        "outside": float(1.0 - inside),
+        "counts": "time",
+    }
+    return fractions

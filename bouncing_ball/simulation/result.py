@@ -206,6 +206,9 @@ class SimulationResult:
         The fitted decay rate -ln lambda of the bounce chain's correlations, lambda
         (``relaxation_eigenvalue``), n_c = 1 / rate (``correlation_bounces``), each with its
         ``_err``, and the lags of the fit (``estimators.bounce_chain_decay``).
+    outside_fractions : dict
+        The fraction of each table's distribution outside its finite bins: {table: {below,
+        above, outside, counts}} (``estimators.outside_fractions``).
     summary_table : pandas.DataFrame
         One row: the scalars, their errors, the counts (as the workflow's summary table);
         ``observables()`` is the same scalars as a tidy table.
@@ -480,6 +483,16 @@ class SimulationResult:
         from ..estimators import bounce_chain_decay
 
         return bounce_chain_decay(list(self.tallies))
+
+    @cached_property
+    def outside_fractions(self) -> dict:
+        """How much of each table's distribution lies outside its finite bins
+        (``estimators.outside_fractions``): {table: {below, above, outside, counts}} for
+        ``p0v`` (collisions), ``position`` (time), ``flight_time`` (flights) and
+        ``distribution`` (time)."""
+        from ..estimators import outside_fractions
+
+        return outside_fractions(list(self.tallies))
 
     @property
     def relaxation_eigenvalue(self) -> float:

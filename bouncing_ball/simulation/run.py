@@ -10,6 +10,7 @@ import threading
 import time
 
 from ..restitution import parse_restitution, restitution_label
+from ..scales import resolve_bins
 from ..settings import MAX_SHARDS, ShardSettings, real_number, whole_number
 from ..units import PhysicalUnits
 from .result import SimulationResult
@@ -24,8 +25,9 @@ __all__ = [
 ]
 
 # the shard settings ``simulate`` uses where it is not told otherwise (the default config's
-# ``simulation`` section holds the workflow's); every bin set is ``ShardSettings``' default,
-# and equilibration_time follows from the relaxation time at r
+# ``simulation`` section holds the workflow's); every bin set not given, or given as "auto",
+# takes its range from r's scales (``scales.resolve_bins``), and equilibration_time follows
+# from the relaxation time at r
 # (``simulation.equilibration.default_equilibration_time``)
 DEFAULT_SETTINGS = {
     "criterion_c": 3.0,
@@ -68,7 +70,7 @@ def _shard_settings(shard_time, settings, restitution):
         overrides["equilibration_time"] = default_equilibration_time(restitution)
     try:
         return ShardSettings.from_mapping(
-            {**DEFAULT_SETTINGS, **overrides, "shard_time": shard_time}
+            resolve_bins({**DEFAULT_SETTINGS, **overrides, "shard_time": shard_time}, restitution)
         )
     except (KeyError, TypeError) as error:
         raise ValueError(f"settings: {error}") from None
@@ -379,7 +381,11 @@ def simulate(
         The shard settings (``settings.ShardSettings``), or a dict overriding some of
         ``DEFAULT_SETTINGS`` and ``ShardSettings``' defaults (equilibration_time, criterion_c,
         min_step_divisor, max_steps, speed_bins, position_bins, velocity_bins,
-        flight_time_bins, min_step_floor).  equilibration_time defaults to
+        flight_time_bins, min_step_floor).  A bin set not given, or ``"auto"`` (or a dict
+        with some of its lo, hi, per_decade or width ``"auto"``), takes its range from r's
+        scales (``scales.resolve_bins``): every shard of r shares it, and it leaves about
+        1e-6 of the collisions, the time and the flights outside at each end (the result's
+        ``outside_fractions`` says how much).  equilibration_time defaults to
         ``simulation.equilibration.default_equilibration_time(r)``: 20 relaxation times of the process
         at r, at least 1e3.  Their ranges are ``ShardSettings``', the
         workflow's config check's: c of eq. (criterion) at least ``MIN_CRITERION_C``,

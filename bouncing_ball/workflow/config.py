@@ -20,6 +20,7 @@ import jsonschema
 import yaml
 
 from ..bins import linear_bins, log_bins
+from ..scales import AUTO, SOLVER_TABLE_POINTS, resolve_bins, resolve_solver_grids
 from ..equilibrium import check_solver_settings
 from ..restitution import (
     EXACT_RESTITUTIONS,
@@ -32,16 +33,15 @@ from ..restitution import (
     restitution_label,
     shared_label_message,
 )
-from ..settings import (
-    DEFAULT_FLIGHT_TIME_BINS,
-    DEFAULT_VELOCITY_BINS,
-    RETURN_LAW_SPEED_BINS,
-    ShardSettings,
-)
+from ..settings import RETURN_LAW_SPEED_BINS, ShardSettings
 from ..tallies import HISTOGRAMS, HISTOGRAMS_2D
 
 # the config's schema, in the repository that holds this package
 SCHEMA = Path(__file__).resolve().parents[1] / "workflow" / "schemas" / "config.schema.yaml"
+
+#: The shard settings that are bin sets: ``"auto"`` (r's scales, ``scales.resolve_bins``),
+#: partly automatic, or explicit.
+BIN_SETTINGS = ("speed_bins", "position_bins", "velocity_bins", "flight_time_bins")
 
 # the memory one job may ask for, in bytes: ``check_config`` refuses settings whose largest
 # arrays would need more (estimated from the settings, before any job runs)
@@ -148,12 +148,13 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
         check_types(config, schema, "config")
     grid = restitution_grid(config["restitution"])
     simulation = config["simulation"]
-    for name in ("speed_bins", "position_bins", "velocity_bins", "flight_time_bins"):
-        bins = simulation.get(name)  # the last two are optional (settings.ShardSettings defaults)
-        if bins is not None and not bins["lo"] < bins["hi"]:
-            raise ValueError(
-                f"simulation.{name}: lo = {bins['lo']} must be smaller than hi = {bins['hi']}"
-            )
+    for name in BIN_SETTINGS:
+        bins = simulation.get(name)  # optional: r's scales (scales.resolve_bins)
+        if isinstance(bins, dict) and not {bins.get("lo"), bins.get("hi")} & {None, AUTO}:
+            if not bins["lo"] < bins["hi"]:
+                raise ValueError(
+                    f"simulation.{name}: lo = {bins['lo']} must be smaller than hi = {bins['hi']}"
+                )
     for name, positive in (
         ("solver.output_speeds", True),
         ("solver.flight_times", True),
@@ -165,6 +166,8 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
     ):
         section, key = name.split(".")
         points = config[section][key]
+        if not isinstance(points, dict) or AUTO in (points.get("min"), points.get("max")):
+            continue  # r's scales (scales.resolve_grid)
         if not points["min"] < points["max"]:
             raise ValueError(
                 f"{name}: min = {points['min']} must be smaller than max = {points['max']}"
@@ -229,7 +232,10 @@ def check_shard_settings(config: dict) -> None:
     ``simulation.per_restitution``) checked by ``settings.ShardSettings``, the library's own
     check: the pipeline and ``simulate`` refuse the same settings.  ValueError naming the
     section otherwise."""
-    cases = {"simulation": simulation_settings(config, "")}  # no r has the label ""
+    cases = {
+        f"simulation (r = {label})": simulation_settings(config, label)
+        for label in known_restitutions(config)
+    }
     for key in per_restitution(config):
         cases[f"simulation.per_restitution.{key}"] = simulation_settings(
             config, restitution_label(parse_restitution(key))
@@ -248,7 +254,6 @@ def check_figure_positions(config: dict) -> None:
     cells of the x bin that holds x, and Fig. 11 one panel per speed bin that holds a speed: an
     underflow or overflow bin there would be set against a value at one end of it.
     ValueError naming the key otherwise."""
-    position_bins = config["simulation"]["position_bins"]
     for section in ("solver", "exact"):
         positions = config[section]["positions"]
         for index, x in enumerate(positions):
@@ -257,33 +262,37 @@ def check_figure_positions(config: dict) -> None:
                 raise ValueError(
                     f"{where}: x = {x} repeats {section}.positions[{positions.index(x)}]"
                 )
-            if (
-                section == "solver"
-                and x > 0
-                and not (position_bins["lo"] <= x < position_bins["hi"])
-            ):
+    for label in restitution_grid(config["figures"]["fig8"], "figures.fig8"):
+        position_bins = log_bins(simulation_settings(config, label)["position_bins"])
+        for index, x in enumerate(config["solver"]["positions"]):
+            if x > 0 and not (position_bins.lo <= x < position_bins.hi):
                 raise ValueError(
-                    f"{where}: x = {x} is outside simulation.position_bins "
-                    f"[{position_bins['lo']}, {position_bins['hi']}): Fig. 8 would draw the "
-                    "simulation's underflow or overflow bin against the curve at x; use 0 or "
-                    "an x inside the bins"
+                    f"solver.positions[{index}]: x = {x} is outside the position bins of "
+                    f"r = {label} (simulation.position_bins) [{position_bins.lo:.6g}, "
+                    f"{position_bins.hi:.6g}): Fig. 8 would draw the simulation's underflow or "
+                    "overflow bin against the curve at x; use 0 or an x inside the bins"
                 )
-    speed_bins = log_bins(config["simulation"]["speed_bins"])
-    shown = {}
-    for index, speed in enumerate(config["figures"]["return_speeds"]):
-        where = f"figures.return_speeds[{index}]"
-        if not speed_bins.lo <= speed < speed_bins.hi:
-            raise ValueError(
-                f"{where}: u = {speed} is outside simulation.speed_bins "
-                f"[{speed_bins.lo}, {speed_bins.hi}): Fig. 11 draws one panel per speed bin"
+    for label in restitution_grid(config["figures"]["fig11"], "figures.fig11"):
+        speed_bins = log_bins(simulation_settings(config, label)["speed_bins"])
+        shown = {}
+        for index, speed in enumerate(config["figures"]["return_speeds"]):
+            where = f"figures.return_speeds[{index}]"
+            if not speed_bins.lo <= speed < speed_bins.hi:
+                raise ValueError(
+                    f"{where}: u = {speed} is outside the speed bins of r = {label} "
+                    f"(simulation.speed_bins) [{speed_bins.lo:.6g}, {speed_bins.hi:.6g}): "
+                    "Fig. 11 draws one panel per speed bin"
+                )
+            bin_index = int(
+                math.floor(math.log10(speed / speed_bins.lo) * speed_bins.per_decade + 1e-9)
             )
-        bin_index = int(math.floor(math.log10(speed / speed_bins.lo) * speed_bins.per_decade))
-        if bin_index in shown:
-            raise ValueError(
-                f"{where}: u = {speed} is in the speed bin of figures.return_speeds"
-                f"[{shown[bin_index]}]: each panel of Fig. 11 is one speed bin"
-            )
-        shown[bin_index] = index
+            if bin_index in shown:
+                raise ValueError(
+                    f"{where}: u = {speed} is in the speed bin of figures.return_speeds"
+                    f"[{shown[bin_index]}] at r = {label}: each panel of Fig. 11 is one speed "
+                    "bin"
+                )
+            shown[bin_index] = index
 
 
 # the peak memory of a solve job per point of its output grids, in bytes (tracemalloc at
@@ -305,16 +314,13 @@ BYTES_PER_CELL_IN_MEMORY, BYTES_PER_CELL_IN_A_TABLE = 3 * 8, 64
 
 def tally_cells(simulation: dict) -> dict[str, int]:
     """{tally: cells} of one shard's tallies (each bin range with under- and overflow), from
-    the bins of a config-shaped ``simulation`` mapping (the optional ones at their defaults)."""
+    the explicit bins of a config-shaped ``simulation`` mapping of one r
+    (``simulation_settings``)."""
     bins = {
         "speed_bins": log_bins(simulation["speed_bins"]),
         "position_bins": log_bins(simulation["position_bins"]),
-        "velocity_bins": linear_bins(simulation["velocity_bins"])
-        if simulation.get("velocity_bins")
-        else DEFAULT_VELOCITY_BINS,
-        "flight_time_bins": log_bins(simulation["flight_time_bins"])
-        if simulation.get("flight_time_bins")
-        else DEFAULT_FLIGHT_TIME_BINS,
+        "velocity_bins": linear_bins(simulation["velocity_bins"]),
+        "flight_time_bins": log_bins(simulation["flight_time_bins"]),
         "return_law_speed_bins": RETURN_LAW_SPEED_BINS,
     }
     cells = {name: bins[spec].n + 2 for name, (spec, _, _) in HISTOGRAMS.items()}
@@ -346,26 +352,27 @@ def check_memory(config: dict) -> None:
     overrides of ``shards`` and ``shards_per_job`` included.  ValueError naming the key."""
     for key, per_point in SOLVER_BYTES_PER_POINT.items():
         section, name = key.split(".")
-        points = config[section][name]["points"]
+        spec = config[section][name]
+        points = spec.get("points", AUTO) if isinstance(spec, dict) else AUTO
+        points = SOLVER_TABLE_POINTS[name] if points == AUTO else points
         if points * per_point > MEMORY_BUDGET:
             raise ValueError(
                 f"{key}: {points} points would need about {_gib(points * per_point)} in the "
                 f"solve job, more than a job's {_gib(MEMORY_BUDGET)}; use at most "
                 f"{int(MEMORY_BUDGET // per_point)} points"
             )
-    cases = {None: simulation_settings(config, "")}  # no r has the label "": the defaults
-    for key in per_restitution(config):
-        cases[key] = simulation_settings(config, restitution_label(parse_restitution(key)))
-    for label, settings in cases.items():
+    overridden = {restitution_label(parse_restitution(key)): key for key in per_restitution(config)}
+    for label in {**known_restitutions(config), **overridden}:
+        settings = simulation_settings(config, label)
         shards, per_job = int(settings["shards"]), int(settings["shards_per_job"])
         per_job = min(per_job, shards)
         check_merge_memory(
             settings,
             shards,
             per_job,
-            f"simulation.per_restitution.{label} ({shards} shards, {per_job} a job)"
-            if label
-            else f"simulation.shards = {shards}, shards_per_job = {per_job}",
+            f"simulation.per_restitution.{overridden[label]} ({shards} shards, {per_job} a job)"
+            if label in overridden
+            else f"r = {label}: simulation.shards = {shards}, shards_per_job = {per_job}",
         )
 
 
@@ -436,26 +443,25 @@ AUTO_EQUILIBRATION = "auto"
 
 
 def simulation_settings(config: dict, label: str) -> dict:
-    """The simulation parameters of one r: the defaults with its overrides applied, and
-    ``equilibration_time: auto`` replaced by ``simulation.equilibration.default_equilibration_time`` at
-    that r (the r of ``restitution`` or the figures with that label; for the label "", which
-    no r has, by ``simulation.equilibration.MIN_EQUILIBRATION_TIME``)."""
+    """The simulation parameters of one r: the defaults with its overrides applied, every
+    bin set that is ``auto`` (or partly so, or missing) made explicit from r's scales
+    (``scales.resolve_bins``), and ``equilibration_time: auto`` replaced by
+    ``simulation.equilibration.default_equilibration_time`` at that r (the r of
+    ``restitution``, the figures or the overrides with that label, or the label read as r)."""
     simulation = config["simulation"]
     settings = {"min_step_floor": 0.0}  # optional key: the paper's rule alone
     settings.update({k: v for k, v in simulation.items() if k != "per_restitution"})
     for key, override in per_restitution(config).items():
         if restitution_label(parse_restitution(key)) == label:
             settings.update(override)
+    exact = _restitution_of_label(config, label)
+    settings = resolve_bins(settings, exact)
     if settings["equilibration_time"] == AUTO_EQUILIBRATION:
         # imported here: the relaxation time needs the solver (scipy, numba), which importing
         # this module does not load
-        from ..simulation.equilibration import MIN_EQUILIBRATION_TIME, default_equilibration_time
+        from ..simulation.equilibration import default_equilibration_time
 
-        settings["equilibration_time"] = (
-            default_equilibration_time(_restitution_of_label(config, label))
-            if label
-            else MIN_EQUILIBRATION_TIME
-        )
+        settings["equilibration_time"] = default_equilibration_time(exact)
     return settings
 
 
@@ -522,9 +528,11 @@ def shard_batches(config: dict, label: str) -> list[tuple[int, int]]:
     return batch_ranges(int(settings["shards"]), int(settings["shards_per_job"]))
 
 
-def solver_settings(config: dict) -> dict:
-    """What one solve is run with (not the r grid of Fig. 6, which has its own job)."""
-    return {
+def solver_settings(config: dict, label: str) -> dict:
+    """What one solve of r = ``label`` is run with (not the r grid of Fig. 6, which has its
+    own job): the ``solver`` section with every ``"auto"`` grid made explicit at r
+    (``scales.resolve_solver_grids``)."""
+    settings = {
         key: config["solver"][key]
         for key in (
             "quadrature_step",
@@ -537,11 +545,13 @@ def solver_settings(config: dict) -> dict:
             "weight_panel_nodes",
         )
     }
+    return resolve_solver_grids(settings, _restitution_of_label(config, label))
 
 
-def exact_settings(config: dict) -> dict:
-    """What the exact-solution stage is run with: its section plus the solver's output speeds."""
-    return {"output_speeds": config["solver"]["output_speeds"], **config["exact"]}
+def exact_settings(config: dict, label: str) -> dict:
+    """What the exact solution of r = ``label`` is computed with: the ``exact`` section plus
+    the solver's output speeds at that r (``solver_settings``)."""
+    return {"output_speeds": solver_settings(config, label)["output_speeds"], **config["exact"]}
 
 
 # ---- the studies (config/studies.yaml; workflow/rules/studies.smk) ----

@@ -20,7 +20,7 @@ rule exact_solution:
         cpus_per_task=1,
     params:
         restitution=exact_value,
-        settings=exact_settings(config),
+        settings=lambda wildcards: exact_settings(config, wildcards.r),
         code=code(stages.EXACT, "exact_solution.py"),
     script:
         "../../scripts/exact_solution.py"

@@ -25,7 +25,7 @@ rule solve:
         cpus_per_task=1,
     params:
         restitution=solver_restitution_value,
-        settings=solver_settings(config),
+        settings=lambda wildcards: solver_settings(config, wildcards.r),
         # the simulation's speed bins, on which the return-speed law is averaged
         speed_bins=lambda wildcards: settings(wildcards)["speed_bins"],
         code=code(stages.SOLVER, "solve.py"),
