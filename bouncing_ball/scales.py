@@ -52,6 +52,7 @@ __all__ = [
     "solver_table_ranges",
     "resolve_solver_grids",
     "tail_fractions",
+    "outside_summary",
 ]
 
 #: The fraction of a distribution each end of an automatic range aims to leave out.
@@ -334,14 +335,15 @@ def resolve_bins(settings: dict, restitution) -> dict:
     """
     floor = float(settings.get("min_step_floor", 0.0))
     divisor = float(settings.get("min_step_divisor", 500.0))
+    # out of range, the shard settings' own check refuses them; the bins need some value
+    floor = floor if 0.0 <= floor < 1.0 else 0.0
+    divisor = divisor if 0.0 < divisor < 1e100 else 500.0
     speed = smallest_simulated_speed(floor, divisor)
     automatic = {
         "speed_bins": lambda spec: auto_log_bins(
             spec, outgoing_speed_range(restitution, speed), 10
         ),
-        "position_bins": lambda spec: auto_log_bins(
-            spec, position_range(restitution, speed**2), 5
-        ),
+        "position_bins": lambda spec: auto_log_bins(spec, position_range(restitution, speed**2), 5),
         "flight_time_bins": lambda spec: auto_log_bins(
             spec, flight_time_range(restitution, speed**2), 5
         ),
@@ -356,8 +358,18 @@ def resolve_bins(settings: dict, restitution) -> dict:
 
 
 def is_auto(spec) -> bool:
-    """Whether a bin set or grid (config-shaped) asks for any part from r's scales: ``"auto"``,
-    or a dict with a part ``"auto"`` or a range end missing."""
+    """Whether a bin set (config-shaped) asks for any part from r's scales.
+
+    Parameters
+    ----------
+    spec : object
+        A bin set: ``"auto"``, a dict, or a ``bins.LogBins`` / ``bins.LinearBins``.
+
+    Returns
+    -------
+    bool
+        True for ``"auto"``, or a dict with a part ``"auto"`` or an end (lo, hi) missing.
+    """
     if isinstance(spec, str):
         return spec == AUTO
     if isinstance(spec, dict):
@@ -479,7 +491,18 @@ def resolve_solver_grids(settings: dict, restitution) -> dict:
 
 
 def is_grid_auto(spec) -> bool:
-    """Whether a grid (config-shaped) asks for any part from r's scales."""
+    """Whether a grid (config-shaped) asks for any part from r's scales.
+
+    Parameters
+    ----------
+    spec : object
+        A grid: ``"auto"`` or a dict of min, max and points.
+
+    Returns
+    -------
+    bool
+        True for ``"auto"``, or a dict with a part ``"auto"`` or missing.
+    """
     if isinstance(spec, str):
         return spec == AUTO
     return isinstance(spec, dict) and (
@@ -535,3 +558,34 @@ def tail_fractions(edges, mass_density):
     if not math.isfinite(total) or total <= 0.0:
         return tuple(math.inf if not math.isfinite(t) else 1.0 for t in tails)
     return tails[0] / total, tails[1] / total
+
+
+def outside_summary(fractions: dict) -> str:
+    """One line of how much of each table's distribution lies outside its range.
+
+    Parameters
+    ----------
+    fractions : dict
+        {table: {"below", "above", "outside", "counts"}}, as ``estimators.outside_fractions``
+        and ``workflow.solver_tables.outside_fractions`` give them (None: unbounded).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from bouncing_ball.scales import outside_summary
+    >>> print(outside_summary({"p0v": {"below": 1e-7, "above": 0.0, "outside": 1e-7,
+    ...                                "counts": "collisions"}}))
+    outside the tables' ranges: p0v 1.0e-07 of the collisions (below 1.0e-07, above 0.0e+00)
+    """
+
+    def shown(value):
+        return "unbounded" if value is None else f"{value:.1e}"
+
+    return "outside the tables' ranges: " + "; ".join(
+        f"{name} {shown(part['outside'])} of the {part['counts']} (below {shown(part['below'])}, "
+        f"above {shown(part['above'])})"
+        for name, part in fractions.items()
+    )

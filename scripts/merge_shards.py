@@ -13,11 +13,13 @@ from bouncing_ball.estimators import (
     distribution_histogram,
     flight_time_histogram,
     outgoing_speed_histogram,
+    outside_fractions,
     position_histogram,
     position_moments_summary,
     return_speed_table,
 )
 from bouncing_ball.restitution import exact_string, parse_restitution, restitution_label
+from bouncing_ball.scales import outside_summary
 from bouncing_ball.settings import ShardSettings
 from bouncing_ball.simulation.equilibration import (
     early_check,
@@ -66,6 +68,9 @@ with job_log(snakemake.log[0], exit_when_done=True):
         logging.warning(message)
     else:
         logging.info(early_check_message(equilibration, label))
+    # how much of each table's distribution lies beyond its bins (the bins follow r's scales)
+    provenance["outside"] = outside_fractions(shards)
+    logging.info("r=%s: %s", label, outside_summary(provenance["outside"]))
     # the solver's P(0, u), which the controlled estimates lean on (the estimators never solve)
     theory = solved_outgoing_density(exact)
     summary = position_moments_summary(shards, exact, theory)

@@ -14,6 +14,7 @@ from bouncing_ball import solver
 from bouncing_ball.bins import linear_grid, log_bins, log_grid
 from bouncing_ball.equilibrium import Equilibrium
 from bouncing_ball.restitution import exact_string, parse_restitution
+from bouncing_ball.scales import outside_summary
 from bouncing_ball.workflow import solver_tables
 from bouncing_ball.workflow.io import write_tables
 from bouncing_ball.workflow.jobs import job_log
@@ -115,7 +116,10 @@ with job_log(snakemake.log[0], exit_when_done=True):
         "speed_bins": snakemake.params.speed_bins,
         "code": snakemake.params.code,
         "normalisation": "momentum balance M_2 = r / (1 + r)",
+        # how much of each distribution lies beyond its table's range
+        "outside": solver_tables.outside_fractions(tables),
     }
+    logging.info("r=%s: %s", label, outside_summary(provenance["outside"]))
     write_tables(
         {
             snakemake.output.summary: pd.DataFrame([row]),

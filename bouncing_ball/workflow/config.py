@@ -20,7 +20,6 @@ import jsonschema
 import yaml
 
 from ..bins import linear_bins, log_bins
-from ..scales import AUTO, SOLVER_TABLE_POINTS, resolve_bins, resolve_solver_grids
 from ..equilibrium import check_solver_settings
 from ..restitution import (
     EXACT_RESTITUTIONS,
@@ -33,6 +32,7 @@ from ..restitution import (
     restitution_label,
     shared_label_message,
 )
+from ..scales import AUTO, SOLVER_TABLE_POINTS, resolve_bins, resolve_solver_grids
 from ..settings import RETURN_LAW_SPEED_BINS, ShardSettings
 from ..tallies import HISTOGRAMS, HISTOGRAMS_2D
 
@@ -128,7 +128,9 @@ def check_types(instance, schema: dict, source: str) -> None:
     strict = jsonschema.validators.extend(
         base, type_checker=base.TYPE_CHECKER.redefine("integer", _is_integer)
     )
-    for error in strict(schema).iter_errors(instance):
+    # the error that says most: inside an anyOf ("auto" or a mapping), the mapping's own
+    error = jsonschema.exceptions.best_match(strict(schema).iter_errors(instance))
+    if error is not None:
         where = ".".join(str(part) for part in error.absolute_path) or "the top level"
         hint = (
             " (write a whole number without a decimal point or exponent, e.g. 1000000000)"
@@ -148,13 +150,6 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
         check_types(config, schema, "config")
     grid = restitution_grid(config["restitution"])
     simulation = config["simulation"]
-    for name in BIN_SETTINGS:
-        bins = simulation.get(name)  # optional: r's scales (scales.resolve_bins)
-        if isinstance(bins, dict) and not {bins.get("lo"), bins.get("hi")} & {None, AUTO}:
-            if not bins["lo"] < bins["hi"]:
-                raise ValueError(
-                    f"simulation.{name}: lo = {bins['lo']} must be smaller than hi = {bins['hi']}"
-                )
     for name, positive in (
         ("solver.output_speeds", True),
         ("solver.flight_times", True),
@@ -204,7 +199,6 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
             raise ValueError(
                 f"fits.{side}: min = {window['min']} must be smaller than max = {window['max']}"
             )
-    check_figure_positions(config)
     seen = {}
     for key in per_restitution(config):
         where = f"simulation.per_restitution.{key}"
@@ -222,6 +216,7 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
                 f"({label}); add r = {key} to restitution, or key the override by {label}"
             )
     check_shard_settings(config)
+    check_figure_positions(config)
     check_equilibration(config)
     check_memory(config)
     return grid
@@ -232,14 +227,22 @@ def check_shard_settings(config: dict) -> None:
     ``simulation.per_restitution``) checked by ``settings.ShardSettings``, the library's own
     check: the pipeline and ``simulate`` refuse the same settings.  ValueError naming the
     section otherwise."""
-    cases = {
-        f"simulation (r = {label})": simulation_settings(config, label)
-        for label in known_restitutions(config)
-    }
+    known = known_restitutions(config)
+    first = next(iter(known))  # the bins follow some r
+    cases = {"simulation": simulation_settings(config, first, overrides=False)}
     for key in per_restitution(config):
         cases[f"simulation.per_restitution.{key}"] = simulation_settings(
             config, restitution_label(parse_restitution(key))
         )
+    for label in known:  # the bins of each r, partly automatic or not, ordered
+        settings = simulation_settings(config, label)
+        for name in BIN_SETTINGS:
+            bins = settings[name]
+            if not bins["lo"] < bins["hi"]:
+                raise ValueError(
+                    f"simulation.{name} at r = {label}: lo = {bins['lo']:.6g} must be smaller "
+                    f"than hi = {bins['hi']:.6g} (an end not given follows r's scales)"
+                )
     for where, settings in cases.items():
         try:
             ShardSettings.from_mapping(settings)
@@ -442,17 +445,18 @@ def known_restitutions(config: dict) -> dict[str, Fraction]:
 AUTO_EQUILIBRATION = "auto"
 
 
-def simulation_settings(config: dict, label: str) -> dict:
+def simulation_settings(config: dict, label: str, overrides: bool = True) -> dict:
     """The simulation parameters of one r: the defaults with its overrides applied, every
     bin set that is ``auto`` (or partly so, or missing) made explicit from r's scales
     (``scales.resolve_bins``), and ``equilibration_time: auto`` replaced by
     ``simulation.equilibration.default_equilibration_time`` at that r (the r of
-    ``restitution``, the figures or the overrides with that label, or the label read as r)."""
+    ``restitution``, the figures or the overrides with that label, or the label read as r).
+    With ``overrides`` False, the section's own settings at that r, without r's overrides."""
     simulation = config["simulation"]
     settings = {"min_step_floor": 0.0}  # optional key: the paper's rule alone
     settings.update({k: v for k, v in simulation.items() if k != "per_restitution"})
     for key, override in per_restitution(config).items():
-        if restitution_label(parse_restitution(key)) == label:
+        if overrides and restitution_label(parse_restitution(key)) == label:
             settings.update(override)
     exact = _restitution_of_label(config, label)
     settings = resolve_bins(settings, exact)

@@ -22,6 +22,8 @@ __all__ = [
     "weight_table",
     "flight_time_table",
     "return_speed_table",
+    "DISTRIBUTION_TABLES",
+    "outside_fractions",
     "weight_frame",
     "position_frame",
     "distribution_frame",
@@ -399,6 +401,52 @@ def flight_time_table(equilibrium, times):
     for per_collision in (False, True):  # nu(T) and rho(T) finite
         equilibrium._flight_times(times, "times", per_collision=per_collision)
     return flight_time.flight_time_table(equilibrium.solution, times)
+
+
+#: The solver's tables that hold a distribution: {table: (its variable, the column of the
+#: distribution's density over that variable, what it counts)}; ``outside_fractions``.
+DISTRIBUTION_TABLES = {
+    "p0v": ("v", None, "collisions"),  # v P(0, v): the collisions' outgoing speeds
+    "position": ("x", "px", "time"),
+    "flight_time": ("t", "density", "flights"),
+}
+
+
+def outside_fractions(tables: dict) -> dict:
+    """How much of each distribution a solve's tables leave outside their ranges
+    (``scales.tail_fractions``: each end continued by the power law of its last two points).
+
+    Parameters
+    ----------
+    tables : dict
+        Rule solve's tables by name; those of ``DISTRIBUTION_TABLES`` are read (the
+        collisions of P(0, v) are v P(0, v)).
+
+    Returns
+    -------
+    dict
+        {table: {"below", "above", "outside", "counts"}}, the fractions of the whole; None
+        where the end's slope cannot bound its tail (below r_c, v P(0, v) ~ v^(1 - beta) is
+        not integrable at 0: the collision rate is infinite, eq. (collrate)).
+    """
+    from ..scales import tail_fractions
+
+    fractions = {}
+    for name, (variable, column, counted) in DISTRIBUTION_TABLES.items():
+        if name not in tables:
+            continue
+        table = tables[name]
+        z = table[variable].to_numpy()
+        density = z * table["p0v"].to_numpy() if column is None else table[column].to_numpy()
+        below, above = tail_fractions(z, density)
+        finite = [value if np.isfinite(value) else None for value in (below, above)]
+        fractions[name] = {
+            "below": finite[0],
+            "above": finite[1],
+            "outside": below + above if None not in finite else None,
+            "counts": counted,
+        }
+    return fractions
 
 
 def return_speed_table(equilibrium, speed_bins):

@@ -410,7 +410,9 @@ def test_flight_times_beyond_the_library_table_range_are_refused(key, value, rel
 
 
 def test_the_schema_and_the_readme_bound_flight_times_by_the_library_range():
-    bounds = _schema()["properties"]["solver"]["properties"]["flight_times"]["properties"]
+    bounds = _schema()["properties"]["solver"]["properties"]["flight_times"]["allOf"][1][
+        "properties"
+    ]
     assert (bounds["min"]["minimum"], bounds["max"]["maximum"]) == FLIGHT_TIME_TABLE_RANGE
     low, high = FLIGHT_TIME_TABLE_RANGE
     readme = (REPOSITORY / "config" / "README.md").read_text()
