@@ -53,7 +53,13 @@ __all__ = [
     "resolve_solver_grids",
     "tail_fractions",
     "outside_summary",
+    "OUTSIDE_WARNING",
+    "estimated_outside_fractions",
 ]
+
+#: The fraction of a distribution outside an explicit bin set or grid above which the config
+#: check warns, naming r, the key and the fraction.
+OUTSIDE_WARNING = 1.0e-4
 
 #: The fraction of a distribution each end of an automatic range aims to leave out.
 TAIL_FRACTION = 1.0e-6
@@ -240,6 +246,65 @@ def velocity_range(restitution):
     """
     _, q, _ = _exponents(restitution)
     return max((DECAY_LENGTHS + 4.0) / q, 30.0)
+
+
+def _power_tail(ratio, power):
+    """min(1, ratio^power): the part of a power-law end below ``ratio`` of its scale."""
+    if power <= 0.0:
+        return 1.0
+    return min(1.0, math.exp(power * math.log(max(ratio, 1e-300))))
+
+
+def _exponential_tail(length, powers=1):
+    """e^-length (1 + length)^powers, at most 1: an exponential end beyond ``length`` of its
+    decay lengths."""
+    return min(1.0, math.exp(-length) * (1.0 + length) ** powers) if length > 0 else 1.0
+
+
+def estimated_outside_fractions(settings: dict, restitution) -> dict:
+    """About how much of each distribution explicit shard bins leave outside at r, from the
+    asymptotic forms that the automatic ranges follow (no solve).
+
+    Parameters
+    ----------
+    settings : dict
+        Config-shaped shard settings with explicit bins (``resolve_bins``' result).
+    restitution : float, str or fractions.Fraction
+        r, 0 < r < 1.
+
+    Returns
+    -------
+    dict
+        {bin setting: fraction outside (both ends)}: of the collisions for speed_bins, the
+        time for position_bins and velocity_bins, the flights for flight_time_bins; a rough
+        estimate (within a factor of about 10 where it is small), for a warning.
+
+    Examples
+    --------
+    >>> from bouncing_ball.scales import estimated_outside_fractions
+    >>> bins = {"speed_bins": {"lo": 1e-4, "hi": 100, "per_decade": 10},
+    ...         "position_bins": {"lo": 1e-3, "hi": 1e3, "per_decade": 5},
+    ...         "velocity_bins": {"lo": -24, "hi": 20, "width": 0.25},
+    ...         "flight_time_bins": {"lo": 1e-12, "hi": 1e3, "per_decade": 5}}
+    >>> outside = estimated_outside_fractions(bins, 0.99)
+    >>> print(f"{outside['speed_bins']:.2f} {outside['position_bins']:.2f}")
+    0.55 0.85
+    """
+    _, q, beta = _exponents(restitution)
+    b = _large_height_rate(q)
+    speeds, heights = settings["speed_bins"], settings["position_bins"]
+    flights, velocities = settings["flight_time_bins"], settings["velocity_bins"]
+    largest = max(-velocities["lo"], velocities["hi"])
+    fractions = {
+        "speed_bins": _power_tail(q * speeds["lo"], 2.0 - beta)
+        + _exponential_tail(q * speeds["hi"]),
+        "position_bins": _power_tail(5.0 * b**2 * heights["lo"], (4.0 - beta) / 3.0)
+        + _exponential_tail(b * math.sqrt(heights["hi"])),
+        "flight_time_bins": _power_tail(q**2 * flights["lo"], 1.0 - 0.5 * beta)
+        + max(_exponential_tail(q * flights["hi"] / 2.5), math.exp(-flights["hi"] / 5.0)),
+        "velocity_bins": 2.0 * _exponential_tail(q * min(-velocities["lo"], largest), 2),
+    }
+    return {name: min(1.0, fraction) for name, fraction in fractions.items()}
 
 
 def _decade_aligned(lo, hi, per_decade):

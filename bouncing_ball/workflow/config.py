@@ -32,7 +32,16 @@ from ..restitution import (
     restitution_label,
     shared_label_message,
 )
-from ..scales import AUTO, SOLVER_TABLE_POINTS, resolve_bins, resolve_solver_grids
+from ..scales import (
+    AUTO,
+    OUTSIDE_WARNING,
+    SOLVER_TABLE_POINTS,
+    estimated_outside_fractions,
+    is_auto,
+    is_grid_auto,
+    resolve_bins,
+    resolve_solver_grids,
+)
 from ..settings import RETURN_LAW_SPEED_BINS, ShardSettings
 from ..tallies import HISTOGRAMS, HISTOGRAMS_2D
 
@@ -149,7 +158,6 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
     if schema is not None:
         check_types(config, schema, "config")
     grid = restitution_grid(config["restitution"])
-    simulation = config["simulation"]
     for name, positive in (
         ("solver.output_speeds", True),
         ("solver.flight_times", True),
@@ -216,6 +224,7 @@ def check_config(config: dict, schema: dict | None = None) -> dict[str, Fraction
                 f"({label}); add r = {key} to restitution, or key the override by {label}"
             )
     check_shard_settings(config)
+    warn_incomplete_bins(config)
     check_figure_positions(config)
     check_equilibration(config)
     check_memory(config)
@@ -248,6 +257,61 @@ def check_shard_settings(config: dict) -> None:
             ShardSettings.from_mapping(settings)
         except (TypeError, ValueError) as error:
             raise ValueError(f"{where}: {error}") from None
+
+
+class IncompleteTableWarning(UserWarning):
+    """Explicit bins or grids that leave more than ``scales.OUTSIDE_WARNING`` of a
+    distribution outside their range at some r."""
+
+
+# the solver's grids of a distribution, as the simulation's bins they match: (config key,
+# bin setting whose tails it shares)
+_SOLVER_GRIDS = {
+    "output_speeds": "speed_bins",
+    "position_grid": "position_bins",
+    "flight_times": "flight_time_bins",
+}
+
+
+def warn_incomplete_bins(config: dict) -> None:
+    """Warn (``IncompleteTableWarning``), naming r, the key and the fraction, where an explicit
+    bin set of the simulation or grid of the solver leaves more than ``scales.OUTSIDE_WARNING``
+    of its distribution outside, by the asymptotic forms (``scales.estimated_outside_fractions``);
+    ``auto`` ranges follow r and leave about 1e-6 at each end."""
+    import warnings
+
+    simulation = config["simulation"]
+    for label in known_restitutions(config):
+        settings = simulation_settings(config, label)
+        estimates = estimated_outside_fractions(settings, _restitution_of_label(config, label))
+        solver = solver_settings(config, label)
+        grids = {
+            name: {"lo": solver[key]["min"], "hi": solver[key]["max"], "per_decade": 1}
+            for key, name in _SOLVER_GRIDS.items()
+        }
+        solved = estimated_outside_fractions(
+            {**grids, "velocity_bins": settings["velocity_bins"]},
+            _restitution_of_label(config, label),
+        )
+        cases = [
+            (f"simulation.{name}", estimates[name], simulation.get(name)) for name in BIN_SETTINGS
+        ]
+        cases += [
+            (f"solver.{key}", solved[name], config["solver"][key])
+            for key, name in _SOLVER_GRIDS.items()
+        ]
+        for key, fraction, spec in cases:
+            automatic = (
+                spec is None or is_auto(spec) or (key.startswith("solver") and is_grid_auto(spec))
+            )
+            if not automatic and fraction > OUTSIDE_WARNING:
+                warnings.warn(
+                    f"{key} leaves about {fraction:.1e} of the distribution at r = {label} "
+                    f"outside its range (more than {OUTSIDE_WARNING:g}); give it as auto to "
+                    "follow the scales of each r",
+                    IncompleteTableWarning,
+                    stacklevel=2,
+                )
 
 
 def check_figure_positions(config: dict) -> None:
