@@ -644,7 +644,15 @@ BAD = [
     (_with(["simulation", "shard_time"], -1.0), "shard_time"),
     (_with(["simulation", "criterion_c"], 0.0), "criterion_c"),
     (_with(["simulation", "shard_time"], "1e5"), "shard_time"),
-    (_with(["simulation", "speed_bins", "lo"], 1.0e3), "speed_bins"),
+    (
+        _with(["simulation", "speed_bins"], {"lo": 1.0e3, "hi": 1.0e2, "per_decade": 10}),
+        "simulation.speed_bins at r = 0.5: lo = 1000 must be smaller than hi = 100",
+    ),
+    (
+        _with(["simulation", "speed_bins"], {"lo": 1.0e3, "per_decade": 10}),
+        "simulation.speed_bins at r = 0.5: lo = 1000 must be smaller than hi = 25.1189 (an end "
+        "not given follows r's scales)",
+    ),
     (_with(["simulation", "shardz"], 4), "'shardz' was unexpected"),
     (_with(["sead"], 4), "'sead' was unexpected"),
     (_with(["simulation", "per_restitution"], {"2": {"shards": 2}}), "per_restitution.2"),
@@ -652,7 +660,7 @@ BAD = [
     (_with(["solver", "quadrature_step"], 0.7), "quadrature_step"),
     (
         _with(["solver", "output_speeds", "min"], 0.0),
-        "0.0 is less than the minimum of 1e-100\n\nFailed validating 'minimum' in schema['properties']['solver']['properties']['output_speeds']",
+        "0.0 is less than the minimum of 1e-100\n\nFailed validating 'minimum' in schema['properties']['solver']['properties']['output_speeds']['allOf'][1]['properties']['min']",
     ),
     (_with(["exact", "speeds", "max"], -3), "exact.speeds: min = -2 must be smaller"),
     (_with(["exact", "positions"], [-0.1]), "positions"),
