@@ -314,10 +314,6 @@ def test_a_number_that_is_not_finite_is_refused_naming_the_key(key, value, where
     [
         ("figures.return_speeds", [1.0e6], r"figures.return_speeds\[0\]: u = 1000000.0 is outside"),
         ("figures.return_speeds", [0.3, 0.31], r"figures.return_speeds\[1\]: .*speed bin of"),
-            "solver.positions",
-            [0, 1.0e-9],
-            r"solver.positions\[1\]: x = 1e-09 is outside the position bins of r = 0.5",
-        ),
         ("solver.positions", [0, 2.0e3], r"solver.positions\[1\]: x = 2000.0 is outside"),
         ("solver.positions", [0, 0.1, 0.1], r"solver.positions\[2\]: x = 0.1 repeats .*\[1\]"),
         ("exact.positions", [0, 0.1, 0], r"exact.positions\[2\]: x = 0 repeats .*\[0\]"),
