@@ -151,7 +151,13 @@ VALIDATION_CHECKS = {
     "small_speed_fit_chi2_per_dof": "small-v fit: chi^2/dof",
     "large_speed_fit_joint_p_value": "large-v fit: joint p-value of the theory's exponents",
     "large_speed_fit_chi2_per_dof": "large-v fit: chi^2/dof",
+    "simulated_outside": "simulated tables: largest fraction outside their bins",
+    "solved_outside": "solver's tables: largest fraction outside their range",
 }
+
+#: The fraction of a distribution a table may leave outside its range and still count as
+#: whole (the automatic ranges of ``scales`` leave about 1e-6 at each end).
+COMPLETE_TABLE = 1.0e-4
 
 # "paper quality": the speeds over which the relative error of P(0, v) is reported
 QUALITY_SPEEDS = (0.01, 5.0)
@@ -468,10 +474,75 @@ def fit_checks(fits):
     return rows
 
 
+def coverage_checks(simulated_outside=None, solved_outside=None) -> list[dict]:
+    """How much of its distribution each table of one r leaves outside its range.
+
+    Parameters
+    ----------
+    simulated_outside, solved_outside : dict, optional
+        The ``outside`` provenance of rule merge_shards' and rule solve's tables ({table:
+        {"below", "above", "outside", "counts"}}; None where unbounded).
+
+    Returns
+    -------
+    list of dict
+        One row for each given: the largest fraction outside, with each table's in the
+        detail, and whether every table holds all but ``COMPLETE_TABLE`` of its distribution.
+
+    Examples
+    --------
+    >>> from bouncing_ball.validation.checks import coverage_checks
+    >>> row, = coverage_checks({"p0v": {"below": 2e-6, "above": 0.0, "outside": 2e-6,
+    ...                                  "counts": "collisions"}})
+    >>> print(row["value"], row["detail"])
+    2e-06 p0v 2.0e-06 of the collisions; every table holds all but 0.0001 of its distribution
+    """
+    rows = []
+    for check, outside in (
+        ("simulated_outside", simulated_outside),
+        ("solved_outside", solved_outside),
+    ):
+        if outside is None:
+            continue
+        parts = {name: part["outside"] for name, part in outside.items()}
+        value = max((np.inf if v is None else v) for v in parts.values())
+        shown = "; ".join(
+            f"{name} {'an unbounded part' if v is None else f'{v:.1e}'} of the "
+            f"{outside[name]['counts']}"
+            for name, v in parts.items()
+        )
+        verdict = (
+            f"every table holds all but {COMPLETE_TABLE:g} of its distribution"
+            if value <= COMPLETE_TABLE
+            else f"incomplete: more than {COMPLETE_TABLE:g} outside (give the bins or grids as auto)"
+        )
+        rows.append(
+            {
+                "check": check,
+                "reference": "none",
+                "bins": 0,
+                "value": value,
+                "bin_centre": np.nan,
+                "p_sign_flip": np.nan,
+                "detail": f"{shown}; {verdict}",
+            }
+        )
+    return rows
+
+
 def validation_rows(
-    label, restitution, p0v, position, fits, shards, solver_curve=None, per_shard=None
+    label,
+    restitution,
+    p0v,
+    position,
+    fits,
+    shards,
+    solver_curve=None,
+    per_shard=None,
+    outside=None,
 ) -> list[dict]:
-    """Every check of one r: ``outgoing_speed_checks``, ``position_checks``, ``fit_checks``.
+    """Every check of one r: ``outgoing_speed_checks``, ``position_checks``, ``fit_checks``,
+    ``coverage_checks``.
 
     Parameters
     ----------
@@ -487,6 +558,9 @@ def validation_rows(
         The solver's P(0, v) grid (where r is not 1/2 or 1/3).
     per_shard : dict, optional
         The shards' ``shard_ratios`` (for the p_sign_flip of the chi^2/n rows).
+    outside : tuple of dict, optional
+        The ``outside`` provenance of the simulated and the solver's tables
+        (``coverage_checks``).
 
     Returns
     -------
@@ -497,6 +571,7 @@ def validation_rows(
         *outgoing_speed_checks(p0v, restitution, shards, solver_curve, per_shard),
         *position_checks(position, restitution, shards, per_shard),
         *fit_checks(fits),
+        *coverage_checks(*(outside or ())),
     ]
     return [{"r_label": label, "r": float(restitution), **row} for row in rows]
 
