@@ -374,8 +374,11 @@ def fit_shards(side, lower, upper, counts, times, errors, restitution, free):
     if free:
         exponents = len(names) - 1
         deviation = _parameter_vector(fit)[1:] - np.array(theory_exponents(side, restitution))
-        if shards > exponents:
-            t_squared = float(deviation @ np.linalg.solve(covariance[1:, 1:], deviation))
+        exponent_covariance = covariance[1:, 1:]
+        # a singular covariance (shards whose exponents do not scatter: a window of too few
+        # bins or counts) allows no joint test
+        if shards > exponents and np.linalg.matrix_rank(exponent_covariance) == exponents:
+            t_squared = float(deviation @ np.linalg.solve(exponent_covariance, deviation))
             statistic = (shards - exponents) * t_squared / (exponents * (shards - 1))
             joint = _f_survival(statistic, exponents, shards - exponents)
     return AsymptoticFit(
