@@ -233,7 +233,9 @@ def read_tables_of_one_restitution(*paths, kinds=None) -> list[tuple["pd.DataFra
 
 def comparison_panels(solver_paths, simulation_paths, exact_paths, kinds) -> list[dict]:
     """One dict per r of a figure that compares the solver with the simulation, and with the
-    exact solution where r has one: ``restitution`` (the exact r), ``solver``, ``simulated`` and ``exact`` (None where r has no exact solution).
+    exact solution where r has one: ``restitution`` (the exact r), ``solver``, ``simulated``,
+    ``exact`` (None where r has no exact solution) and ``outside`` (the simulated tables'
+    ``outside`` provenance, {} where it has none).
     ``kinds``: the (solver, simulated, exact) ``TableKind``; each solver table is paired with
     the simulation table of the same position and refused unless both are of one r."""
     solver_kind, simulated_kind, exact_kind = kinds
@@ -243,7 +245,7 @@ def comparison_panels(solver_paths, simulation_paths, exact_paths, kinds) -> lis
         exact[provenance["r"]] = table
     panels = []
     for paths in zip(solver_paths, simulation_paths, strict=True):
-        (solved, provenance), (simulated, _) = read_tables_of_one_restitution(
+        (solved, provenance), (simulated, simulated_provenance) = read_tables_of_one_restitution(
             *paths, kinds=(solver_kind, simulated_kind)
         )
         panels.append(
@@ -252,6 +254,8 @@ def comparison_panels(solver_paths, simulation_paths, exact_paths, kinds) -> lis
                 "solver": solved,
                 "simulated": simulated,
                 "exact": exact.get(provenance["r"]),
+                # how much of each distribution the simulated tables leave outside their bins
+                "outside": simulated_provenance.get("outside", {}),
             }
         )
     return panels

@@ -15,6 +15,7 @@ matplotlib.use("Agg")
 import numpy as np  # noqa: E402
 from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.ticker import NullLocator  # noqa: E402
 
 from .. import __version__  # noqa: E402
 from ..restitution import exact_string  # noqa: E402
@@ -369,23 +370,54 @@ TIME_AVERAGE_LABELS = {
 
 
 @_styled
-def time_averages_figure(solved, simulated, exact, critical_restitution):
-    """Fig. 6: <x>, Delta x and I against r: the solver's curve over the grid (eq. (inteq)
-    with the Ito identities; I by eq. (collrate)), the simulation's points, the exact
-    values at r = 1/2 and 1/3.
+def time_averages_figure(solved, simulated, exact, critical_restitution, per_restitution=None):
+    """Fig. 6: <x>, Delta x and I against 1 - r on a log axis, so that the elastic end opens
+    up: the solver's curve over the grid (eq. (inteq) with the Ito identities; I by
+    eq. (collrate)), the solver at each simulated r, the quasi-elastic forms to first order in
+    1 - r (``quasi_elastic.quasi_elastic_form``) where 1 - r <= 0.1, the simulation's points,
+    the exact values at r = 1/2 and 1/3.
 
     ``solved``: table r, mean_x, delta_x, collision_rate; ``simulated``: merged
-    summary rows (with ``*_err``); ``exact``: exact summary rows.
+    summary rows (with ``*_err``); ``exact``: exact summary rows; ``per_restitution``: the
+    solver's summary rows of the simulated r (optional).
     """
+    from ..quasi_elastic import quasi_elastic_form
+
     figure, axes = new_figure(3, 1, width=4.6, height=7.2, sharex=True)
+    shown_r = [solved.r, simulated.r if len(simulated) else []]
+    if per_restitution is not None and len(per_restitution):
+        shown_r.append(per_restitution.r)
+    largest = max(
+        float(np.max(np.asarray(values, dtype=float))) for values in shown_r if len(values)
+    )
+    inelasticity = np.geomspace(min(0.1, 0.5 * (1.0 - largest)), 0.1, 60)
     for axis, quantity in zip(axes[:, 0], ("mean_x", "delta_x", "collision_rate")):
         values = solved[quantity].to_numpy()
         finite = np.isfinite(values)
-        axis.plot(solved.r[finite], values[finite], color="C0", label="solver, eq. (inteq)")
+        axis.plot(1.0 - solved.r[finite], values[finite], color="C0", label="solver, eq. (inteq)")
+        if per_restitution is not None and len(per_restitution):
+            axis.plot(
+                1.0 - per_restitution.r,
+                per_restitution[quantity],
+                "s",
+                color="C0",
+                markersize=5,
+                markerfacecolor="none",
+                label="solver at each simulated r",
+            )
+        limit = [quasi_elastic_form(quantity, 1.0 - e) for e in inelasticity]
+        axis.plot(
+            inelasticity,
+            limit,
+            color="C2",
+            linestyle="--",
+            linewidth=1.0,
+            label="quasi-elastic form, to first order in 1 - r",
+        )
         if len(simulated):
             _error_bars(
                 axis,
-                simulated.r,
+                1.0 - simulated.r,
                 simulated[quantity],
                 simulated[f"{quantity}_err"],
                 color="k",
@@ -395,23 +427,36 @@ def time_averages_figure(solved, simulated, exact, critical_restitution):
             )
         if len(exact):
             axis.plot(
-                exact.r, exact[quantity], "x", color="C3", markersize=6, label="exact, r = 1/2, 1/3"
+                1.0 - exact.r,
+                exact[quantity],
+                "x",
+                color="C3",
+                markersize=6,
+                label="exact, r = 1/2, 1/3",
             )
         axis.set_ylabel(TIME_AVERAGE_LABELS[quantity])
         axis.set_yscale("log")  # <x> and Delta x grow without bound as r -> 1, I as r -> r_c
         if quantity == "collision_rate":
-            axis.axvline(critical_restitution, color="0.5", linestyle=":", linewidth=0.9)
+            axis.axvline(1.0 - critical_restitution, color="0.5", linestyle=":", linewidth=0.9)
             axis.annotate(
                 r"$r_c$: $I = \infty$ below",
-                (critical_restitution, 0.9),
+                (1.0 - critical_restitution, 0.9),
                 xycoords=("data", "axes fraction"),
-                xytext=(4, 0),
+                xytext=(-4, 0),
                 textcoords="offset points",
+                ha="right",
                 color="0.3",
             )
-    axes[0, 0].legend(loc="upper left")
-    axes[-1, 0].set_xlim(0.0, 1.0)
-    axes[-1, 0].set_xlabel(r"$r$")
+    axes[0, 0].legend(loc="upper left", fontsize=7)
+    bottom = axes[-1, 0]
+    bottom.set_xscale("log")
+    bottom.set_xlim(1.0, 0.5 * inelasticity[0])  # r grows to the right, as in the paper
+    bottom.set_xlabel(r"$1 - r$")
+    top = axes[0, 0].secondary_xaxis("top", functions=(lambda e: e, lambda e: e))
+    ticks = [r for r in (0.1, 0.5, 0.9, 0.99, 0.999, 0.9999) if 1.0 - r >= 0.5 * inelasticity[0]]
+    top.set_xticks([1.0 - r for r in ticks], [f"{r:g}" for r in ticks])
+    top.xaxis.set_minor_locator(NullLocator())
+    top.set_xlabel(r"$r$")
     return figure
 
 
@@ -522,10 +567,14 @@ def joint_distribution_figure(panels):
 def position_density_figure(panels):
     """Fig. 9 (past the paper): P(x) for every simulated r: the solver through w(F),
     eqs. (weightfunc), (P(x)1) (line), the simulation's bins (points, one-sigma errors) and
-    the exact eq. (P(x)2) where r is 1/2 or 1/3 (dotted).
+    the exact eq. (P(x)2) where r is 1/2 or 1/3 (dotted).  Each panel spans the heights
+    that hold all but about 1e-6 of the time (where x P(x) is above 1e-6 of its largest
+    value), and says how much of the time the simulated bins leave outside, or that they
+    recorded none.
 
     ``panels``: dicts with ``restitution``, ``solver`` (x, px), ``simulated`` (x_lo, x_hi,
-    x, px, px_err) and ``exact`` (x, px, or None).
+    x, px, px_err), ``exact`` (x, px, or None) and ``outside`` (the simulation's
+    ``outside`` provenance, optional).
     """
     figure, axes = _panel_grid(len(panels))
     for index, (axis, panel) in enumerate(zip(axes, panels)):
@@ -553,9 +602,30 @@ def position_density_figure(panels):
             )
         axis.set_xscale("log")
         axis.set_yscale("log")
-        if len(bins):
-            axis.set_ylim(bins.px.min() / 10, bins.px.max() * 5)
-            axis.set_xlim(bins.x_lo.min(), bins.x_hi.max())
+        mass = (solver.x * solver.px).to_numpy()
+        body = solver[np.isfinite(mass) & (mass >= 1e-6 * np.nanmax(mass))]
+        if len(body):
+            axis.set_xlim(body.x.min(), body.x.max())
+            axis.set_ylim(body.px.min() / 3, body.px.max() * 5)
+        outside = (panel.get("outside") or {}).get("position")
+        note = (
+            "no simulated time in the bins"
+            if not len(bins)
+            else f"simulated bins: {outside['outside']:.0e} of the time outside"
+            if outside
+            else ""
+        )
+        if note:
+            axis.text(
+                0.98,
+                0.97,
+                note,
+                transform=axis.transAxes,
+                ha="right",
+                va="top",
+                fontsize=7,
+                color="0.3",
+            )
         axis.set_xlabel(r"$x$")
         axis.set_ylabel(r"$P(x)$")
         panel_title(axis, restitution_text(panel["restitution"]))

@@ -149,6 +149,7 @@ rule fig6:
     input:
         grid="results/solver/time_averages.parquet",
         simulation=expand("results/simulation/r{r}/summary.parquet", r=RESTITUTION),
+        solver=expand("results/solver/r{r}/summary.parquet", r=RESTITUTION),
         exact=expand("results/exact/r{r}/summary.parquet", r=EXACT_LABELS),
     output:
         "results/figures/fig6.pdf",
