@@ -21,7 +21,8 @@ __all__ = [
     "validation_table",
     "validation_markdown",
     "POSITION_RANGE",
-    "QUALITY_SPEEDS",
+    "QUALITY_SCALED_SPEEDS",
+    "quality_speeds",
     "VALIDATION_CHECKS",
     "VALIDATION_COLUMNS",
 ]
@@ -132,16 +133,16 @@ VALIDATION_COLUMNS = (
 VALIDATION_CHECKS = {
     "p0v_chi2_per_bin": "P(0,v): chi^2/n",
     "p0v_worst_bin": "P(0,v): worst bin, z",
-    "p0v_largest_relative_error": "P(0,v): largest relative error, 0.01 <= v <= 5",
+    "p0v_largest_relative_error": "P(0,v): largest relative error, 0.01 <= q v <= 5",
     "p0v_martingale_chi2_per_bin": "P(0,v) martingale-controlled: chi^2/n",
     "p0v_martingale_worst_bin": "P(0,v) martingale-controlled: worst bin, z",
     "p0v_martingale_largest_relative_error": (
-        "P(0,v) martingale-controlled: largest relative error, 0.01 <= v <= 5"
+        "P(0,v) martingale-controlled: largest relative error, 0.01 <= q v <= 5"
     ),
     "p0v_controlled_chi2_per_bin": "P(0,v) controlled with eq. (kernel3): chi^2/n",
     "p0v_controlled_worst_bin": "P(0,v) controlled with eq. (kernel3): worst bin, z",
     "p0v_controlled_largest_relative_error": (
-        "P(0,v) controlled with eq. (kernel3): largest relative error, 0.01 <= v <= 5"
+        "P(0,v) controlled with eq. (kernel3): largest relative error, 0.01 <= q v <= 5"
     ),
     "px_chi2_per_bin": "P(x): chi^2/n",
     "px_worst_bin": "P(x): worst bin, z",
@@ -153,8 +154,42 @@ VALIDATION_CHECKS = {
     "large_speed_fit_chi2_per_dof": "large-v fit: chi^2/dof",
 }
 
-# "paper quality": the speeds over which the relative error of P(0, v) is reported
-QUALITY_SPEEDS = (0.01, 5.0)
+# "paper quality": the speeds over which the relative error of P(0, v) is reported, in units
+# of 1/q(r), the large-v decay length of eqs. (asym3)-(asym6): 0.01 <= v <= 5 at r = 1/2
+# (q = 1); the speeds scale like 1/q, ~ 1/(1 - r) near r = 1
+QUALITY_SCALED_SPEEDS = (0.01, 5.0)
+
+
+def quality_speeds(restitution) -> tuple:
+    """The speeds over which the validation table reports the largest relative error of P(0, v).
+
+    ``QUALITY_SCALED_SPEEDS`` in units of 1/q(r), q the large-speed decay rate of eqs.
+    (asym3)-(asym6): the window follows the speeds of r (which grow like 1/(1 - r) near
+    r = 1) and is 0.01 <= v <= 5 at r = 1/2.
+
+    Parameters
+    ----------
+    restitution : float or fractions.Fraction
+        r, 0 < r < 1.
+
+    Returns
+    -------
+    tuple of float
+        (lowest, highest) v.
+
+    Examples
+    --------
+    >>> from bouncing_ball.validation import quality_speeds
+    >>> print([round(v, 4) for v in quality_speeds(0.5)], [round(v, 4) for v in quality_speeds(0.25)])
+    [0.01, 5.0] [0.005, 2.5]
+    """
+    from ..asymptotics import large_speed_decay_rate
+
+    q = large_speed_decay_rate(float(restitution))
+    low, high = QUALITY_SCALED_SPEEDS
+    return low / q, high / q
+
+
 # the heights over which P(x) and <v^2>_x are held against eqs. (P(x)2), (moment2)
 POSITION_RANGE = (1.0e-3, 50.0)
 
@@ -252,8 +287,9 @@ def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None, per
         Rows of ``VALIDATION_COLUMNS`` without r: chi^2/n and the worst z of
         z = (simulation - reference) / p0v_err over the bins with an error (not the under-
         and overflow bins, nor bins beyond the solver's grid), and the largest relative error
-        p0v_err / p0v over the bins with 0.01 <= v <= 5 (an empty bin there counts as an
-        infinite relative error): these ``p0v_*`` rows of the plain counts, with the
+        p0v_err / p0v over the bins of ``quality_speeds(restitution)`` (0.01 <= q v <= 5;
+        an empty bin there counts as an
+        infinite relative error, and the row says so): these ``p0v_*`` rows of the plain counts, with the
         p_sign_flip of chi^2/n, judge agreement.  The same three of ``p0v_martingale``
         (``p0v_martingale_*``, the martingale controls: still independent of the theory)
         and of ``p0v_controlled`` (``p0v_controlled_*``, the return-law control of
@@ -310,38 +346,58 @@ def _outgoing_speed_rows(quantity, simulated, restitution, shards, solver_curve,
         per_shard, "p0v", residuals.bin.to_numpy(), residuals.reference.to_numpy(), shards
     )
     rows = _z_rows(quantity, reference, where, z, shards, "v", deviations)
-    low, high = QUALITY_SPEEDS
-    quality = simulated[(simulated.v >= low) & (simulated.v <= high)]
+    rows.append(_relative_error_row(quantity, simulated, restitution))
+    return rows
+
+
+def _relative_error_row(quantity, simulated, restitution):
+    """The largest relative error of the table's p0v over ``quality_speeds(restitution)``,
+    with the reason of an inf (bins without a collision) or a NaN (no bin there)."""
+    from ..asymptotics import large_speed_decay_rate
+
+    low, high = quality_speeds(restitution)
+    scaled_low, scaled_high = QUALITY_SCALED_SPEEDS
+    window = (
+        f"{_number(low, 3)} <= v <= {_number(high, 3)} ({scaled_low:g} <= q v <= {scaled_high:g}, "
+        f"q = {large_speed_decay_rate(float(restitution)):.4g} of eqs. (asym4), (asym6))"
+    )
+    finite = np.isfinite(simulated.v_hi) & (simulated.v_lo > 0.0)
+    quality = simulated[finite & (simulated.v >= low) & (simulated.v <= high)]
+    empty = (quality.p0v <= 0.0) | ~np.isfinite(quality.p0v_err)
     with np.errstate(divide="ignore", invalid="ignore"):
-        relative = np.where(
-            (quality.p0v > 0.0) & np.isfinite(quality.p0v_err),
-            quality.p0v_err / quality.p0v,
-            np.inf,
-        )
+        relative = np.where(empty, np.inf, quality.p0v_err / quality.p0v)
+    covered = simulated[finite]
     if len(relative):
         k = _largest(relative, quality.v.to_numpy())
         largest, at = float(relative[k]), float(quality.v.iloc[k])
+        detail = f"max of p0v_err / p0v over the bins with {window}, at v = {_number(at, 3)}"
+        if count := int(np.sum(empty)):
+            detail += (
+                f"; {count} of them without a collision or an error (an infinite relative "
+                "error: the run is too short there)"
+            )
     else:
         largest, at = np.nan, np.nan
-    rows.append(
-        {
-            "check": f"{quantity}_largest_relative_error",
-            "reference": "none",
-            "bins": len(relative),
-            "value": largest,
-            "bin_centre": at,
-            "p_sign_flip": np.nan,
-            "detail": f"max of p0v_err / p0v over the bins with {low:g} <= v <= {high:g}, "
-            f"at v = {_number(at, 3)}"
-            + (
-                f"; {empty} of them without a collision (an infinite relative error: the run "
-                "is too short there)"
-                if (empty := int(np.sum(~np.isfinite(relative))))
-                else ""
-            ),
-        }
-    )
-    return rows
+        detail = f"no bin with its centre in {window}" + (
+            f": the bins span {_number(covered.v_lo.min(), 3)} <= v <= "
+            f"{_number(covered.v_hi.max(), 3)}"
+            if len(covered)
+            else ": the table has no finite bins"
+        )
+    if len(relative) and len(covered) and (covered.v_lo.min() > low or covered.v_hi.max() < high):
+        detail += (
+            f"; the bins cover only {_number(max(low, covered.v_lo.min()), 3)} <= v <= "
+            f"{_number(min(high, covered.v_hi.max()), 3)} of it"
+        )
+    return {
+        "check": f"{quantity}_largest_relative_error",
+        "reference": "none",
+        "bins": len(relative),
+        "value": largest,
+        "bin_centre": at,
+        "p_sign_flip": np.nan,
+        "detail": detail,
+    }
 
 
 def position_checks(position, restitution, shards, per_shard=None):
@@ -529,6 +585,15 @@ def _shown_value(check, value):
     return f"{value:.3g}"
 
 
+def _shown_check(check, restitution):
+    """The check's name; a relative-error row's with its window's speeds at r."""
+    name = VALIDATION_CHECKS[check]
+    if check.endswith("largest_relative_error"):
+        low, high = quality_speeds(restitution)
+        name += f" ({_number(low, 3)} <= v <= {_number(high, 3)})"
+    return name
+
+
 def validation_markdown(table: pd.DataFrame) -> str:
     """The validation table for a reader, as results/tables/validation.md.
 
@@ -546,7 +611,7 @@ def validation_markdown(table: pd.DataFrame) -> str:
     shown = pd.DataFrame(
         {
             "r": table.r_label.astype(str),
-            "check": table.check.map(VALIDATION_CHECKS),
+            "check": [_shown_check(c, r) for c, r in zip(table.check, table.r)],
             "reference": table.reference,
             "bins": table.bins.astype(str),
             "value": [_shown_value(c, v) for c, v in zip(table.check, table.value)],

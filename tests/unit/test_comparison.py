@@ -22,6 +22,7 @@ from bouncing_ball.validation import (
     moments_table,
     outgoing_speed_checks,
     outgoing_speed_residuals,
+    quality_speeds,
     ratio_deviations,
     shard_ratios,
     sign_flip_test,
@@ -388,6 +389,71 @@ def test_validation_names_the_same_bin_of_equal_worst_values_in_any_order_of_the
         assert row.value == np.inf and row.bin_centre == p0v.loc[inside[4], "v"]
 
 
+def _collision_counted_bins(restitution, collisions, rng, lo=1e-4, hi=1e3):
+    """Bins of P(0, v) ~ v^-beta e^(-q v) from Poisson counts of ``collisions`` collisions
+    (a bin's collisions come at the rate v P(0, v) dv, eq. (collrate)), with the errors of the
+    counts; an empty bin has p0v 0 and no error, as in a merged table."""
+    from bouncing_ball import fits
+
+    (beta,) = fits.theory_exponents(fits.SMALL_SPEED, float(restitution))
+    q = fits.theory_exponents(fits.LARGE_SPEED, float(restitution))[1]
+    edges = np.geomspace(lo, hi, int(round(10 * np.log10(hi / lo))) + 1)
+    lower, upper = edges[:-1], edges[1:]
+    shape = fits.bin_average(fits.large_speed_form, lower, upper, 0.0, beta, q)
+    weight = shape * 0.5 * (upper**2 - lower**2)
+    counts = rng.poisson(collisions * weight / weight.sum())
+    density = counts / (0.5 * (upper**2 - lower**2))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        errors = np.where(counts > 0, density / np.sqrt(counts), np.nan)
+    return pd.DataFrame(
+        {
+            "v_lo": lower,
+            "v_hi": upper,
+            "v": np.sqrt(lower * upper),
+            "p0v": density,
+            "p0v_err": errors,
+            "count": counts,
+        }
+    ), pd.DataFrame({"v": np.sqrt(lower * upper), "p0v": shape})
+
+
+def test_the_relative_error_window_follows_the_speeds_of_r():
+    """At r = 0.99 the window 0.01 <= v <= 5 sat in the far low-speed tail (speeds scale like
+    1/q, q = 0.0151) and the row read inf from its empty bins.  1.2e7 collisions (the default
+    run at r = 0.99) fill every bin of 0.01 <= q v <= 5 = 0.66 <= v <= 330, where the largest
+    relative error is that of the rarest bin, about 1/sqrt(its count)."""
+    restitution = Fraction(99, 100)
+    low, high = quality_speeds(restitution)
+    assert (low, high) == pytest.approx((0.01 / 0.015149984850015164, 5 / 0.015149984850015164))
+    p0v, curve = _collision_counted_bins(restitution, 1.2e7, np.random.default_rng(17))
+    row = _by_check(outgoing_speed_checks(p0v, restitution, 8, solver_curve=curve)).loc[
+        "p0v_largest_relative_error"
+    ]
+    inside = p0v[(p0v.v >= low) & (p0v.v <= high)]
+    assert row.bins == len(inside) > 0
+    rarest = 1.0 / np.sqrt(inside["count"].min())
+    assert np.isfinite(row.value) and row.value == pytest.approx(rarest, rel=1e-12)
+    assert "0.66 <= v <= 330 (0.01 <= q v <= 5, q = 0.01515" in row.detail
+    markdown = validation_markdown(
+        validation_table([{**row.to_dict(), "r_label": "0.99", "r": 0.99, "check": row.name}])
+    )
+    assert "largest relative error, 0.01 <= q v <= 5 (0.66 <= v <= 330)" in markdown
+    # a run with no bin in the window: NaN, and the row says why
+    below = p0v[p0v.v_hi < 0.5]
+    row = _by_check(outgoing_speed_checks(below, restitution, 8, solver_curve=curve)).loc[
+        "p0v_largest_relative_error"
+    ]
+    assert np.isnan(row.value) and "no bin with its centre in 0.66 <= v <= 330" in row.detail
+    assert "the bins span 0.0001 <= v <= 0.398" in row.detail
+    # a short run (6e4 collisions, 8 shards of 2e6): an infinite error says it is empty bins
+    short, _ = _collision_counted_bins(restitution, 6e4, np.random.default_rng(18))
+    row = _by_check(outgoing_speed_checks(short, restitution, 8, solver_curve=curve)).loc[
+        "p0v_largest_relative_error"
+    ]
+    if not np.isfinite(row.value):
+        assert "without a collision or an error" in row.detail
+
+
 def test_validation_at_an_r_without_exact_solution_uses_the_solver_and_skips_p_x():
     """At r = 0.6 the reference of P(0, v) is the solver's curve (here a curve 1% high, which
     the residuals must show); there is no P(x) row."""
@@ -431,7 +497,8 @@ def test_validation_fit_rows_and_markdown():
     assert table.p_sign_flip.isna().all()
     markdown = validation_markdown(table)
     assert markdown.count("\n") == len(table) + 2
-    assert "P(0,v): largest relative error, 0.01 <= v <= 5" in markdown and "| 1%" in markdown
+    assert "P(0,v): largest relative error, 0.01 <= q v <= 5 (0.01 <= v <= 5)" in markdown
+    assert "| 1%" in markdown
     # one column separator per column and edge on every line: no '|' inside a cell
     assert {line.count("|") for line in markdown.splitlines()} == {9}
 
