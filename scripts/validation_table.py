@@ -35,8 +35,10 @@ with job_log(snakemake.log[0], exit_when_done=True):
         strict=True,
     )
     for paths in inputs:
-        (p0v, provenance), (position, _), (curve, _), (fits, _) = read_tables_of_one_restitution(
-            *paths, kinds=(SIMULATED_P0V, SIMULATED_POSITION, SOLVER_P0V, FITS)
+        (p0v, provenance), (position, _), (curve, _), (fits, fit_provenance) = (
+            read_tables_of_one_restitution(
+                *paths, kinds=(SIMULATED_P0V, SIMULATED_POSITION, SOLVER_P0V, FITS)
+            )
         )
         label = provenance["r_label"]
         # the batch files of r (results/simulation/r{label}/shards*.parquet)
@@ -56,6 +58,8 @@ with job_log(snakemake.log[0], exit_when_done=True):
             len(shards),
             solver_curve=curve,
             per_shard=shard_ratios(shards),
+            # the rule the fit's auto windows were chosen by
+            max_bias=float(fit_provenance["settings"]["max_bias"]),
         )
     table = validation_table(rows)
     write_csv_and_markdown(

@@ -456,18 +456,85 @@ def position_checks(position, restitution, shards, per_shard=None):
     return rows
 
 
-def fit_checks(fits):
+def _fit_problems(fits, side, shards, max_bias):
+    """Why the free-exponent fit of one window tests nothing: [] where it is a check.
+
+    The window must lie where the form holds on the solver's curve (its free fit there within
+    ``max_bias`` of the data's error of the theory's exponents, the rule of
+    ``fits.asymptotic_window``), the small-v window below the large-v one, and the fit must
+    have power: an exponent of the theory beyond the 95% half-width of its fitted value
+    (t(0.975, shards - 1) times its jackknife error), else no fit of these data could tell
+    it from 0, a wrong exponent.  Returns the problems and, apart, the exponents without
+    power where another has it (the joint test then tests the others)."""
+    from ..fits import EXPONENT_NAMES, LARGE_SPEED, SMALL_SPEED, interval_factor
+
+    free = fits[fits.fit == "free_exponents"]
+    simulated = free[(free.source == "simulation") & (free.window == side)].set_index("parameter")
+    solved = free[(free.source == "solver") & (free.window == side)].set_index("parameter")
+    names = list(EXPONENT_NAMES[side])
+    first = simulated.iloc[0]
+    if not np.all(np.isfinite(simulated.loc[names, "value"])):
+        return [
+            f"the fit of free exponents finds no optimum over v in [{_number(first.v_min, 3)}, "
+            f"{_number(first.v_max, 3)}] (the fit's log says why)"
+        ], []
+    problems = []
+    if side == SMALL_SPEED:
+        large = free[(free.source == "simulation") & (free.window == LARGE_SPEED)]
+        if (
+            len(large)
+            and np.isfinite(large.iloc[0].v_min)
+            and first.v_max > large.iloc[0].v_min * (1.0 + 1e-9)
+        ):
+            problems.append(
+                f"its window [{_number(first.v_min, 3)}, {_number(first.v_max, 3)}] is not "
+                f"below the large-v window [{_number(large.iloc[0].v_min, 3)}, "
+                f"{_number(large.iloc[0].v_max, 3)}]"
+            )
+    factor, unresolved = interval_factor(shards), []
+    for name in names:
+        theory, error = float(simulated.loc[name, "theory"]), float(simulated.loc[name, "error"])
+        curve = float(solved.loc[name, "value"]) if name in solved.index else np.nan
+        if not np.isfinite(curve):
+            problems.append(f"the free fit to the solver's curve gives no {name} over this window")
+        elif not abs(curve - theory) <= max_bias * error:
+            problems.append(
+                f"the form does not hold over this window: on the solver's curve the free fit "
+                f"gives {name} = {_number(curve, 3)} against the theory's {_number(theory, 3)}, "
+                f"more than {max_bias:g} of the data's error {_number(error, 2)}"
+            )
+        if not factor * error < abs(theory):
+            unresolved.append(
+                f"the theory's {name} = {_number(theory, 3)} lies within the 95% half-width "
+                f"{_number(factor * error, 2)} of 0, so the fit could not reject {name} = 0"
+            )
+    if len(unresolved) == len(names):
+        problems.append("no power: " + "; ".join(unresolved))
+    return problems, unresolved
+
+
+def fit_checks(fits, shards, max_bias=0.5):
     """The free-exponent fits of the asymptotic forms to the simulated P(0, v), as checks.
 
     Per window (small v, eqs. (asym1), (asym2); large v, eqs. (asym3)-(asym6)) the joint
     p-value of the theory's exponents (Hotelling's T^2 on the jackknife covariance) and the
     fit's chi^2 per degree of freedom (per-bin errors only: indicative, it ignores the
-    correlations between bins).
+    correlations between bins).  A fit that tests nothing is not counted: where the window
+    lies outside the form's regime (on the solver's curve the free exponents drift from the
+    theory's by more than ``max_bias`` of the data's errors, or the small-v window is not
+    below the large-v one) or the fit has no power (every theory's exponent within the 95%
+    half-width of 0), both rows have the value NaN and a detail "not checked: <why>", with
+    what the fit gave; an exponent without power beside one with it is named as not tested.
 
     Parameters
     ----------
     fits : pandas.DataFrame
         A fits table (``fits.asymptotic_fits``).
+    shards : int
+        The number of shards of the simulation's jackknife (the t factor of the intervals).
+    max_bias : float, optional
+        The drift of the form allowed on the solver's curve, in units of the data's error
+        (config ``fits.max_bias``, the rule the auto windows are chosen by).
 
     Returns
     -------
@@ -496,10 +563,21 @@ def fit_checks(fits):
             if np.isfinite(first.v_min)
             else "no usable window"
         )
-        joint = float(first.joint_p_value)
-        if np.isfinite(first.v_min) and not np.isfinite(joint):
-            # Hotelling's T^2 needs more shards than free exponents (fits.fit_shards)
-            fitted += "; no joint test: too few shards for the exponents"
+        joint, chi2 = float(first.joint_p_value), float(first.chi2_per_dof)
+        problems, unresolved = (
+            _fit_problems(fits, side, shards, max_bias) if np.isfinite(first.v_min) else ([], [])
+        )
+        if unresolved and not problems:
+            fitted += "; not tested: " + "; ".join(unresolved)
+        if problems:
+            lead = "not checked: " + "; ".join(problems) + "; the fit: "
+            fitted += f"; joint p {_number(joint, 3)}, chi^2/dof {_number(chi2, 3)}"
+            joint, chi2 = np.nan, np.nan
+        else:
+            lead = ""
+            if np.isfinite(first.v_min) and not np.isfinite(joint):
+                # Hotelling's T^2 needs more shards than free exponents (fits.fit_shards)
+                fitted += "; no joint test: too few shards for the exponents"
         rows += [
             {
                 "check": f"{side}_fit_joint_p_value",
@@ -508,16 +586,16 @@ def fit_checks(fits):
                 "value": joint,
                 "bin_centre": np.nan,
                 "p_sign_flip": np.nan,
-                "detail": f"{where}; {fitted}",
+                "detail": f"{lead}{where}; {fitted}",
             },
             {
                 "check": f"{side}_fit_chi2_per_dof",
                 "reference": "fit",
                 "bins": bins,
-                "value": float(first.chi2_per_dof),
+                "value": chi2,
                 "bin_centre": np.nan,
                 "p_sign_flip": np.nan,
-                "detail": f"{where}; {dof} degrees of freedom; indicative: the bins are "
+                "detail": f"{lead}{where}; {dof} degrees of freedom; indicative: the bins are "
                 "correlated (the joint p-value is the test)",
             },
         ]
@@ -525,7 +603,7 @@ def fit_checks(fits):
 
 
 def validation_rows(
-    label, restitution, p0v, position, fits, shards, solver_curve=None, per_shard=None
+    label, restitution, p0v, position, fits, shards, solver_curve=None, per_shard=None, max_bias=0.5
 ) -> list[dict]:
     """Every check of one r: ``outgoing_speed_checks``, ``position_checks``, ``fit_checks``.
 
@@ -543,6 +621,8 @@ def validation_rows(
         The solver's P(0, v) grid (where r is not 1/2 or 1/3).
     per_shard : dict, optional
         The shards' ``shard_ratios`` (for the p_sign_flip of the chi^2/n rows).
+    max_bias : float, optional
+        Of ``fit_checks``: the fits' ``fits.max_bias``.
 
     Returns
     -------
@@ -552,7 +632,7 @@ def validation_rows(
     rows = [
         *outgoing_speed_checks(p0v, restitution, shards, solver_curve, per_shard),
         *position_checks(position, restitution, shards, per_shard),
-        *fit_checks(fits),
+        *fit_checks(fits, shards, max_bias),
     ]
     return [{"r_label": label, "r": float(restitution), **row} for row in rows]
 
@@ -574,7 +654,9 @@ def validation_table(rows) -> pd.DataFrame:
     return table.astype({"bins": "int64"}) if len(table) else table
 
 
-def _shown_value(check, value):
+def _shown_value(check, value, detail=""):
+    if detail.startswith("not checked"):
+        return "not checked"
     if not np.isfinite(value):
         return "inf" if value == np.inf else ""
     if check.endswith("relative_error"):
@@ -614,7 +696,9 @@ def validation_markdown(table: pd.DataFrame) -> str:
             "check": [_shown_check(c, r) for c, r in zip(table.check, table.r)],
             "reference": table.reference,
             "bins": table.bins.astype(str),
-            "value": [_shown_value(c, v) for c, v in zip(table.check, table.value)],
+            "value": [
+                _shown_value(c, v, d) for c, v, d in zip(table.check, table.value, table.detail)
+            ],
             "at v or x": table.bin_centre.map(lambda value: _number(value, 3)),
             "p_sign_flip": table.p_sign_flip.map(lambda value: _number(value, 2)),
             "detail": table.detail,
