@@ -554,6 +554,8 @@ def fit_checks(fits, shards, max_bias=0.5):
         fitted = ", ".join(
             f"{row.parameter} = {value_with_error(row.value, row.error)} "
             f"(theory {_number(row.theory, 4)})"
+            if np.isfinite(row.value)
+            else f"theory {row.parameter} = {_number(row.theory, 4)}"
             for row in exponents.itertuples()
         )
         dof = int(first.dof) if np.isfinite(first.dof) else 0
@@ -561,7 +563,7 @@ def fit_checks(fits, shards, max_bias=0.5):
         where = (
             f"v in [{_number(first.v_min, 3)}, {_number(first.v_max, 3)}]"
             if np.isfinite(first.v_min)
-            else "no usable window"
+            else "no usable window (the fit's log says why)"
         )
         joint, chi2 = float(first.joint_p_value), float(first.chi2_per_dof)
         problems, unresolved = (

@@ -513,6 +513,9 @@ def test_validation_fit_rows_say_why_a_joint_p_value_is_missing():
     rows = _by_check(fit_checks(fits, shards=2))
     assert "too few shards" in rows.loc["large_speed_fit_joint_p_value", "detail"]
     assert rows.loc["small_speed_fit_joint_p_value", "detail"].startswith("no usable window")
+    fits.loc[fits.window == "small_speed", ["value", "error"]] = np.nan
+    detail = _by_check(fit_checks(fits, shards=2)).loc["small_speed_fit_joint_p_value", "detail"]
+    assert detail == "no usable window (the fit's log says why); theory beta = 1"
     assert rows.loc["small_speed_fit_chi2_per_dof", "bins"] == 0
     assert np.isnan(rows.loc["small_speed_fit_chi2_per_dof", "value"])
 
