@@ -48,6 +48,7 @@ __all__ = [
     "SMALL_SPEED",
     "LARGE_SPEED",
     "WindowError",
+    "FitError",
     "small_speed_form",
     "large_speed_form",
     "theory_exponents",
@@ -76,6 +77,10 @@ LARGE_SPEED = "large_speed"
 
 class WindowError(ValueError):
     """No window on one side holds enough usable bins for a fit."""
+
+
+class FitError(ValueError):
+    """A fit of free exponents finds no optimum (``scipy.optimize.curve_fit`` gives up)."""
 
 
 def small_speed_form(v, log_prefactor, beta):
@@ -243,6 +248,11 @@ def fit_asymptotic_form(side, lower, upper, values, errors, restitution, free):
     -------
     AsymptoticFit
 
+    Raises
+    ------
+    FitError
+        If the free-exponent fit finds no optimum, naming the side and the window.
+
     Examples
     --------
     Exact bin averages of 2 v^-1 at r = 1/2 (beta = 1) give the prefactor back:
@@ -277,15 +287,21 @@ def fit_asymptotic_form(side, lower, upper, values, errors, restitution, free):
             float(upper[-1]),
         )
     start = (np.log(prefactor), *theory)
-    best, covariance = optimize.curve_fit(
-        lambda _, *p: bin_average(form, lower, upper, *p),
-        np.zeros(len(values)),
-        values,
-        p0=start,
-        sigma=errors,
-        absolute_sigma=True,
-        maxfev=20000,
-    )
+    try:
+        best, covariance = optimize.curve_fit(
+            lambda _, *p: bin_average(form, lower, upper, *p),
+            np.zeros(len(values)),
+            values,
+            p0=start,
+            sigma=errors,
+            absolute_sigma=True,
+            maxfev=20000,
+        )
+    except (RuntimeError, ValueError) as error:  # no optimum, or a NaN on the way
+        raise FitError(
+            f"{side} fit of free exponents over v in [{lower[0]:.3g}, {upper[-1]:.3g}] "
+            f"({len(values)} bins) finds no optimum: {error}"
+        ) from None
     spread = np.sqrt(np.diag(covariance))
     residual = (values - bin_average(form, lower, upper, *best)) / errors
     return AsymptoticFit(
@@ -343,6 +359,8 @@ def fit_shards(side, lower, upper, counts, times, errors, restitution, free):
     ------
     ValueError
         With fewer than 2 shards, or an error that is not finite and positive.
+    FitError
+        If a free-exponent fit (of the pooled data or of a shard left out) finds no optimum.
     """
     counts = np.asarray(counts, dtype=float)
     times = np.asarray(times, dtype=float)
@@ -453,31 +471,38 @@ def asymptotic_window(
     Raises
     ------
     WindowError
-        With fewer than ``minimum_bins`` bins, or a drift too large already there.
+        With fewer than ``minimum_bins`` bins, or a drift too large already there, or a fit
+        that finds no optimum there (a larger window whose fit finds none ends the run).
     """
     count = len(lower)
     if count < minimum_bins:
         raise WindowError(f"{side} window: only {count} usable bins, {minimum_bins} needed")
     theory = np.array(theory_exponents(side, restitution))
-    best = None
+    best, failure = None, None
     for size in range(minimum_bins, count + 1):
         window = slice(0, size) if side == SMALL_SPEED else slice(count - size, count)
         parts = (lower[window], upper[window])
-        drift = (
-            _parameter_vector(
-                fit_asymptotic_form(
-                    side, *parts, reference[window], errors[window], restitution, free=True
-                )
-            )[1:]
-            - theory
-        )
-        noisy = fit_shards(
-            side, *parts, counts[:, window], times, errors[window], restitution, free=True
-        )
+        try:
+            drift = (
+                _parameter_vector(
+                    fit_asymptotic_form(
+                        side, *parts, reference[window], errors[window], restitution, free=True
+                    )
+                )[1:]
+                - theory
+            )
+            noisy = fit_shards(
+                side, *parts, counts[:, window], times, errors[window], restitution, free=True
+            )
+        except FitError as error:  # the form cannot be fitted this far in: the window ends
+            failure = error
+            break
         spread = np.array([noisy.errors[name] for name in EXPONENT_NAMES[side]])
         if np.any(np.abs(drift) > max_bias * spread):
             break
         best = window
+    if best is None and failure is not None:
+        raise WindowError(f"{side} window: {failure}")
     if best is None:
         raise WindowError(
             f"{side} window: fitted to the solver over the {minimum_bins} outermost usable bins, the free "
@@ -613,9 +638,10 @@ def asymptotic_fits(
     Returns
     -------
     table : pandas.DataFrame
-        The rows of ``fit_rows``; a side without a usable window gets NaN rows.
+        The rows of ``fit_rows``; a side without a usable window, or a fit that finds no
+        optimum (``FitError``), gets NaN rows.
     problems : list of str
-        Why a side has no window.
+        Why a side has no window, or a fit no value.
     """
     rows, problems = [], []
     for side in (SMALL_SPEED, LARGE_SPEED):
@@ -629,34 +655,50 @@ def asymptotic_fits(
                 window = window_from_range(side, lower, upper, windows[side])
         except WindowError as error:
             problems.append(str(error))
-            names = ("prefactor", *EXPONENT_NAMES[side])
-            empty = AsymptoticFit(
-                side,
-                False,
-                dict.fromkeys(names, np.nan),
-                dict.fromkeys(names, np.nan),
-                np.nan,
-                0,
-                np.nan,
-                np.nan,
-            )
             for source in ("simulation", "solver"):
                 for free in (False, True):
-                    rows += fit_rows(
-                        source, AsymptoticFit(**{**empty.__dict__, "free": free}), theory
-                    )
+                    rows += fit_rows(source, _empty_fit(side, free), theory)
             continue
         parts = (lower[window], upper[window])
         for free in (False, True):
-            simulated = fit_shards(
-                side, *parts, counts[:, window], times, errors[window], restitution, free
-            )
-            rows += fit_rows("simulation", simulated, theory, shards=len(times))
-            solved = fit_asymptotic_form(
-                side, *parts, reference[window], errors[window], restitution, free
-            )
-            rows += fit_rows("solver", solved, theory)
+            for source in ("simulation", "solver"):
+                try:
+                    if source == "simulation":
+                        fit = fit_shards(
+                            side,
+                            *parts,
+                            counts[:, window],
+                            times,
+                            errors[window],
+                            restitution,
+                            free,
+                        )
+                    else:
+                        fit = fit_asymptotic_form(
+                            side, *parts, reference[window], errors[window], restitution, free
+                        )
+                except FitError as error:
+                    problems.append(f"{source}: {error}")
+                    fit = _empty_fit(side, free, parts[0][0], parts[1][-1])
+                rows += fit_rows(
+                    source, fit, theory, shards=len(times) if source == "simulation" else None
+                )
     return pd.DataFrame(rows), problems
+
+
+def _empty_fit(side, free, lower=np.nan, upper=np.nan):
+    """An ``AsymptoticFit`` of NaN values: a side without a window, or a fit without optimum."""
+    names = ("prefactor", *EXPONENT_NAMES[side])
+    return AsymptoticFit(
+        side,
+        free,
+        dict.fromkeys(names, np.nan),
+        dict.fromkeys(names, np.nan),
+        np.nan,
+        0,
+        float(lower),
+        float(upper),
+    )
 
 
 def usable_curve(speeds, density):

@@ -20,9 +20,14 @@ A table written with its provenance, read back with it:
 ('1/2', 2)
 """
 
+import glob
+import hashlib
 import json
 import os
+import re
+import socket
 import tempfile
+import time
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -72,11 +77,11 @@ def atomic_paths(*paths):
     try:
         for path in paths:
             path.parent.mkdir(parents=True, exist_ok=True)
-            for stale in path.parent.glob(f".{path.stem}.*{path.suffix}"):
-                # left by a writer that was killed (SIGKILL skips the cleanup below)
-                stale.unlink(missing_ok=True)
+            _remove_stale_temporaries(path)
             handle, temporary = tempfile.mkstemp(
-                prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent
+                prefix=_temporary_prefix(path),
+                suffix=f"{TEMPORARY_MARK}{path.suffix}",
+                dir=path.parent,
             )
             os.close(handle)
             temporaries.append(temporary)
@@ -101,6 +106,64 @@ def atomic_paths(*paths):
         for temporary in temporaries:
             Path(temporary).unlink(missing_ok=True)
         raise
+
+
+#: What ends a temporary's name before the target's suffix: ``.{name}.{host}.{pid}.{random}.tmp``
+#: followed by the suffix (kept, so that a writer that goes by it, e.g. matplotlib, sees it).
+TEMPORARY_MARK = ".tmp"
+#: Seconds after which a temporary of another host's writer counts as stale (its pid means
+#: nothing here): no write of one file takes that long.
+STALE_AGE = 86400.0
+
+
+def _host_tag() -> str:
+    """8 hex digits of this machine's name: which host a temporary's pid belongs to."""
+    return hashlib.sha256(socket.gethostname().encode()).hexdigest()[:8]
+
+
+def _temporary_prefix(path: Path) -> str:
+    return f".{path.name}.{_host_tag()}.{os.getpid()}."
+
+
+def _temporary_pattern(path: Path):
+    """The names of ``path``'s temporaries and of no other target's: the whole name of the
+    target, then host, pid and mkstemp's random part (letters, digits, '_': no dot)."""
+    return re.compile(
+        rf"\.{re.escape(path.name)}\.([0-9a-f]{{8}})\.([0-9]+)\.[A-Za-z0-9_]+"
+        rf"{re.escape(TEMPORARY_MARK + path.suffix)}"
+    )
+
+
+def _process_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # e.g. another user's process: alive
+        return True
+    return True
+
+
+def _remove_stale_temporaries(path: Path) -> None:
+    """Remove the temporaries of ``path`` left by a writer that was killed (SIGKILL skips the
+    cleanup of ``atomic_paths``): only ``path``'s own (never another target's, whatever its
+    name), and only those whose writer is gone: on this host a pid that no longer runs, of
+    another host one older than ``STALE_AGE``.  A writer of the same file still at work keeps
+    its temporary."""
+    pattern, host = _temporary_pattern(path), _host_tag()
+    for candidate in path.parent.glob(f".{glob.escape(path.name)}.*"):
+        match = pattern.fullmatch(candidate.name)
+        if match is None:
+            continue
+        if match.group(1) == host:
+            gone = int(match.group(2)) != os.getpid() and not _process_alive(int(match.group(2)))
+        else:
+            try:
+                gone = time.time() - candidate.stat().st_mtime > STALE_AGE
+            except FileNotFoundError:
+                continue
+        if gone:
+            candidate.unlink(missing_ok=True)
 
 
 def _umask() -> int:

@@ -39,7 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .asymptotics import _restitution
+from .restitution import restitution_value
 
 __all__ = [
     "RETURN_SPEED_MOMENTS",
@@ -117,8 +117,8 @@ def quasi_elastic_epsilon(restitution) -> float:
 
     Parameters
     ----------
-    restitution : float
-        The restitution coefficient r, 0 < r < 1.
+    restitution : float, str or fractions.Fraction
+        The restitution coefficient r, 0 < r < 1, read as ``restitution.parse_restitution`` reads it.
 
     Returns
     -------
@@ -127,7 +127,7 @@ def quasi_elastic_epsilon(restitution) -> float:
     Raises
     ------
     ValueError
-        If r is not a number in (0, 1).
+        If r is not a number in (0, 1) (naming ``restitution``).
 
     Examples
     --------
@@ -136,6 +136,12 @@ def quasi_elastic_epsilon(restitution) -> float:
     0.25
     """
     return 1.0 - _restitution(restitution)
+
+
+def _restitution(restitution) -> float:
+    """r as a float, parsed as every entry point of the library parses it
+    (``restitution.parse_restitution``: "1/3", np.float32(0.99) as 0.99), 0 < r < 1."""
+    return restitution_value(restitution, "restitution")
 
 
 def _scaled_speeds(w) -> np.ndarray:
@@ -262,8 +268,8 @@ def quasi_elastic_form(name: str, restitution, order: int = 1) -> float:
         One of ``SCALINGS``: ``"collision_rate"`` (I, eq. (collrate)), ``"mean_x"`` and
         ``"delta_x"`` (<x>, Delta x, eq. (xandDeltax)), ``"correlation_bounces"``
         (``correlation_bounces``), ``"bounce_chain_time"`` (that length times 1/I).
-    restitution : float
-        r, 0 < r < 1.
+    restitution : float, str or fractions.Fraction
+        r, 0 < r < 1: a decimal, a numpy float or a fraction string such as "1/3".
     order : int
         0 or 1.
 
@@ -304,8 +310,8 @@ def correlation_bounces(restitution) -> float:
 
     Parameters
     ----------
-    restitution : float
-        r, 0 < r < 1.
+    restitution : float, str or fractions.Fraction
+        r, 0 < r < 1, as for ``quasi_elastic_form``.
 
     Returns
     -------
@@ -322,8 +328,7 @@ def correlation_bounces(restitution) -> float:
     >>> print(round(correlation_bounces(0.99), 6))
     99.499162
     """
-    quasi_elastic_epsilon(restitution)
-    return float(-1.0 / np.log(float(restitution)))
+    return float(-1.0 / np.log(_restitution(restitution)))
 
 
 def relaxation_time(restitution) -> float:
@@ -391,8 +396,8 @@ def quasi_elastic_table(restitutions=TABLE_RESTITUTIONS):
 
     Parameters
     ----------
-    restitutions : sequence of float
-        Each r in the solver's range and in (0, 1); the comparison means something near 1.
+    restitutions : sequence of float, str or fractions.Fraction
+        Each r as ``Equilibrium`` takes it, in the solver's range; the comparison means something near 1.
 
     Returns
     -------
@@ -420,7 +425,7 @@ def quasi_elastic_table(restitutions=TABLE_RESTITUTIONS):
         for name, scaled, limit, first, second in _solver_rows(r):
             records.append(
                 {
-                    "r": float(r),
+                    "r": _restitution(r),
                     "quantity": name,
                     "scaled": float(scaled),
                     "limit": float(limit),

@@ -35,7 +35,7 @@ with job_log(snakemake.log[0], exit_when_done=True):
         strict=True,
     )
     for paths in inputs:
-        (p0v, provenance), (position, _), (curve, solved), (fits, _) = (
+        (p0v, provenance), (position, _), (curve, solved), (fits, fit_provenance) = (
             read_tables_of_one_restitution(
                 *paths, kinds=(SIMULATED_P0V, SIMULATED_POSITION, SOLVER_P0V, FITS)
             )
@@ -58,6 +58,8 @@ with job_log(snakemake.log[0], exit_when_done=True):
             len(shards),
             solver_curve=curve,
             per_shard=shard_ratios(shards),
+            # the rule the fit's auto windows were chosen by
+            max_bias=float(fit_provenance["settings"]["max_bias"]),
             # how much of each distribution the tables leave out (rules merge_shards, solve)
             outside=(provenance.get("outside"), solved.get("outside")),
         )

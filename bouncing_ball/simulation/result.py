@@ -538,8 +538,8 @@ class SimulationResult:
         Parameters
         ----------
         path : str or os.PathLike
-            The file to write (conventionally ``*.parquet``); its folder is made if missing,
-            an existing file replaced.
+            The file to write (conventionally ``*.parquet``; ``~`` is the user's home); its
+            folder is made if missing, an existing file replaced.
 
         Examples
         --------
@@ -551,12 +551,14 @@ class SimulationResult:
         >>> load(path).mean_x == result.mean_x
         True
         """
+        from pathlib import Path
+
         from ..parquet import write_table
         from ..tallies import batch_to_table
 
         write_table(
             batch_to_table(dict(zip(self.shard_indices, self.tallies))),
-            path,
+            Path(path).expanduser(),
             self.provenance(),
         )
 
@@ -595,7 +597,7 @@ def load(path) -> SimulationResult:
     Parameters
     ----------
     path : str or os.PathLike
-        A Parquet file written by ``SimulationResult.save``.
+        A Parquet file written by ``SimulationResult.save`` (``~`` is the user's home).
 
     Returns
     -------
@@ -604,7 +606,8 @@ def load(path) -> SimulationResult:
     Raises
     ------
     parquet.UnreadableFileError
-        Naming the file: missing, not a readable Parquet file (truncated, corrupt), without
+        Naming the file: a folder (naming the saved results it holds), missing, not a
+        readable Parquet file (truncated, corrupt), without
         bouncing_ball's provenance, of another kind (e.g. a table of the workflow), or whose
         shards are not on its settings' bins.
 
@@ -619,7 +622,9 @@ def load(path) -> SimulationResult:
     from ..parquet import UnreadableFileError, provenance_of, read_parquet
     from ..tallies import batch_from_table
 
-    path = Path(path)
+    path = Path(path).expanduser()
+    if path.is_dir():
+        raise UnreadableFileError(_folder_message(path))
     table = read_parquet(pq.read_table, path)
     provenance = provenance_of(path, table.schema)
     if provenance.get("kind") != RESULT_KIND:
@@ -649,3 +654,24 @@ def load(path) -> SimulationResult:
         )
     except (KeyError, TypeError, ValueError) as error:
         raise UnreadableFileError(f"{path}: not a readable SimulationResult ({error})") from None
+
+
+def _folder_message(folder) -> str:
+    """Why ``load`` refuses a folder, naming the saved results in it."""
+    from ..parquet import UnreadableFileError, read_provenance
+
+    results = []
+    for candidate in sorted(folder.glob("*.parquet")):
+        try:
+            if read_provenance(candidate).get("kind") == RESULT_KIND:
+                results.append(candidate.name)
+        except UnreadableFileError:
+            continue
+    if not results:
+        return f"{folder}: a folder, not a file; it holds no saved SimulationResult"
+    named = ", ".join(results)
+    return (
+        f"{folder}: a folder, not a file; it holds {len(results)} saved "
+        f"result{'s' if len(results) > 1 else ''} ({named}): load one, e.g. "
+        f"bouncing_ball.load({str(folder / results[0])!r})"
+    )

@@ -153,6 +153,16 @@ def _stop_workers(pool):
             worker.join(timeout=5.0)
 
 
+def _main_unimportable_by_workers():
+    """The path of the main module where spawned workers cannot import it again (a script
+    read from standard input: ``python - < run.py`` gives ``'<stdin>'``), else None."""
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    if getattr(main, "__spec__", None) is not None or path is None or os.path.isfile(path):
+        return None
+    return path
+
+
 def _run_in_workers(arguments, shards, processes, finished, on_finished):
     """Run shards 0 .. ``shards`` - 1 on ``processes`` spawned workers, putting each shard's
     tallies in ``finished`` as it ends; on any exception (a Ctrl-C) the finished ones are
@@ -393,8 +403,9 @@ def simulate(
     processes : int, optional
         Worker processes (spawned), >= 1; 1 runs the shards in this process.  The numbers do
         not depend on it.  A script that uses more than one must call ``simulate`` under
-        ``if __name__ == "__main__":``.  The workers exit when the process that started them
-        dies, however it dies.
+        ``if __name__ == "__main__":``; one read from standard input (``python - < run.py``),
+        which workers cannot import, runs its shards in this process, with a RuntimeWarning.
+        The workers exit when the process that started them dies, however it dies.
     progress : bool, optional
         Show the shards done as a progress bar (``tqdm.auto``): a widget in a notebook, a
         line on stderr in a terminal; nothing where stderr is a file or a pipe, or with
@@ -490,6 +501,17 @@ def simulate(
     arguments = (float(exact), seed, label, run_settings)
     progress_line.show(0)
     try:
+        if processes > 1 and (main := _main_unimportable_by_workers()) is not None:
+            import warnings
+
+            warnings.warn(
+                f"simulate: processes={processes} runs the shards in this process: spawned "
+                f"workers re-run the main module from its file, and {main!r} is none (save the "
+                "script to a file and run that for workers); the numbers are the same",
+                RuntimeWarning,
+                stacklevel=2,
+            )
+            processes = 1
         if processes == 1:
             _run_here(arguments, shards, finished, lambda: progress_line.show(len(finished)))
         else:

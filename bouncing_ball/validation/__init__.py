@@ -23,7 +23,7 @@ from .against_equilibrium import (
 )
 from .checks import (
     POSITION_RANGE,
-    QUALITY_SPEEDS,
+    QUALITY_SCALED_SPEEDS,
     VALIDATION_CHECKS,
     VALIDATION_COLUMNS,
     exact_outgoing_speed_residuals,
@@ -31,6 +31,7 @@ from .checks import (
     outgoing_speed_checks,
     outgoing_speed_residuals,
     position_checks,
+    quality_speeds,
     validation_markdown,
     validation_rows,
     validation_table,
@@ -92,7 +93,8 @@ __all__ = [
     "SIGN_FLIPS",
     "SIGN_FLIP_SEED",
     "POSITION_RANGE",
-    "QUALITY_SPEEDS",
+    "QUALITY_SCALED_SPEEDS",
+    "quality_speeds",
     "VALIDATION_CHECKS",
     "VALIDATION_COLUMNS",
     "POSITION_EXPONENTS",

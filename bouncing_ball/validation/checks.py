@@ -21,7 +21,8 @@ __all__ = [
     "validation_table",
     "validation_markdown",
     "POSITION_RANGE",
-    "QUALITY_SPEEDS",
+    "QUALITY_SCALED_SPEEDS",
+    "quality_speeds",
     "VALIDATION_CHECKS",
     "VALIDATION_COLUMNS",
 ]
@@ -132,16 +133,16 @@ VALIDATION_COLUMNS = (
 VALIDATION_CHECKS = {
     "p0v_chi2_per_bin": "P(0,v): chi^2/n",
     "p0v_worst_bin": "P(0,v): worst bin, z",
-    "p0v_largest_relative_error": "P(0,v): largest relative error, 0.01 <= v <= 5",
+    "p0v_largest_relative_error": "P(0,v): largest relative error, 0.01 <= q v <= 5",
     "p0v_martingale_chi2_per_bin": "P(0,v) martingale-controlled: chi^2/n",
     "p0v_martingale_worst_bin": "P(0,v) martingale-controlled: worst bin, z",
     "p0v_martingale_largest_relative_error": (
-        "P(0,v) martingale-controlled: largest relative error, 0.01 <= v <= 5"
+        "P(0,v) martingale-controlled: largest relative error, 0.01 <= q v <= 5"
     ),
     "p0v_controlled_chi2_per_bin": "P(0,v) controlled with eq. (kernel3): chi^2/n",
     "p0v_controlled_worst_bin": "P(0,v) controlled with eq. (kernel3): worst bin, z",
     "p0v_controlled_largest_relative_error": (
-        "P(0,v) controlled with eq. (kernel3): largest relative error, 0.01 <= v <= 5"
+        "P(0,v) controlled with eq. (kernel3): largest relative error, 0.01 <= q v <= 5"
     ),
     "px_chi2_per_bin": "P(x): chi^2/n",
     "px_worst_bin": "P(x): worst bin, z",
@@ -159,8 +160,42 @@ VALIDATION_CHECKS = {
 #: whole (the automatic ranges of ``scales`` leave about 1e-6 at each end).
 COMPLETE_TABLE = 1.0e-4
 
-# "paper quality": the speeds over which the relative error of P(0, v) is reported
-QUALITY_SPEEDS = (0.01, 5.0)
+# "paper quality": the speeds over which the relative error of P(0, v) is reported, in units
+# of 1/q(r), the large-v decay length of eqs. (asym3)-(asym6): 0.01 <= v <= 5 at r = 1/2
+# (q = 1); the speeds scale like 1/q, ~ 1/(1 - r) near r = 1
+QUALITY_SCALED_SPEEDS = (0.01, 5.0)
+
+
+def quality_speeds(restitution) -> tuple:
+    """The speeds over which the validation table reports the largest relative error of P(0, v).
+
+    ``QUALITY_SCALED_SPEEDS`` in units of 1/q(r), q the large-speed decay rate of eqs.
+    (asym3)-(asym6): the window follows the speeds of r (which grow like 1/(1 - r) near
+    r = 1) and is 0.01 <= v <= 5 at r = 1/2.
+
+    Parameters
+    ----------
+    restitution : float or fractions.Fraction
+        r, 0 < r < 1.
+
+    Returns
+    -------
+    tuple of float
+        (lowest, highest) v.
+
+    Examples
+    --------
+    >>> from bouncing_ball.validation import quality_speeds
+    >>> print([round(v, 4) for v in quality_speeds(0.5)], [round(v, 4) for v in quality_speeds(0.25)])
+    [0.01, 5.0] [0.005, 2.5]
+    """
+    from ..asymptotics import large_speed_decay_rate
+
+    q = large_speed_decay_rate(float(restitution))
+    low, high = QUALITY_SCALED_SPEEDS
+    return low / q, high / q
+
+
 # the heights over which P(x) and <v^2>_x are held against eqs. (P(x)2), (moment2)
 POSITION_RANGE = (1.0e-3, 50.0)
 
@@ -258,8 +293,9 @@ def outgoing_speed_checks(simulated, restitution, shards, solver_curve=None, per
         Rows of ``VALIDATION_COLUMNS`` without r: chi^2/n and the worst z of
         z = (simulation - reference) / p0v_err over the bins with an error (not the under-
         and overflow bins, nor bins beyond the solver's grid), and the largest relative error
-        p0v_err / p0v over the bins with 0.01 <= v <= 5 (an empty bin there counts as an
-        infinite relative error): these ``p0v_*`` rows of the plain counts, with the
+        p0v_err / p0v over the bins of ``quality_speeds(restitution)`` (0.01 <= q v <= 5;
+        an empty bin there counts as an
+        infinite relative error, and the row says so): these ``p0v_*`` rows of the plain counts, with the
         p_sign_flip of chi^2/n, judge agreement.  The same three of ``p0v_martingale``
         (``p0v_martingale_*``, the martingale controls: still independent of the theory)
         and of ``p0v_controlled`` (``p0v_controlled_*``, the return-law control of
@@ -316,38 +352,58 @@ def _outgoing_speed_rows(quantity, simulated, restitution, shards, solver_curve,
         per_shard, "p0v", residuals.bin.to_numpy(), residuals.reference.to_numpy(), shards
     )
     rows = _z_rows(quantity, reference, where, z, shards, "v", deviations)
-    low, high = QUALITY_SPEEDS
-    quality = simulated[(simulated.v >= low) & (simulated.v <= high)]
+    rows.append(_relative_error_row(quantity, simulated, restitution))
+    return rows
+
+
+def _relative_error_row(quantity, simulated, restitution):
+    """The largest relative error of the table's p0v over ``quality_speeds(restitution)``,
+    with the reason of an inf (bins without a collision) or a NaN (no bin there)."""
+    from ..asymptotics import large_speed_decay_rate
+
+    low, high = quality_speeds(restitution)
+    scaled_low, scaled_high = QUALITY_SCALED_SPEEDS
+    window = (
+        f"{_number(low, 3)} <= v <= {_number(high, 3)} ({scaled_low:g} <= q v <= {scaled_high:g}, "
+        f"q = {large_speed_decay_rate(float(restitution)):.4g} of eqs. (asym4), (asym6))"
+    )
+    finite = np.isfinite(simulated.v_hi) & (simulated.v_lo > 0.0)
+    quality = simulated[finite & (simulated.v >= low) & (simulated.v <= high)]
+    empty = (quality.p0v <= 0.0) | ~np.isfinite(quality.p0v_err)
     with np.errstate(divide="ignore", invalid="ignore"):
-        relative = np.where(
-            (quality.p0v > 0.0) & np.isfinite(quality.p0v_err),
-            quality.p0v_err / quality.p0v,
-            np.inf,
-        )
+        relative = np.where(empty, np.inf, quality.p0v_err / quality.p0v)
+    covered = simulated[finite]
     if len(relative):
         k = _largest(relative, quality.v.to_numpy())
         largest, at = float(relative[k]), float(quality.v.iloc[k])
+        detail = f"max of p0v_err / p0v over the bins with {window}, at v = {_number(at, 3)}"
+        if count := int(np.sum(empty)):
+            detail += (
+                f"; {count} of them without a collision or an error (an infinite relative "
+                "error: the run is too short there)"
+            )
     else:
         largest, at = np.nan, np.nan
-    rows.append(
-        {
-            "check": f"{quantity}_largest_relative_error",
-            "reference": "none",
-            "bins": len(relative),
-            "value": largest,
-            "bin_centre": at,
-            "p_sign_flip": np.nan,
-            "detail": f"max of p0v_err / p0v over the bins with {low:g} <= v <= {high:g}, "
-            f"at v = {_number(at, 3)}"
-            + (
-                f"; {empty} of them without a collision (an infinite relative error: the run "
-                "is too short there)"
-                if (empty := int(np.sum(~np.isfinite(relative))))
-                else ""
-            ),
-        }
-    )
-    return rows
+        detail = f"no bin with its centre in {window}" + (
+            f": the bins span {_number(covered.v_lo.min(), 3)} <= v <= "
+            f"{_number(covered.v_hi.max(), 3)}"
+            if len(covered)
+            else ": the table has no finite bins"
+        )
+    if len(relative) and len(covered) and (covered.v_lo.min() > low or covered.v_hi.max() < high):
+        detail += (
+            f"; the bins cover only {_number(max(low, covered.v_lo.min()), 3)} <= v <= "
+            f"{_number(min(high, covered.v_hi.max()), 3)} of it"
+        )
+    return {
+        "check": f"{quantity}_largest_relative_error",
+        "reference": "none",
+        "bins": len(relative),
+        "value": largest,
+        "bin_centre": at,
+        "p_sign_flip": np.nan,
+        "detail": detail,
+    }
 
 
 def position_checks(position, restitution, shards, per_shard=None):
@@ -406,18 +462,85 @@ def position_checks(position, restitution, shards, per_shard=None):
     return rows
 
 
-def fit_checks(fits):
+def _fit_problems(fits, side, shards, max_bias):
+    """Why the free-exponent fit of one window tests nothing: [] where it is a check.
+
+    The window must lie where the form holds on the solver's curve (its free fit there within
+    ``max_bias`` of the data's error of the theory's exponents, the rule of
+    ``fits.asymptotic_window``), the small-v window below the large-v one, and the fit must
+    have power: an exponent of the theory beyond the 95% half-width of its fitted value
+    (t(0.975, shards - 1) times its jackknife error), else no fit of these data could tell
+    it from 0, a wrong exponent.  Returns the problems and, apart, the exponents without
+    power where another has it (the joint test then tests the others)."""
+    from ..fits import EXPONENT_NAMES, LARGE_SPEED, SMALL_SPEED, interval_factor
+
+    free = fits[fits.fit == "free_exponents"]
+    simulated = free[(free.source == "simulation") & (free.window == side)].set_index("parameter")
+    solved = free[(free.source == "solver") & (free.window == side)].set_index("parameter")
+    names = list(EXPONENT_NAMES[side])
+    first = simulated.iloc[0]
+    if not np.all(np.isfinite(simulated.loc[names, "value"])):
+        return [
+            f"the fit of free exponents finds no optimum over v in [{_number(first.v_min, 3)}, "
+            f"{_number(first.v_max, 3)}] (the fit's log says why)"
+        ], []
+    problems = []
+    if side == SMALL_SPEED:
+        large = free[(free.source == "simulation") & (free.window == LARGE_SPEED)]
+        if (
+            len(large)
+            and np.isfinite(large.iloc[0].v_min)
+            and first.v_max > large.iloc[0].v_min * (1.0 + 1e-9)
+        ):
+            problems.append(
+                f"its window [{_number(first.v_min, 3)}, {_number(first.v_max, 3)}] is not "
+                f"below the large-v window [{_number(large.iloc[0].v_min, 3)}, "
+                f"{_number(large.iloc[0].v_max, 3)}]"
+            )
+    factor, unresolved = interval_factor(shards), []
+    for name in names:
+        theory, error = float(simulated.loc[name, "theory"]), float(simulated.loc[name, "error"])
+        curve = float(solved.loc[name, "value"]) if name in solved.index else np.nan
+        if not np.isfinite(curve):
+            problems.append(f"the free fit to the solver's curve gives no {name} over this window")
+        elif not abs(curve - theory) <= max_bias * error:
+            problems.append(
+                f"the form does not hold over this window: on the solver's curve the free fit "
+                f"gives {name} = {_number(curve, 3)} against the theory's {_number(theory, 3)}, "
+                f"more than {max_bias:g} of the data's error {_number(error, 2)}"
+            )
+        if not factor * error < abs(theory):
+            unresolved.append(
+                f"the theory's {name} = {_number(theory, 3)} lies within the 95% half-width "
+                f"{_number(factor * error, 2)} of 0, so the fit could not reject {name} = 0"
+            )
+    if len(unresolved) == len(names):
+        problems.append("no power: " + "; ".join(unresolved))
+    return problems, unresolved
+
+
+def fit_checks(fits, shards, max_bias=0.5):
     """The free-exponent fits of the asymptotic forms to the simulated P(0, v), as checks.
 
     Per window (small v, eqs. (asym1), (asym2); large v, eqs. (asym3)-(asym6)) the joint
     p-value of the theory's exponents (Hotelling's T^2 on the jackknife covariance) and the
     fit's chi^2 per degree of freedom (per-bin errors only: indicative, it ignores the
-    correlations between bins).
+    correlations between bins).  A fit that tests nothing is not counted: where the window
+    lies outside the form's regime (on the solver's curve the free exponents drift from the
+    theory's by more than ``max_bias`` of the data's errors, or the small-v window is not
+    below the large-v one) or the fit has no power (every theory's exponent within the 95%
+    half-width of 0), both rows have the value NaN and a detail "not checked: <why>", with
+    what the fit gave; an exponent without power beside one with it is named as not tested.
 
     Parameters
     ----------
     fits : pandas.DataFrame
         A fits table (``fits.asymptotic_fits``).
+    shards : int
+        The number of shards of the simulation's jackknife (the t factor of the intervals).
+    max_bias : float, optional
+        The drift of the form allowed on the solver's curve, in units of the data's error
+        (config ``fits.max_bias``, the rule the auto windows are chosen by).
 
     Returns
     -------
@@ -437,6 +560,8 @@ def fit_checks(fits):
         fitted = ", ".join(
             f"{row.parameter} = {value_with_error(row.value, row.error)} "
             f"(theory {_number(row.theory, 4)})"
+            if np.isfinite(row.value)
+            else f"theory {row.parameter} = {_number(row.theory, 4)}"
             for row in exponents.itertuples()
         )
         dof = int(first.dof) if np.isfinite(first.dof) else 0
@@ -444,12 +569,23 @@ def fit_checks(fits):
         where = (
             f"v in [{_number(first.v_min, 3)}, {_number(first.v_max, 3)}]"
             if np.isfinite(first.v_min)
-            else "no usable window"
+            else "no usable window (the fit's log says why)"
         )
-        joint = float(first.joint_p_value)
-        if np.isfinite(first.v_min) and not np.isfinite(joint):
-            # Hotelling's T^2 needs more shards than free exponents (fits.fit_shards)
-            fitted += "; no joint test: too few shards for the exponents"
+        joint, chi2 = float(first.joint_p_value), float(first.chi2_per_dof)
+        problems, unresolved = (
+            _fit_problems(fits, side, shards, max_bias) if np.isfinite(first.v_min) else ([], [])
+        )
+        if unresolved and not problems:
+            fitted += "; not tested: " + "; ".join(unresolved)
+        if problems:
+            lead = "not checked: " + "; ".join(problems) + "; the fit: "
+            fitted += f"; joint p {_number(joint, 3)}, chi^2/dof {_number(chi2, 3)}"
+            joint, chi2 = np.nan, np.nan
+        else:
+            lead = ""
+            if np.isfinite(first.v_min) and not np.isfinite(joint):
+                # Hotelling's T^2 needs more shards than free exponents (fits.fit_shards)
+                fitted += "; no joint test: too few shards for the exponents"
         rows += [
             {
                 "check": f"{side}_fit_joint_p_value",
@@ -458,16 +594,16 @@ def fit_checks(fits):
                 "value": joint,
                 "bin_centre": np.nan,
                 "p_sign_flip": np.nan,
-                "detail": f"{where}; {fitted}",
+                "detail": f"{lead}{where}; {fitted}",
             },
             {
                 "check": f"{side}_fit_chi2_per_dof",
                 "reference": "fit",
                 "bins": bins,
-                "value": float(first.chi2_per_dof),
+                "value": chi2,
                 "bin_centre": np.nan,
                 "p_sign_flip": np.nan,
-                "detail": f"{where}; {dof} degrees of freedom; indicative: the bins are "
+                "detail": f"{lead}{where}; {dof} degrees of freedom; indicative: the bins are "
                 "correlated (the joint p-value is the test)",
             },
         ]
@@ -539,6 +675,7 @@ def validation_rows(
     shards,
     solver_curve=None,
     per_shard=None,
+    max_bias=0.5,
     outside=None,
 ) -> list[dict]:
     """Every check of one r: ``outgoing_speed_checks``, ``position_checks``, ``fit_checks``,
@@ -558,6 +695,8 @@ def validation_rows(
         The solver's P(0, v) grid (where r is not 1/2 or 1/3).
     per_shard : dict, optional
         The shards' ``shard_ratios`` (for the p_sign_flip of the chi^2/n rows).
+    max_bias : float, optional
+        Of ``fit_checks``: the fits' ``fits.max_bias``.
     outside : tuple of dict, optional
         The ``outside`` provenance of the simulated and the solver's tables
         (``coverage_checks``).
@@ -570,7 +709,7 @@ def validation_rows(
     rows = [
         *outgoing_speed_checks(p0v, restitution, shards, solver_curve, per_shard),
         *position_checks(position, restitution, shards, per_shard),
-        *fit_checks(fits),
+        *fit_checks(fits, shards, max_bias),
         *coverage_checks(*(outside or ())),
     ]
     return [{"r_label": label, "r": float(restitution), **row} for row in rows]
@@ -593,7 +732,9 @@ def validation_table(rows) -> pd.DataFrame:
     return table.astype({"bins": "int64"}) if len(table) else table
 
 
-def _shown_value(check, value):
+def _shown_value(check, value, detail=""):
+    if detail.startswith("not checked"):
+        return "not checked"
     if not np.isfinite(value):
         return "inf" if value == np.inf else ""
     if check.endswith("relative_error"):
@@ -602,6 +743,15 @@ def _shown_value(check, value):
     if check.endswith("worst_bin"):
         return f"{value:+.2f}"
     return f"{value:.3g}"
+
+
+def _shown_check(check, restitution):
+    """The check's name; a relative-error row's with its window's speeds at r."""
+    name = VALIDATION_CHECKS[check]
+    if check.endswith("largest_relative_error"):
+        low, high = quality_speeds(restitution)
+        name += f" ({_number(low, 3)} <= v <= {_number(high, 3)})"
+    return name
 
 
 def validation_markdown(table: pd.DataFrame) -> str:
@@ -621,10 +771,12 @@ def validation_markdown(table: pd.DataFrame) -> str:
     shown = pd.DataFrame(
         {
             "r": table.r_label.astype(str),
-            "check": table.check.map(VALIDATION_CHECKS),
+            "check": [_shown_check(c, r) for c, r in zip(table.check, table.r)],
             "reference": table.reference,
             "bins": table.bins.astype(str),
-            "value": [_shown_value(c, v) for c, v in zip(table.check, table.value)],
+            "value": [
+                _shown_value(c, v, d) for c, v, d in zip(table.check, table.value, table.detail)
+            ],
             "at v or x": table.bin_centre.map(lambda value: _number(value, 3)),
             "p_sign_flip": table.p_sign_flip.map(lambda value: _number(value, 2)),
             "detail": table.detail,

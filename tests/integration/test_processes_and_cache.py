@@ -111,3 +111,33 @@ def test_simulate_is_reproducible_whatever_the_processes():
     )
     again = bb.simulate(0.6, processes=1, progress=False, **{**arguments, "seed": 12})
     assert not again.batch_frame().equals(one.batch_frame())
+
+
+STDIN_SCRIPT = """
+import warnings
+import bouncing_ball as bb
+
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+    two = bb.simulate("1/2", shards=2, shard_time=200.0, seed=3, progress=False, processes=2)
+one = bb.simulate("1/2", shards=2, shard_time=200.0, seed=3, progress=False, processes=1)
+print(two.mean_x == one.mean_x, two.collision_rate == one.collision_rate)
+print([str(w.message) for w in caught if w.category is RuntimeWarning])
+"""
+
+
+def test_simulate_with_workers_from_a_script_on_standard_input_runs_and_says_why():
+    """``python - < run.py`` with processes=2 died with BrokenProcessPool: spawned workers
+    re-run the main module from its path, '<stdin>'."""
+    run = subprocess.run(
+        [sys.executable, "-"],
+        input=STDIN_SCRIPT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=dict(os.environ, PYTHONPATH=str(PACKAGE.parent)),
+    )
+    assert run.returncode == 0, run.stderr
+    same, warned = run.stdout.strip().splitlines()
+    assert same == "True True"
+    assert "processes=2 runs the shards in this process" in warned and "'<stdin>'" in warned

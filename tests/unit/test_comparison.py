@@ -22,6 +22,7 @@ from bouncing_ball.validation import (
     moments_table,
     outgoing_speed_checks,
     outgoing_speed_residuals,
+    quality_speeds,
     ratio_deviations,
     shard_ratios,
     sign_flip_test,
@@ -297,7 +298,9 @@ def _fits_table(joint_p=0.4, chi2=1.1):
                             "window": side,
                             "fit": fit,
                             "parameter": name,
-                            "value": 1.02,
+                            # the solver's free fit gives the theory's exponents: the
+                            # form holds over the window
+                            "value": 1.0 if source == "solver" and name != "prefactor" else 1.02,
                             "error": 0.03,
                             "theory": np.nan if name == "prefactor" else 1.0,
                             "joint_p_value": joint_p if fit == "free_exponents" else np.nan,
@@ -388,6 +391,71 @@ def test_validation_names_the_same_bin_of_equal_worst_values_in_any_order_of_the
         assert row.value == np.inf and row.bin_centre == p0v.loc[inside[4], "v"]
 
 
+def _collision_counted_bins(restitution, collisions, rng, lo=1e-4, hi=1e3):
+    """Bins of P(0, v) ~ v^-beta e^(-q v) from Poisson counts of ``collisions`` collisions
+    (a bin's collisions come at the rate v P(0, v) dv, eq. (collrate)), with the errors of the
+    counts; an empty bin has p0v 0 and no error, as in a merged table."""
+    from bouncing_ball import fits
+
+    (beta,) = fits.theory_exponents(fits.SMALL_SPEED, float(restitution))
+    q = fits.theory_exponents(fits.LARGE_SPEED, float(restitution))[1]
+    edges = np.geomspace(lo, hi, int(round(10 * np.log10(hi / lo))) + 1)
+    lower, upper = edges[:-1], edges[1:]
+    shape = fits.bin_average(fits.large_speed_form, lower, upper, 0.0, beta, q)
+    weight = shape * 0.5 * (upper**2 - lower**2)
+    counts = rng.poisson(collisions * weight / weight.sum())
+    density = counts / (0.5 * (upper**2 - lower**2))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        errors = np.where(counts > 0, density / np.sqrt(counts), np.nan)
+    return pd.DataFrame(
+        {
+            "v_lo": lower,
+            "v_hi": upper,
+            "v": np.sqrt(lower * upper),
+            "p0v": density,
+            "p0v_err": errors,
+            "count": counts,
+        }
+    ), pd.DataFrame({"v": np.sqrt(lower * upper), "p0v": shape})
+
+
+def test_the_relative_error_window_follows_the_speeds_of_r():
+    """At r = 0.99 the window 0.01 <= v <= 5 sat in the far low-speed tail (speeds scale like
+    1/q, q = 0.0151) and the row read inf from its empty bins.  1.2e7 collisions (the default
+    run at r = 0.99) fill every bin of 0.01 <= q v <= 5 = 0.66 <= v <= 330, where the largest
+    relative error is that of the rarest bin, about 1/sqrt(its count)."""
+    restitution = Fraction(99, 100)
+    low, high = quality_speeds(restitution)
+    assert (low, high) == pytest.approx((0.01 / 0.015149984850015164, 5 / 0.015149984850015164))
+    p0v, curve = _collision_counted_bins(restitution, 1.2e7, np.random.default_rng(17))
+    row = _by_check(outgoing_speed_checks(p0v, restitution, 8, solver_curve=curve)).loc[
+        "p0v_largest_relative_error"
+    ]
+    inside = p0v[(p0v.v >= low) & (p0v.v <= high)]
+    assert row.bins == len(inside) > 0
+    rarest = 1.0 / np.sqrt(inside["count"].min())
+    assert np.isfinite(row.value) and row.value == pytest.approx(rarest, rel=1e-12)
+    assert "0.66 <= v <= 330 (0.01 <= q v <= 5, q = 0.01515" in row.detail
+    markdown = validation_markdown(
+        validation_table([{**row.to_dict(), "r_label": "0.99", "r": 0.99, "check": row.name}])
+    )
+    assert "largest relative error, 0.01 <= q v <= 5 (0.66 <= v <= 330)" in markdown
+    # a run with no bin in the window: NaN, and the row says why
+    below = p0v[p0v.v_hi < 0.5]
+    row = _by_check(outgoing_speed_checks(below, restitution, 8, solver_curve=curve)).loc[
+        "p0v_largest_relative_error"
+    ]
+    assert np.isnan(row.value) and "no bin with its centre in 0.66 <= v <= 330" in row.detail
+    assert "the bins span 0.0001 <= v <= 0.398" in row.detail
+    # a short run (6e4 collisions, 8 shards of 2e6): an infinite error says it is empty bins
+    short, _ = _collision_counted_bins(restitution, 6e4, np.random.default_rng(18))
+    row = _by_check(outgoing_speed_checks(short, restitution, 8, solver_curve=curve)).loc[
+        "p0v_largest_relative_error"
+    ]
+    if not np.isfinite(row.value):
+        assert "without a collision or an error" in row.detail
+
+
 def test_validation_at_an_r_without_exact_solution_uses_the_solver_and_skips_p_x():
     """At r = 0.6 the reference of P(0, v) is the solver's curve (here a curve 1% high, which
     the residuals must show); there is no P(x) row."""
@@ -410,7 +478,7 @@ def test_validation_at_an_r_without_exact_solution_uses_the_solver_and_skips_p_x
 
 
 def test_validation_fit_rows_and_markdown():
-    rows = _by_check(fit_checks(_fits_table(joint_p=0.37, chi2=1.25)))
+    rows = _by_check(fit_checks(_fits_table(joint_p=0.37, chi2=1.25), shards=16))
     assert list(rows.index) == [
         "small_speed_fit_joint_p_value",
         "small_speed_fit_chi2_per_dof",
@@ -431,7 +499,8 @@ def test_validation_fit_rows_and_markdown():
     assert table.p_sign_flip.isna().all()
     markdown = validation_markdown(table)
     assert markdown.count("\n") == len(table) + 2
-    assert "P(0,v): largest relative error, 0.01 <= v <= 5" in markdown and "| 1%" in markdown
+    assert "P(0,v): largest relative error, 0.01 <= q v <= 5 (0.01 <= v <= 5)" in markdown
+    assert "| 1%" in markdown
     # one column separator per column and edge on every line: no '|' inside a cell
     assert {line.count("|") for line in markdown.splitlines()} == {9}
 
@@ -441,11 +510,98 @@ def test_validation_fit_rows_say_why_a_joint_p_value_is_missing():
     fits.loc[fits.window == "large_speed", "joint_p_value"] = np.nan  # 2 shards, 2 exponents
     fits.loc[fits.window == "small_speed", ["joint_p_value", "chi2_per_dof", "dof"]] = np.nan
     fits.loc[fits.window == "small_speed", ["v_min", "v_max"]] = np.nan  # no usable window
-    rows = _by_check(fit_checks(fits))
+    rows = _by_check(fit_checks(fits, shards=2))
     assert "too few shards" in rows.loc["large_speed_fit_joint_p_value", "detail"]
     assert rows.loc["small_speed_fit_joint_p_value", "detail"].startswith("no usable window")
+    fits.loc[fits.window == "small_speed", ["value", "error"]] = np.nan
+    detail = _by_check(fit_checks(fits, shards=2)).loc["small_speed_fit_joint_p_value", "detail"]
+    assert detail == "no usable window (the fit's log says why); theory beta = 1"
     assert rows.loc["small_speed_fit_chi2_per_dof", "bins"] == 0
     assert np.isnan(rows.loc["small_speed_fit_chi2_per_dof", "value"])
+
+
+def _fits_at_099(time):
+    """The fits of 16 synthetic shards of P(0, v) = A v^-m e^(-q v) at r = 0.99 (the theory's
+    m = 2e-4, q = 0.0151, A from I = 0.00377) over 1.26 <= v <= 39.8, as a run near r = 1 has
+    them: no small speeds, both auto windows from the lowest bin, and a curve whose e^(-q v)
+    passes, fitted with a free beta, for a power law."""
+    from fit_support import _bins, synthetic_shards
+
+    from bouncing_ball import fits
+    from bouncing_ball.estimators import jackknife, outgoing_speed_density
+
+    m, q = fits.theory_exponents(fits.LARGE_SPEED, 0.99)
+    truth = (np.log(0.00377 * q**2), m, q)
+    edges = np.geomspace(10**0.1, 10**1.6, 16)
+    lower, upper = _bins(edges)
+    counts, times = synthetic_shards(np.random.default_rng(5), fits.LARGE_SPEED, truth, edges, time)
+    _, errors = jackknife(lambda c, t: outgoing_speed_density(c, t, lower, upper), counts, times)
+    reference = fits.bin_average(fits.large_speed_form, lower, upper, *truth)
+    windows = dict.fromkeys((fits.SMALL_SPEED, fits.LARGE_SPEED), "auto")
+    table, problems = fits.asymptotic_fits(
+        lower, upper, counts, times, errors, reference, 0.99, windows
+    )
+    assert problems == []
+    return table, len(times)
+
+
+def test_fits_that_test_nothing_are_not_counted_as_checks():
+    """At r = 0.99 the table reported "small-v fit: joint p 0.903" for a window inside the
+    large-v one, where beta = 0.011 cannot be told from 0, and a large-v p for q = 0.013 +-
+    0.013.  Such rows are "not checked: <why>", their values NaN, what the fit gave kept in
+    the detail; an exponent without power beside one with it is named, not counted."""
+    table, shards = _fits_at_099(2.0e5)
+    rows = _by_check(fit_checks(table, shards))
+    small, large = (
+        rows.loc["small_speed_fit_joint_p_value"],
+        rows.loc["large_speed_fit_joint_p_value"],
+    )
+    assert np.isnan(small.value) and np.isnan(large.value)
+    assert (
+        rows.loc[["small_speed_fit_chi2_per_dof", "large_speed_fit_chi2_per_dof"]]
+        .value.isna()
+        .all()
+    )
+    assert small.detail.startswith(
+        "not checked: its window [1.26, 10] is not below the large-v window [1.26, 39.8]"
+    )
+    assert "could not reject beta = 0" in small.detail and "joint p 0.541" in small.detail
+    assert large.detail.startswith("not checked: no power: ")
+    assert "could not reject m = 0" in large.detail and "could not reject q = 0" in large.detail
+    markdown = validation_markdown(
+        validation_table(
+            [{**row, "r_label": "0.99", "r": 0.99} for row in fit_checks(table, shards)]
+        )
+    )
+    assert markdown.count("| not checked |") == 4
+    # ten times the time resolves q: the large-v row is a check of q, m named as not tested
+    table, shards = _fits_at_099(2.0e6)
+    large = _by_check(fit_checks(table, shards)).loc["large_speed_fit_joint_p_value"]
+    assert 0.0 < large.value <= 1.0
+    assert "not tested: the theory's m = 0.000202" in large.detail
+    assert "reject q = 0" not in large.detail
+
+
+def test_a_window_where_the_form_does_not_hold_on_the_solvers_curve_is_not_checked():
+    """A window given by hand (fits.large_speed_window) where the solver's own curve, fitted
+    with free exponents, gives m off the theory's by more than max_bias of the data's error."""
+    fits = _fits_table()
+    drifted = (fits.source == "solver") & (fits.window == "large_speed") & (fits.parameter == "m")
+    fits.loc[drifted & (fits.fit == "free_exponents"), "value"] = 1.02  # 0.02 > 0.5 x 0.03
+    rows = _by_check(fit_checks(fits, shards=16, max_bias=0.5))
+    row = rows.loc["large_speed_fit_joint_p_value"]
+    assert np.isnan(row.value)
+    assert row.detail.startswith(
+        "not checked: the form does not hold over this window: on the solver's curve the free "
+        "fit gives m = 1.02 against the theory's 1, more than 0.5 of the data's error 0.03"
+    )
+    assert rows.loc["small_speed_fit_joint_p_value", "value"] == 0.4  # untouched
+    assert (
+        _by_check(fit_checks(fits, shards=16, max_bias=1.0)).loc[
+            "large_speed_fit_joint_p_value", "value"
+        ]
+        == 0.4
+    )
 
 
 def _correlated_deviations(rng, shards=16, bins=30, correlation=0.8):

@@ -111,3 +111,35 @@ def test_fit_bins_are_chosen_by_the_collisions_they_should_hold_not_by_their_cou
     assert chosen.beyond == 1  # [1, 10) reaches past v = 5 and holds 3 collisions
     exact = outgoing_speed_bin_average(lambda v: np.exp(-v), chosen.lower, chosen.upper)
     np.testing.assert_allclose(chosen.reference, exact, rtol=1e-6)
+
+
+def _no_optimum(*args, **kwargs):
+    raise RuntimeError("Optimal parameters not found: maxfev = 20000")
+
+
+@pytest.mark.parametrize("window", ["auto", {"min": 1e-4, "max": 1e-2}])
+def test_a_free_fit_without_optimum_gives_nan_rows_and_says_why(monkeypatch, window):
+    """At r = 0.999 curve_fit gave up (maxfev) inside asymptotic_window and the fit job
+    crashed; the free-exponent rows are NaN instead, with the reason, and the rest stands."""
+    r, truth, edges, time = CASES[fits.SMALL_SPEED]
+    lower, upper = _bins(edges)
+    counts, times = synthetic_shards(np.random.default_rng(1), fits.SMALL_SPEED, truth, edges, time)
+    _, errors = jackknife(lambda c, t: outgoing_speed_density(c, t, lower, upper), counts, times)
+    reference = fits.bin_average(fits.small_speed_form, lower, upper, *truth)
+    monkeypatch.setattr(fits.optimize, "curve_fit", _no_optimum)
+    windows = {fits.SMALL_SPEED: window, fits.LARGE_SPEED: {"min": 1.0, "max": 2.0}}
+    table, problems = fits.asymptotic_fits(
+        lower, upper, counts, times, errors, reference, r, windows
+    )
+    small = table[table.window == fits.SMALL_SPEED]
+    assert any(
+        "small_speed fit of free exponents" in p and "finds no optimum" in p for p in problems
+    )
+    assert small[small.fit == "free_exponents"].value.isna().all()
+    if window == "auto":  # no window can be chosen without a free fit
+        assert small.value.isna().all()
+    else:  # the theory's exponents are fitted as before
+        fixed = small[small.fit == "fixed_exponents"]
+        assert fixed.value.notna().all() and (fixed.v_min == lower[0]).all()
+    with pytest.raises(fits.FitError, match=r"small_speed fit .* finds no optimum"):
+        fits.fit_asymptotic_form(fits.SMALL_SPEED, lower, upper, reference, errors, r, True)

@@ -72,3 +72,67 @@ def test_a_reader_refuses_a_table_of_another_kind_naming_the_file(tmp_path):
     with pytest.raises(UnreadableFileError, match="exponents.parquet: .*lacks the columns m, q"):
         read_table(path, EXPONENTS)
     assert read_table(path)[1]["rule"] == "theory"  # no kind asked: read as it is
+
+
+def _save_in_a_loop(path, saves, start, failures):
+    import pandas as pd
+
+    from bouncing_ball.parquet import write_table as write
+
+    start.wait()
+    for k in range(saves):
+        try:
+            write(pd.DataFrame({"v": [float(k)] * 2000}), path, {"save": k})
+        except OSError as error:
+            failures.put(f"{path.name} save {k}: {type(error).__name__}: {error}")
+
+
+def test_two_writers_in_one_folder_never_remove_each_others_temporaries(tmp_path):
+    """run1.parquet's writer took run1.seed2.parquet's temporaries for stale ones (a glob
+    .run1.*.parquet) and removed them mid-write: a save of the other failed."""
+    import multiprocessing
+
+    context = multiprocessing.get_context("fork")
+    start, failures = context.Event(), context.Queue()
+    writers = [
+        context.Process(target=_save_in_a_loop, args=(tmp_path / name, 60, start, failures))
+        for name in ("run1.parquet", "run1.seed2.parquet")
+    ]
+    for writer in writers:
+        writer.start()
+    start.set()
+    for writer in writers:
+        writer.join(timeout=120)
+    found = []
+    while not failures.empty():
+        found.append(failures.get())
+    assert [writer.exitcode for writer in writers] == [0, 0]
+    assert found == []
+    assert sorted(path.name for path in tmp_path.iterdir()) == [
+        "run1.parquet",
+        "run1.seed2.parquet",
+    ]
+
+
+def test_only_a_targets_own_temporaries_of_a_gone_writer_are_removed(tmp_path):
+    """A killed writer's temporary of the same file goes; another target's, or a live
+    writer's, stays."""
+    import subprocess
+    import sys
+
+    from bouncing_ball import parquet
+
+    gone = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True
+    )
+    dead_pid = int(gone.stdout)
+    host = parquet._host_tag()
+    suffix = parquet.TEMPORARY_MARK + ".parquet"
+    left = tmp_path / f".run1.parquet.{host}.{dead_pid}.abc_12{suffix}"
+    other = tmp_path / f".run1.seed2.parquet.{host}.{dead_pid}.abc_12{suffix}"
+    live = tmp_path / f".run1.parquet.{host}.{os.getppid()}.xyz{suffix}"
+    for path in (left, other, live):
+        path.write_text("half a file")
+    write_table(pd.DataFrame({"v": [1.0]}), tmp_path / "run1.parquet", {})
+    assert not left.exists()
+    assert other.exists() and live.exists()

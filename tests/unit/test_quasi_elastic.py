@@ -145,8 +145,42 @@ def test_restitution_outside_the_open_unit_interval_is_refused(r):
         qe.relaxation_time,
         lambda x: qe.quasi_elastic_form("mean_x", x),
     ):
-        with pytest.raises(ValueError, match="restitution must lie in"):
+        with pytest.raises(
+            ValueError,
+            match="restitution: .*(outside the allowed range 0 < r < 1|not a finite number)",
+        ):
             call(r)
+
+
+def test_r_is_parsed_as_equilibrium_parses_it():
+    """quasi_elastic_form("mean_x", "1/3") said "could not convert string to float", and
+    np.float32(0.99) gave 17600.034 (the float32's binary value) where Equilibrium reads 0.99."""
+    import numpy as np
+
+    assert qe.quasi_elastic_form("mean_x", "1/3") == qe.quasi_elastic_form("mean_x", 1 / 3)
+    assert qe.quasi_elastic_form("mean_x", np.float32(0.99)) == qe.quasi_elastic_form(
+        "mean_x", 0.99
+    )
+    assert qe.correlation_bounces("99/100") == qe.correlation_bounces(0.99)
+    assert qe.quasi_elastic_epsilon(np.float32(0.75)) == 0.25
+    for bad in ("half", "1/0"):
+        with pytest.raises(ValueError, match="restitution: "):
+            qe.quasi_elastic_form("mean_x", bad)
+
+
+def test_the_table_and_the_curves_take_r_as_equilibrium_does():
+    """quasi_elastic_table(["1/2"]) refused while scaled_speed_curves(["1/2"]) took it."""
+    import numpy as np
+
+    table = qe.quasi_elastic_table(["1/2", np.float32(0.5)])
+    assert list(table.r.unique()) == [0.5]
+    first, second = (table[table.index < len(table) // 2], table[table.index >= len(table) // 2])
+    assert first.scaled.to_numpy().tolist() == second.scaled.to_numpy().tolist()
+    curves = qe.scaled_speed_curves(["1/2", np.float32(0.5)], [1.0])
+    assert curves.r.tolist() == [0.5, 0.5]
+    for call in (qe.quasi_elastic_table, lambda r: qe.scaled_speed_curves(r, [1.0])):
+        with pytest.raises(ValueError, match="outside the allowed range|the solver's range"):
+            call(["3/2"])
 
 
 def test_bad_arguments_are_refused():

@@ -258,3 +258,30 @@ def test_load_refuses_shards_that_are_not_its_provenances(pair, tmp_path):
     write_table(table, path, {**provenance, "shard_indices": [0, 1, 2]})
     with pytest.raises(UnreadableFileError, match="pair.parquet: not a readable SimulationResult"):
         bb.load(path)
+
+
+def test_load_of_a_folder_of_two_results_names_them(pair, tmp_path):
+    """It said the shards were not on the configured bins (pyarrow read both files as one)."""
+    pair.save(tmp_path / "run1.parquet")
+    pair.save(tmp_path / "run1.seed2.parquet")
+    with pytest.raises(UnreadableFileError) as refused:
+        bb.load(tmp_path)
+    message = str(refused.value)
+    assert (
+        "a folder, not a file; it holds 2 saved results (run1.parquet, run1.seed2.parquet)"
+        in message
+    )
+    assert "bins" not in message
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    with pytest.raises(UnreadableFileError, match="empty: a folder, not a file; it holds no saved"):
+        bb.load(empty)
+
+
+def test_save_and_load_expand_the_users_home(pair, tmp_path, monkeypatch):
+    """save("~/x.parquet") made a folder named '~'."""
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    monkeypatch.chdir(tmp_path)
+    pair.save("~/x.parquet")
+    assert (tmp_path / "home" / "x.parquet").is_file() and not (tmp_path / "~").exists()
+    _same(pair, bb.load("~/x.parquet"))
