@@ -262,8 +262,9 @@ def _exponential_tail(length, powers=1):
 
 
 def estimated_outside_fractions(settings: dict, restitution) -> dict:
-    """About how much of each distribution explicit shard bins leave outside at r, from the
-    asymptotic forms that the automatic ranges follow (no solve).
+    """About how much of each distribution explicit shard bins leave outside at r.
+
+    From the asymptotic forms that the automatic ranges follow (no solve).
 
     Parameters
     ----------
