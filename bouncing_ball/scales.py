@@ -17,7 +17,7 @@ paper and of ``distribution.exponents``:
   a speed below T^(1/2) round, so T_hi = 2.5 ``DECAY_LENGTHS`` / q (and at least
   ``LONGEST_NOISE_FLIGHT``, the flights the noise keeps up where q is large) and
   T_lo = eps^(2 / (2 - beta)) / q^2;
-- velocities of P(x, v): |v| <= (``DECAY_LENGTHS`` + 4) / q, and at least 30.
+- velocities of P(x, v): |v| <= (``DECAY_LENGTHS`` + 4) / q, and at least 40.
 
 Where 2 - beta is small (r just above r_c) or negative (below r_c, where the collapse is cut
 off by the simulation's floor), the low ends stop at the smallest speed and time the
@@ -233,19 +233,19 @@ def velocity_range(restitution):
     Returns
     -------
     float
-        max(26 / q, 30): a flight's |v| stays below its incoming speed, up to the noise, and
+        max(26 / q, 40): a flight's |v| stays below its incoming speed, up to the noise, and
         the time at speeds above 26 / q is about e^-26 (q v)^2 of the whole; where q is large
         the noise keeps flights up longer (at r = 1/4 and 1/2 about 1e-6 of the time has
-        |v| > 22).
+        |v| > 22, and in some runs at r = 1/4 3e-5 has v < -30).
 
     Examples
     --------
     >>> from bouncing_ball.scales import velocity_range
     >>> print(f"{velocity_range(0.5):.3g} {velocity_range(0.99):.4g}")
-    30 1716
+    40 1716
     """
     _, q, _ = _exponents(restitution)
-    return max((DECAY_LENGTHS + 4.0) / q, 30.0)
+    return max((DECAY_LENGTHS + 4.0) / q, 40.0)
 
 
 def _power_tail(ratio, power):
@@ -484,7 +484,7 @@ SOLVER_TABLE_POINTS = {
 # range (flight_time.FLIGHT_TIME_TABLE_RANGE) and distribution.SMALLEST_WEIGHT_FORCE (not
 # imported: they load the solver)
 _SOLVER_SMALLEST_SPEED = 1e-100
-_FLIGHT_TIME_TABLE_RANGE = (1e-30, 1e4)
+_FLIGHT_TIME_TABLE_RANGE = (1e-100, 1e4)
 _SMALLEST_WEIGHT_FORCE = 2e-4
 
 
@@ -500,7 +500,7 @@ def solver_table_ranges(restitution) -> dict:
     -------
     dict
         ``output_speeds`` (``outgoing_speed_range`` down to 1e-100), ``flight_times``
-        (``flight_time_range`` within the flight-time table's 1e-30 .. 1e4),
+        (``flight_time_range`` within the flight-time table's 1e-100 .. 1e4),
         ``position_grid`` (``position_range``), ``speeds`` (+- ``velocity_range``) and
         ``forces``: the F of eq. (weightfunc) whose saddle point F ~ b / (2 x^(1/2)) of
         eq. (P(x)1) lies in the heights' range, a decade more each way, from 2e-4 (below,

@@ -14,7 +14,7 @@ from .asymptotic_forms import (
     short_time_constant,
     small_speed_amplitude,
 )
-from .equilibrium_density import SHORT_FLIGHT_TIME, flight_rate_density
+from .equilibrium_density import flight_rate_density
 from .equilibrium_moments import (
     collision_rate,
     flight_time_second_moment,
@@ -39,10 +39,11 @@ _BIN_NODES, _BIN_WEIGHTS = np.polynomial.legendre.leggauss(16)
 
 
 #: The flight times of the pipeline's table (config solver.flight_times, min and max): from
-#: SHORT_FLIGHT_TIME (below, the table's rate_density is its short_time_form) to 1e4 (beyond,
+#: 1e-100 (below SHORT_FLIGHT_TIME, 1e-30, the table's rate_density is its short_time_form,
+#: A C_beta T^(-beta/2), which stays within doubles down to 1e-100 for beta < 5/2) to 1e4 (beyond,
 #: nu(T) is 0 for r <= 0.618, where it decays like e^(-3T/16), and the quadrature of each T
 #: costs T^(1/2) nodes).
-FLIGHT_TIME_TABLE_RANGE = (SHORT_FLIGHT_TIME, 1.0e4)
+FLIGHT_TIME_TABLE_RANGE = (1.0e-100, 1.0e4)
 
 
 def flight_time_summary(solution):

@@ -442,9 +442,9 @@ def time_averages_figure(solved, simulated, exact, critical_restitution, per_res
                 r"$r_c$: $I = \infty$ below",
                 (1.0 - critical_restitution, 0.9),
                 xycoords=("data", "axes fraction"),
-                xytext=(-4, 0),
+                xytext=(4, 0),
                 textcoords="offset points",
-                ha="right",
+                ha="left",
                 color="0.3",
             )
     axes[0, 0].legend(loc="upper left", fontsize=7)
@@ -462,18 +462,23 @@ def time_averages_figure(solved, simulated, exact, critical_restitution, per_res
 
 @_styled
 def residuals_figure(panels):
-    """Fig. 7: (simulation - solver) / sigma of every P(0, v) bin, one row per simulated r.
+    """Fig. 7: (simulation - solver) / sigma of every P(0, v) bin, one row per simulated r,
+    against q(r) v: the speed in units of the large-v decay length 1/q of eqs. (asym4)-(asym6),
+    so that every r's bins, which follow its own scales, read alike (each panel spans its own
+    bins).
 
     ``panels``: (r, residual table with columns v, residual) pairs.
     """
-    figure, axes = new_figure(
-        len(panels), 1, width=5.0, height=1.3 + 1.2 * len(panels), sharex=True
-    )
+    from ..asymptotics import large_speed_decay_rate
+
+    # each r on its own range of speeds: near r_c the bins reach down by decades
+    figure, axes = new_figure(len(panels), 1, width=5.0, height=1.3 + 1.3 * len(panels))
     for index, (axis, (restitution, residuals)) in enumerate(zip(axes[:, 0], panels)):
         axis.axhspan(-2, 2, color="0.92", zorder=0)
         axis.axhline(0.0, color="0.5", linewidth=0.8)
+        q = large_speed_decay_rate(float(restitution))
         axis.plot(
-            residuals.v,
+            q * residuals.v,
             residuals.residual,
             linestyle="none",
             color="k",
@@ -486,7 +491,12 @@ def residuals_figure(panels):
             0.01,
             0.93,
             f"{restitution_text(restitution)}:  "
-            rf"$\chi^2/n = {chi2:.2f}$, $n = {len(residuals)}$",
+            rf"$\chi^2/n = {chi2:.2f}$, $n = {len(residuals)}$"
+            + (
+                f", v in [{residuals.v.min():.2g}, {residuals.v.max():.2g}]"
+                if len(residuals)
+                else ", no bin with counts"
+            ),
             transform=axis.transAxes,
             va="top",
             bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.85, "pad": 1.5},
@@ -496,7 +506,7 @@ def residuals_figure(panels):
         axis.set_ylim(-limit, limit)
         axis.set_xscale("log")
         axis.set_ylabel(r"$\Delta P / \sigma$")
-    axes[-1, 0].set_xlabel(r"$v$")
+    axes[-1, 0].set_xlabel(r"$q(r)\, v$")
     return figure
 
 
