@@ -678,8 +678,9 @@ def validation_rows(
     max_bias=0.5,
     outside=None,
 ) -> list[dict]:
-    """Every check of one r: ``outgoing_speed_checks``, ``position_checks``, ``fit_checks``,
-    ``coverage_checks``.
+    """Every check of one r.
+
+    ``outgoing_speed_checks``, ``position_checks``, ``fit_checks``, ``coverage_checks``.
 
     Parameters
     ----------

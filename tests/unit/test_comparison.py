@@ -325,7 +325,12 @@ def test_validation_of_noisy_exact_bins_gives_chi2_near_one(restitution):
     rng = np.random.default_rng(11)
     p0v, _ = _simulated_bins(restitution, 0.01, rng, lo=1e-4, hi=100.0)
     position = _position_bins(restitution, 0.01, rng)
-    rows = _by_check(validation_rows("label", restitution, p0v, position, _fits_table(), shards=16))
+    outside = {"p0v": {"below": 1e-6, "above": 0.0, "outside": 1e-6, "counts": "collisions"}}
+    rows = _by_check(
+        validation_rows(
+            "label", restitution, p0v, position, _fits_table(), shards=16, outside=(outside,) * 2
+        )
+    )
     assert list(rows.index) == list(VALIDATION_CHECKS)
     assert (rows.r_label == "label").all() and (rows.r == float(restitution)).all()
     speeds = rows.loc["p0v_chi2_per_bin"]

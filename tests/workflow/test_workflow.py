@@ -755,7 +755,7 @@ BAD += [
         _with(["solver", "restitution_grid", "points"], 100_000_000),
         "instance['solver']['restitution_grid']['points']",
     ),
-    (_with(["solver", "positions"], [0, 1.0e-4]), "solver.positions[1]: x = 0.0001 is outside"),
+    (_with(["solver", "positions"], [0, 2.0e3]), "solver.positions[1]: x = 2000.0 is outside"),
     (_with(["solver", "positions"], [0, 0.1, 0]), "solver.positions[2]: x = 0 repeats"),
 ]
 
