@@ -29,12 +29,12 @@ __all__ = [
     "outside_fractions",
 ]
 
-#: What each table's histogram counts, for ``outside_fractions``: (table, tally field, what
-#: it counts).
+#: What each table's histogram counts, for ``outside_fractions``: (table, tally field, its
+#: bins, what it counts).
 _COVERED = (
-    ("p0v", "speed_counts", "collisions"),
-    ("position", "position_time", "time"),
-    ("flight_time", "flight_time_counts", "flights"),
+    ("p0v", "speed_counts", "speed_bins", "collisions"),
+    ("position", "position_time", "position_bins", "time"),
+    ("flight_time", "flight_time_counts", "flight_time_bins", "flights"),
 )
 
 
@@ -398,16 +398,17 @@ def outside_fractions(shards: list[ShardTallies]) -> dict:
     -------
     dict
         {table: {"below": fraction, "above": fraction, "outside": their sum, "counts": what
-        is counted}} for the tables ``p0v``, ``position``, ``flight_time`` and ``distribution``
-        (whose below and above are of v: its x overflow is in ``outside``); NaN where the
-        shards recorded nothing.
+        is counted, "lo", "hi": the range of the finite bins}} for the tables ``p0v``,
+        ``position``, ``flight_time`` and ``distribution`` (whose below, above, lo and hi are
+        of v: its x overflow is in ``outside``); NaN where the shards recorded nothing.
 
     Examples
     --------
     See the module's example.
     """
     fractions = {}
-    for table, field, counted in _COVERED:
+    first = shards[0]
+    for table, field, bins, counted in _COVERED:
         total = np.sum([getattr(s, field) for s in shards], axis=0).astype(float)
         whole = total.sum()
         below, above = (total[0] / whole, total[-1] / whole) if whole > 0 else (np.nan,) * 2
@@ -416,6 +417,8 @@ def outside_fractions(shards: list[ShardTallies]) -> dict:
             "above": float(above),
             "outside": float(below + above),
             "counts": counted,
+            "lo": float(getattr(first, bins).lo),
+            "hi": float(getattr(first, bins).hi),
         }
     cells = np.sum([s.position_velocity_time for s in shards], axis=0)
     whole = cells.sum()
@@ -429,5 +432,7 @@ def outside_fractions(shards: list[ShardTallies]) -> dict:
         "above": float(v_above),
         "outside": float(1.0 - inside),
         "counts": "time",
+        "lo": float(first.velocity_bins.lo),
+        "hi": float(first.velocity_bins.hi),
     }
     return fractions

@@ -629,9 +629,9 @@ def coverage_checks(simulated_outside=None, solved_outside=None) -> list[dict]:
     --------
     >>> from bouncing_ball.validation.checks import coverage_checks
     >>> row, = coverage_checks({"p0v": {"below": 2e-6, "above": 0.0, "outside": 2e-6,
-    ...                                  "counts": "collisions"}})
+    ...                                  "counts": "collisions", "lo": 1e-6, "hi": 25.1}})
     >>> print(row["value"], row["detail"])
-    2e-06 p0v 2.0e-06 of the collisions; every table holds all but 0.0001 of its distribution
+    2e-06 p0v 2.0e-06 of the collisions outside [1e-06, 25.1]; every table holds all but 0.0001 of its distribution
     """
     rows = []
     for check, outside in (
@@ -645,6 +645,11 @@ def coverage_checks(simulated_outside=None, solved_outside=None) -> list[dict]:
         shown = "; ".join(
             f"{name} {'an unbounded part' if v is None else f'{v:.1e}'} of the "
             f"{outside[name]['counts']}"
+            + (
+                f" outside [{outside[name]['lo']:.3g}, {outside[name]['hi']:.3g}]"
+                if "lo" in outside[name]
+                else ""
+            )
             for name, v in parts.items()
         )
         verdict = (

@@ -524,6 +524,10 @@ def simulation_settings(config: dict, label: str, overrides: bool = True) -> dic
             settings.update(override)
     exact = _restitution_of_label(config, label)
     settings = resolve_bins(settings, exact)
+    if isinstance(settings["shard_time"], dict):
+        settings["shard_time"] = _in_relaxation_times(
+            settings["shard_time"]["relaxation_times"], exact, label
+        )
     if settings["equilibration_time"] == AUTO_EQUILIBRATION:
         # imported here: the relaxation time needs the solver (scipy, numba), which importing
         # this module does not load
@@ -531,6 +535,20 @@ def simulation_settings(config: dict, label: str, overrides: bool = True) -> dic
 
         settings["equilibration_time"] = default_equilibration_time(exact)
     return settings
+
+
+def _in_relaxation_times(count: float, exact: Fraction, label: str) -> float:
+    """``count`` relaxation times of the process at r (``Equilibrium.relaxation_time``),
+    rounded up to two significant digits; ValueError at or below r_c, where there is none."""
+    from ..simulation.equilibration import _two_digits_up, equilibration_relaxation_time
+
+    relaxation = equilibration_relaxation_time(exact)
+    if relaxation is None:
+        raise ValueError(
+            f"simulation.shard_time at r = {label}: {{relaxation_times: {count}}} needs a "
+            "relaxation time, and at or below r_c the outgoing speeds collapse; give a time"
+        )
+    return _two_digits_up(count * relaxation)
 
 
 def _restitution_of_label(config: dict, label: str) -> Fraction:

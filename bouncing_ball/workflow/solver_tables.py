@@ -425,7 +425,8 @@ def outside_fractions(tables: dict) -> dict:
     Returns
     -------
     dict
-        {table: {"below", "above", "outside", "counts"}}, the fractions of the whole; None
+        {table: {"below", "above", "outside", "counts", "lo", "hi"}}, the fractions of the
+        whole and the table's range; None
         where the end's slope cannot bound its tail (below r_c, v P(0, v) ~ v^(1 - beta) is
         not integrable at 0: the collision rate is infinite, eq. (collrate)).
     """
@@ -445,6 +446,8 @@ def outside_fractions(tables: dict) -> dict:
             "above": finite[1],
             "outside": below + above if None not in finite else None,
             "counts": counted,
+            "lo": float(z[0]),
+            "hi": float(z[-1]),
         }
     return fractions
 
