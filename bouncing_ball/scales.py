@@ -484,7 +484,7 @@ SOLVER_TABLE_POINTS = {
 # range (flight_time.FLIGHT_TIME_TABLE_RANGE) and distribution.SMALLEST_WEIGHT_FORCE (not
 # imported: they load the solver)
 _SOLVER_SMALLEST_SPEED = 1e-100
-_FLIGHT_TIME_TABLE_RANGE = (1e-100, 1e4)
+_FLIGHT_TIME_TABLE_RANGE = (1e-100, 1e5)
 _SMALLEST_WEIGHT_FORCE = 2e-4
 
 
@@ -500,7 +500,7 @@ def solver_table_ranges(restitution) -> dict:
     -------
     dict
         ``output_speeds`` (``outgoing_speed_range`` down to 1e-100), ``flight_times``
-        (``flight_time_range`` within the flight-time table's 1e-100 .. 1e4),
+        (``flight_time_range`` within the flight-time table's 1e-100 .. 1e5),
         ``position_grid`` (``position_range``), ``speeds`` (+- ``velocity_range``) and
         ``forces``: the F of eq. (weightfunc) whose saddle point F ~ b / (2 x^(1/2)) of
         eq. (P(x)1) lies in the heights' range, a decade more each way, from 2e-4 (below,
@@ -622,7 +622,8 @@ def tail_fractions(edges, mass_density):
         tails.append(z[first] * f[first] / beyond if beyond > 0.0 else math.inf)
     total = inside + sum(tails)
     if not math.isfinite(total) or total <= 0.0:
-        return tuple(math.inf if not math.isfinite(t) else 1.0 for t in tails)
+        # an unbounded end holds all of an infinite whole; a bounded one, none of it
+        return tuple(math.inf if not math.isfinite(t) else 0.0 for t in tails)
     return tails[0] / total, tails[1] / total
 
 

@@ -399,8 +399,9 @@ def test_a_position_beyond_the_largest_height_is_refused_naming_the_key(section)
     [("solver.flight_times.min", 1.0e-250, "less"), ("solver.flight_times.max", 1.0e14, "greater")],
 )
 def test_flight_times_beyond_the_library_table_range_are_refused(key, value, relation):
-    """Below 1e-30 the flight-time table is its short-flight law; beyond 1e4 it is 0 for
-    r <= 0.618 and each T costs T^(1/2) nodes: refused before any job, naming the key."""
+    """Below 1e-100 the flight-time density leaves the range of doubles at some r; beyond 1e5
+    (past the longest flights at r = 0.999) each T costs T^(1/2) nodes: refused before any
+    job, naming the key."""
     config = _set(_small_config(), key, value)
     with pytest.raises(
         ValueError, match=rf"{re.escape(key)}: {re.escape(repr(value))} is {relation} than"
