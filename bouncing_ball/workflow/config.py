@@ -37,8 +37,6 @@ from ..scales import (
     OUTSIDE_WARNING,
     SOLVER_TABLE_POINTS,
     estimated_outside_fractions,
-    is_auto,
-    is_grid_auto,
     resolve_bins,
     resolve_solver_grids,
 )
@@ -274,8 +272,9 @@ _SOLVER_GRIDS = {
 
 
 def warn_incomplete_bins(config: dict) -> None:
-    """Warn (``IncompleteTableWarning``), naming r, the key and the fraction, where an explicit
-    bin set of the simulation or grid of the solver leaves more than ``scales.OUTSIDE_WARNING``
+    """Warn (``IncompleteTableWarning``), naming r, the key and the fraction, where a bin set of
+    the simulation or a grid of the solver with an end fixed by the config leaves more than
+    ``scales.OUTSIDE_WARNING``
     of its distribution outside, by the asymptotic forms (``scales.estimated_outside_fractions``);
     ``auto`` ranges follow r and leave about 1e-6 at each end."""
     import warnings
@@ -294,17 +293,17 @@ def warn_incomplete_bins(config: dict) -> None:
             _restitution_of_label(config, label),
         )
         cases = [
-            (f"simulation.{name}", estimates[name], simulation.get(name)) for name in BIN_SETTINGS
+            (f"simulation.{name}", estimates[name], simulation.get(name), ("lo", "hi"))
+            for name in BIN_SETTINGS
         ]
         cases += [
-            (f"solver.{key}", solved[name], config["solver"][key])
+            (f"solver.{key}", solved[name], config["solver"][key], ("min", "max"))
             for key, name in _SOLVER_GRIDS.items()
         ]
-        for key, fraction, spec in cases:
-            automatic = (
-                spec is None or is_auto(spec) or (key.startswith("solver") and is_grid_auto(spec))
-            )
-            if not automatic and fraction > OUTSIDE_WARNING:
+        for key, fraction, spec, ends in cases:
+            # an end the config fixes (the others follow r)
+            fixed = isinstance(spec, dict) and any(spec.get(end, AUTO) != AUTO for end in ends)
+            if fixed and fraction > OUTSIDE_WARNING:
                 warnings.warn(
                     f"{key} leaves about {fraction:.1e} of the distribution at r = {label} "
                     f"outside its range (more than {OUTSIDE_WARNING:g}); give it as auto to "
