@@ -834,9 +834,14 @@ def test_a_bad_config_leaves_existing_results_untouched(finished_run, tmp_path):
     assert {path: path.stat().st_mtime_ns for path in (directory / "results").rglob("*")} == before
 
 
-def test_the_quick_look_and_the_test_config_plan_a_run():
-    """config/quick.yaml (an overlay of config.yaml) and .test/config/config.yaml validate."""
-    for arguments in (["--configfile", "config/quick.yaml"], ["--configfile", str(TEST_CONFIG)]):
+def test_the_quick_look_the_elastic_end_and_the_test_config_plan_a_run():
+    """config/quick.yaml and config/elastic.yaml (overlays of config.yaml) and
+    .test/config/config.yaml validate."""
+    for arguments in (
+        ["--configfile", "config/quick.yaml"],
+        ["--configfile", "config/elastic.yaml", "results/tables/moments.md"],
+        ["--configfile", str(TEST_CONFIG)],
+    ):
         planned = subprocess.run(
             [sys.executable, "-m", "snakemake", "--dry-run", *arguments],
             cwd=REPOSITORY,
