@@ -839,7 +839,7 @@ def test_the_quick_look_the_elastic_end_and_the_test_config_plan_a_run():
     .test/config/config.yaml validate."""
     for arguments in (
         ["--configfile", "config/quick.yaml"],
-        ["--configfile", "config/elastic.yaml", "results/tables/moments.md"],
+        ["results/tables/moments.md", "--configfile", "config/elastic.yaml"],
         ["--configfile", str(TEST_CONFIG)],
     ):
         planned = subprocess.run(
