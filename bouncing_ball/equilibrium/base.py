@@ -857,7 +857,7 @@ class EquilibriumBase(abc.ABC):
         x_lo, x_hi, v_lo, v_hi = np.broadcast_arrays(x_lo, x_hi, v_lo, v_hi)
         with self._paper_bounds():
             average = distribution.distribution_cell_average(
-                x_lo, x_hi, v_lo, v_hi, self.weight_function
+                x_lo, x_hi, v_lo, v_hi, self.weight_function, outgoing=self._outgoing
             )
         return _out(self._physical(average, "phase_space_density"))
 
