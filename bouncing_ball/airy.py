@@ -151,7 +151,8 @@ def check_force_integral_point(x: float, v: float) -> None:
 
     The integral converges and quad evaluates it at x > 0 where the phase of psi_F(-v) stays
     below ``LARGEST_AIRY_PHASE`` (any x > 0 where v <= 0; x >= 1e-4 up to v = 18), and at x = 0
-    only with v < 0.
+    only with v < 0.  Below that x at v > 0, P(x, v) is the near-wall series of eq. (fp)
+    (``near_wall.distribution_near_wall``).
 
     Parameters
     ----------

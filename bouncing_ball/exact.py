@@ -667,9 +667,9 @@ def _log_weight_rest(force, restitution):
 
 
 def distribution_on_ray(x, v, restitution):
-    """P(x, v) of eqs. (fpsol), (psi), (weightfunc2) for v > 0 by the F integral on a ray in
-    the complex F plane: any x >= 0, however fast the Airy factor oscillates on the real axis.
+    """P(x, v) of eqs. (fpsol), (psi), (weightfunc2), v > 0, by the F integral on a complex ray.
 
+    Any x >= 0, however fast the Airy factor oscillates on the real axis.
     On the real axis Ai(z) = 2 Re[-omega Ai(omega z)], omega = e^(2 pi i / 3); for
     z = -F^(1/3) v + F^(-2/3) / 4 the half -omega Ai(omega z) ~ e^(i (2/3) F^(1/2) v^(3/2)) decays
     in the upper half F plane, and w(F) of eq. (weightfunc2) is analytic for Re F > 0, so its
@@ -711,7 +711,7 @@ def distribution_on_ray(x, v, restitution):
     >>> from bouncing_ball.exact import distribution_on_ray, outgoing_speed_density
     >>> values = distribution_on_ray([0.0, 1e-5], 20.0, "1/2")
     >>> print(values, outgoing_speed_density(20.0, "1/2"))
-    [3.43525604e-11 3.43525421e-11] 3.435256037397596e-11
+    [3.43525604e-11 3.43525613e-11] 3.435256037397596e-11
     """
     _which(restitution)
     x, v = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(v, dtype=float))
@@ -795,7 +795,10 @@ def distribution_with_error(x, v, restitution):
     F integral of eqs. (fpsol), (psi), (weightfunc2) over the same range of ln F as
     ``distribution_by_force_integral``, to 1e-10 relative, every point at once by an adaptive
     21-point Gauss-Kronrod rule, each point's intervals bisected on its own
-    (``_force_integrals``).
+    (``_force_integrals``); next to the floor at large v > 0, where that integral oscillates
+    too fast (x < 1.7e-8 v^3, ``near_wall.near_wall_points``), the Taylor series in x of
+    eq. (fp) from eq. (P(0,v)) (``near_wall.distribution_near_wall``, to ~1e-13 of
+    ``distribution_on_ray``).
 
     Parameters
     ----------

@@ -18,8 +18,11 @@ derivatives are its spectral derivatives at the nodes.  The terms fall like
 (x q / v)^n / n! (gravity: the series of P(0, (v^2 + 2 x)^(1/2))) and (x q^2 / v)^n,
 (x / v^3)^n (the noise).  The series stops where a term falls below 1e-17 of the sum; its
 error estimate is the difference from the same series on a Chebyshev interpolant with every
-other node (``NEAR_WALL_CHECK``), which also measures the interpolation and the rounding of the
-spectral derivatives.  The contributions this expansion misses (the region v ~ x^(1/3) where
+other node (which measures the truncation and the interpolation), plus the series' response to
+a rounding of ``FLOOR_NOISE`` of P(0, v) at the nodes in the highest Chebyshev mode (the
+spectral derivatives amplify it by at most ~3 up to x = ``NEAR_WALL_REACH`` v^3, much less
+where the series is used).  A smooth error of P(0, v) itself carries into P(x, v) one to one,
+and is not in the estimate.  The contributions this expansion misses (the region v ~ x^(1/3) where
 P(0, v) ~ v^-beta is singular, reached only by the noise) are of order e^(-v^3 / (9 x)): none
 in doubles where the series is used, x <= ``NEAR_WALL_REACH`` v^3.
 """
@@ -34,6 +37,7 @@ __all__ = [
     "NEAR_WALL_REACH",
     "NEAR_WALL_TOLERANCE",
     "NEAR_WALL_CELL_NODES",
+    "FLOOR_NOISE",
     "near_wall_points",
     "distribution_near_wall",
     "distribution_near_wall_cell_average",
@@ -55,6 +59,12 @@ NEAR_WALL_REACH = 1.0e-6
 NEAR_WALL_TOLERANCE = 1.0e-11
 
 
+#: The relative rounding of P(0, v) at a window's nodes the error estimate carries through the
+#: spectral derivatives (the solver's Nystrom formula is a sum of positive terms, each to
+#: ~1e-15; its smooth error is P(0, v)'s own, carried into P(x, v) one to one).
+FLOOR_NOISE = 1e-14
+
+
 #: Gauss-Legendre nodes per panel in v of ``distribution_near_wall_cell_average``.
 NEAR_WALL_CELL_NODES = 8
 
@@ -63,9 +73,10 @@ _MOST_TERMS = 200
 
 
 def near_wall_points(x, v):
-    """Where P(x, v) is the near-wall series (``distribution_near_wall``) rather than the F
-    integral of eq. (fpsol): x > 0, v > 0 and the Airy phase of the F integral beyond
-    ``airy.LARGEST_AIRY_PHASE`` (x < 60 ((2/3) v^(3/2) / LARGEST_AIRY_PHASE)^2 = 1.7e-8 v^3).
+    """Where P(x, v) is the near-wall series rather than the F integral of eq. (fpsol).
+
+    At x > 0, v > 0 where the Airy phase of the F integral passes ``airy.LARGEST_AIRY_PHASE``:
+    x < 60 ((2/3) v^(3/2) / LARGEST_AIRY_PHASE)^2 = 1.7e-8 v^3 (``distribution_near_wall``).
 
     Parameters
     ----------
@@ -104,6 +115,9 @@ _NODES, _MATRIX = _chebyshev(NEAR_WALL_NODES)
 
 
 _CHECK_NODES, _CHECK_MATRIX = _chebyshev((NEAR_WALL_NODES + 1) // 2)
+
+
+_ALTERNATING = (-1.0) ** np.arange(NEAR_WALL_NODES)
 
 
 def _window(speeds, restitution):
@@ -148,7 +162,7 @@ def _series_at(unique, largest, outgoing, restitution):
     out = []
     for k, speed in enumerate(unique):
         if not np.all(density[k] > 0.0) or not np.all(np.isfinite(density[k])):
-            out.append((np.zeros(1), np.zeros(1)))
+            out.append((np.zeros(1), np.zeros(1), np.zeros(1)))
             continue
         log_density = np.log(density[k])
         at = density[k, _NODES.size // 2]
@@ -156,7 +170,14 @@ def _series_at(unique, largest, outgoing, restitution):
         check = _coefficients(
             largest[k], speed, radius[k], log_density[::2], _CHECK_NODES, _CHECK_MATRIX
         )
-        out.append((at * main, at * check))
+        # the spectral derivatives' response to a rounding of ln P(0, .) at the nodes: the
+        # highest Chebyshev mode, (-1)^j (the worst case), of size 1e-8 (linear response)
+        shaken = _coefficients(
+            largest[k], speed, radius[k], log_density + 1e-8 * _ALTERNATING, _NODES, _MATRIX
+        )
+        size = min(main.size, shaken.size)
+        response = np.abs(shaken[:size] - main[:size]) / 1e-8
+        out.append((at * main, at * check, at * FLOOR_NOISE * response))
     return out
 
 
@@ -235,20 +256,22 @@ def distribution_near_wall(x, speeds, outgoing, restitution):
     which = which.reshape(v.shape)
     largest = np.zeros(unique.size)
     np.maximum.at(largest, which.ravel(), x.ravel())
-    for k, (main, check) in enumerate(_series_at(unique, largest, outgoing, restitution)):
+    series = _series_at(unique, largest, outgoing, restitution)
+    for k, (main, check, response) in enumerate(series):
         at = which == k
         value = np.polynomial.polynomial.polyval(x[at], main)
         error = np.abs(value - np.polynomial.polynomial.polyval(x[at], check))
-        error += 4e-16 * np.abs(value)
+        error += np.polynomial.polynomial.polyval(x[at], response) + 4e-16 * np.abs(value)
         _checked(value, error, x[at], unique[k])
         values[at], errors[at] = value, error
     return values, errors
 
 
 def distribution_near_wall_cell_average(x_lo, x_hi, v_lo, v_hi, outgoing, restitution):
-    """The average of P(x, v) over cells next to the floor at large v, by the series of
-    ``distribution_near_wall``: (1 / area) int_{x_lo}^{x_hi} dx int_{v_lo}^{v_hi} dv P(x, v).
+    """The average of P(x, v) over a cell next to the floor at large v, from the near-wall series.
 
+    (1 / area) int_{x_lo}^{x_hi} dx int_{v_lo}^{v_hi} dv P(x, v), by the series of
+    ``distribution_near_wall``.
     The x average of each power x^n in closed form, the v average by Gauss-Legendre
     (``NEAR_WALL_CELL_NODES`` nodes) on panels no wider than v / 8 and 1 / (q + 1 / v) (q the
     large-v decay rate of P(0, v)), across which P(0, v) changes by at most about e.
@@ -290,11 +313,12 @@ def distribution_near_wall_cell_average(x_lo, x_hi, v_lo, v_hi, outgoing, restit
     # the x average of x^n over [x_lo, x_hi]
     total, error = 0.0, 0.0
     series = _series_at(speeds, np.full(speeds.size, x_hi), outgoing, restitution)
-    for speed, weight, (main, check) in zip(speeds, weights, series):
-        n = np.arange(max(main.size, check.size))
+    for speed, weight, (main, check, response) in zip(speeds, weights, series):
+        n = np.arange(max(main.size, check.size, response.size))
         average = (x_hi ** (n + 1) - x_lo ** (n + 1)) / ((n + 1) * (x_hi - x_lo))
         value = float(main @ average[: main.size])
         difference = abs(value - float(check @ average[: check.size])) + 4e-16 * abs(value)
+        difference += float(response @ average[: response.size])
         _checked(np.array([value]), np.array([difference]), x_hi, speed)
         total += weight * value
         error += weight * difference

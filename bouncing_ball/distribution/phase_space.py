@@ -396,7 +396,10 @@ def distribution_with_error(x, v, weight, solution):
     """P(x, v) and an estimate of its absolute error, for broadcast arrays x >= 0 and v.
 
     x > 0: eq. (fpsol) by the F integral, every v at one x by one fixed rule
-    (``distribution_by_force_rule``).  x = 0: the outgoing side is the
+    (``distribution_by_force_rule``), except next to the floor at large v > 0, where its Airy
+    factor oscillates too fast (x < 1.7e-8 v^3, ``near_wall.near_wall_points``): there the
+    Taylor series in x of eq. (fp) from the solver's P(0, v)
+    (``near_wall.distribution_near_wall``).  x = 0: the outgoing side is the
     solver's P(0, v), the incoming side the boundary condition eq. (bc),
     P(0, -v) = r^2 P(0, r v); P(0, 0) diverges and is NaN.
 
@@ -408,20 +411,22 @@ def distribution_with_error(x, v, weight, solution):
         w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
         ``closed_form_weight_function``).
     solution : solver.OutgoingSpeedSolution
-        P(0, v) of eq. (inteq), used at x = 0 only (evaluating it there compiles the kernel on
-        its first call).
+        P(0, v) of eq. (inteq), used at x = 0 and by the near-wall series (evaluating it
+        compiles the kernel on its first call).
 
     Returns
     -------
     values : numpy.ndarray
         P(x, v), the broadcast shape.
     errors : numpy.ndarray
-        Estimates of their absolute errors (``distribution_by_force_rule``; 0 at x = 0).
+        Estimates of their absolute errors (``distribution_by_force_rule``, or
+        ``near_wall.distribution_near_wall``; 0 at x = 0).
 
     Raises
     ------
     ValueError
-        Before any integral, as ``check_force_integral_point`` for each (x, v) with x != 0.
+        Before any integral, for an x < 0 or NaN (``check_force_integral_point``); as
+        ``near_wall.distribution_near_wall`` for a point next to the floor.
 
     Examples
     --------
@@ -480,7 +485,8 @@ def distribution(x, v, weight, solution):
         w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
         ``closed_form_weight_function``).
     solution : solver.OutgoingSpeedSolution
-        P(0, v) of eq. (inteq), used at x = 0 only (``distribution_with_error``).
+        P(0, v) of eq. (inteq), used at x = 0 and next to the floor at large v
+        (``distribution_with_error``).
 
     Returns
     -------
@@ -490,7 +496,7 @@ def distribution(x, v, weight, solution):
     Raises
     ------
     ValueError
-        As ``check_force_integral_point`` for each (x, v) with x != 0.
+        As ``distribution_with_error``.
 
     Examples
     --------
