@@ -170,7 +170,7 @@ class _OutgoingDensity:
     largest: float  # P(0, v) is trusted up to here
     panel_edges: np.ndarray  # in s = ln v + v^(1/2)
     coefficients: np.ndarray  # Chebyshev coefficients of ln P + beta ln v + q v, per panel
-    nodes: np.ndarray  # u grid of the complex Nystrom sum
+    nodes: np.ndarray  # u grid of the complex Nystrom sum (empty where r > RAY_RESTITUTION)
     log_weights: np.ndarray  # ln(weight u P(0, u))
     remainder: float  # closed-form part of the lower tail, times P(0, u_0)
     # P(0, v) on the ray arg v = RAY_ANGLE where r > RAY_RESTITUTION (``_RayDensity``), else None
@@ -303,6 +303,11 @@ class _OutgoingDensity:
         magnitudes of its terms (rounding errors are ~1e-16 of it: at complex v the terms
         cancel, increasingly so as Im(v)^2 / Re(v) grows).  ``slack``: per v, the e-folds by
         which its result may be less accurate (``_complex_kernel_sums``; none if None)."""
+        if self.ray is not None:
+            raise ValueError(
+                f"r = {self.restitution}: above RAY_RESTITUTION, A(F) is taken on the ray "
+                "and P(0, v) has no wedge grid (use ray.log_density)"
+            )
         v = np.ascontiguousarray(np.asarray(v, dtype=complex).ravel())
         slack = np.zeros(v.size) if slack is None else np.ascontiguousarray(slack, dtype=float)
         r = self.restitution
@@ -382,6 +387,22 @@ def _outgoing_density(solution, panel_width=1.0, panel_order=20) -> _OutgoingDen
             for row in smooth.reshape(count, panel_order)
         ]
     )
+    if r > RAY_RESTITUTION:
+        # A(F) is taken on the ray (``_ray_density``): no wedge, no complex Nystrom sum
+        return _OutgoingDensity(
+            r,
+            beta,
+            q,
+            log_amplitude,
+            u0,
+            largest,
+            edges,
+            coefficients,
+            np.empty(0),
+            np.empty(0),
+            np.nan,
+            _ray_density(solution),
+        )
     # the u grid of the complex Nystrom sum: the solver's rule, REFINE times finer
     step = solution.step / REFINE
     s0 = coordinate_of_speed(u0)
@@ -403,7 +424,6 @@ def _outgoing_density(solution, panel_width=1.0, panel_order=20) -> _OutgoingDen
         / -np.expm1(-alpha * step)
         * main_density[0]
     )
-    ray = _ray_density(solution) if r > RAY_RESTITUTION else None
     return _OutgoingDensity(
         r,
         beta,
@@ -416,7 +436,7 @@ def _outgoing_density(solution, panel_width=1.0, panel_order=20) -> _OutgoingDen
         nodes,
         log_weights,
         remainder,
-        ray,
+        None,
     )
 
 
