@@ -56,9 +56,9 @@ RAY_REFINE = 2  # the ray's grid is this many times finer than the solver's
 
 
 #: An entry of the ray's operator whose Gaussian bound is below e^-RAY_NEGLIGIBLE_EFOLDS
-#: (~1e-52) of its row's largest is dropped: the operator is a band where rho is large (the
+#: (~1e-39) of its row's largest is dropped: the operator is a band where rho is large (the
 #: return speed of a flight leaving at u spreads over ~(4 u / 3)^(1/2)), solved as sparse.
-RAY_NEGLIGIBLE_EFOLDS = 120.0
+RAY_NEGLIGIBLE_EFOLDS = 90.0
 
 
 _RAY_GL = tuple(np.polynomial.legendre.leggauss(count) for count in (20, 40, 64))
