@@ -403,7 +403,7 @@ FIRST_CURVE_RESTITUTIONS = (0.6, 0.95, 0.99)
 FIRST_CURVE_POINTS = 1000
 
 
-# a fresh process: solve (untimed), then time the first P(x) curve over the span of P(x)
+# a fresh process: solve (untimed), then time (CPU) the first P(x) curve over the span of P(x)
 # (1e-6 / q^2 to (22 / b)^2, b the large-x rate: docs/distribution.md) and a second one
 _FIRST_CURVE = """
 import json, sys, time
@@ -416,12 +416,12 @@ b = q * np.sqrt(2.0 * (3.0 - 2.0 * q) / 3.0) if r > 0.5 else np.sqrt(2.0 / 3.0)
 x = np.geomspace(1e-6 / q**2, (22.0 / b) ** 2, points)
 eq = Equilibrium(r)
 eq.p0v(1.0)
-started = time.perf_counter()
+started = time.process_time()
 eq.px(x)
-first = time.perf_counter() - started
-started = time.perf_counter()
+first = time.process_time() - started
+started = time.process_time()
 eq.px(x)
-print(json.dumps({"first": first, "second": time.perf_counter() - started}))
+print(json.dumps({"first": first, "second": time.process_time() - started}))
 """
 
 
@@ -439,7 +439,8 @@ def _first_curve(r, environment):
 
 def first_curve_benchmark():
     """The first P(x) curve of FIRST_CURVE_POINTS points at a new r after its solve (building
-    w(F) of eq. (weightfunc) and P(x) of eq. (P(x)1)), each in a fresh process: with numba's
+    w(F) of eq. (weightfunc) and P(x) of eq. (P(x)1)), in CPU seconds of one core (BLAS pinned
+    to one thread, so a shared machine's load does not count), each in a fresh process: with numba's
     on-disk cache cold (an empty NUMBA_CACHE_DIR: the compile is in the time) and warm (a
     second process on the same cache), and the second curve in the same process."""
     rows = []

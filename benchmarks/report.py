@@ -306,16 +306,16 @@ def _first_curve(results) -> str:
         {
             "r": f"{row['r']:g}",
             "points": f"{row['points']}",
-            "first, cold cache s": f"{row['first_cold_seconds']:.2f}",
-            "first, warm cache s": f"{row['first_warm_seconds']:.2f}",
-            "second s": f"{row['second_seconds']:.3f}",
+            "first, cold cache CPU s": f"{row['first_cold_seconds']:.2f}",
+            "first, warm cache CPU s": f"{row['first_warm_seconds']:.2f}",
+            "second CPU s": f"{row['second_seconds']:.3f}",
             "target": f"<= {FIRST_CURVE_TARGET_SECONDS:g} s: "
             + _verdict(row["first_warm_seconds"], FIRST_CURVE_TARGET_SECONDS),
         }
         for row in f["rows"]
     ]
     return (
-        "## The first P(x) curve at a new r\n\nAfter the solve, each r in a fresh process: "
+        "## The first P(x) curve at a new r\n\nAfter the solve, CPU seconds on one core, each r in a fresh process: "
         "w(F) is built and P(x) evaluated (numba's on-disk cache empty, then warm).\n\n"
         + _table(rows)
     )
