@@ -126,58 +126,66 @@ def _window(speeds, restitution):
 
 
 def _coefficients(largest, speed, radius, log_density, nodes, matrix):
-    """c_n = p_n(v) / n! at the window's centre, n = 0, 1, ..., until two terms in a row are
-    below 1e-17 of the sum at x = ``largest``: ``log_density`` = ln P(0, .) at
-    v = ``speed`` + ``radius`` ``nodes``, ``matrix`` the nodes' differentiation matrix on
-    [-1, 1]."""
-    v = speed + radius * nodes
-    matrix = matrix / radius
+    """a_n = p_n(v) X^n / n! at the window's centre, X = ``largest`` (or 1 where it is 0),
+    n = 0, 1, ..., until two terms in a row are below 1e-17 of the sum at x = X:
+    ``log_density`` = ln P(0, .) at v = ``speed`` + ``radius`` ``nodes``, ``matrix`` the
+    nodes' differentiation matrix on [-1, 1].  In the window's variable w = v' / v (D = d/dw,
+    G1 = D g, G2 = D^2 g) the step is p_{n+1} = [D^2 p_n + (v + 2 G1) D p_n
+    + (G2 + G1^2 + v G1) p_n] / (v^3 w): every factor stays O(1) at any v > 0."""
+    scale = largest if largest > 0.0 else 1.0
+    w = 1.0 + (radius / speed) * nodes
+    matrix = matrix * (speed / radius)
     first = matrix @ log_density
     second = matrix @ first
-    drift = 1.0 + 2.0 * first
-    rate = second + first * first + first
+    drift = speed + 2.0 * first
+    rate = second + first * first + speed * first
+    factor = scale / (speed**3 * w)
     centre = nodes.size // 2
     coefficients = [1.0]
     term = np.ones(nodes.size)
-    total, power, small = 1.0, 1.0, 0
+    total, small = 1.0, 0
     for n in range(1, _MOST_TERMS):
         slope = matrix @ term
-        term = (matrix @ slope + drift * slope + rate * term) / (v * n)
+        term = (matrix @ slope + drift * slope + rate * term) * (factor / n)
         coefficients.append(term[centre])
-        power *= largest
-        total += power * term[centre]
-        small = small + 1 if abs(power * term[centre]) <= 1e-17 * abs(total) else 0
+        total += term[centre]
+        small = small + 1 if abs(term[centre]) <= 1e-17 * abs(total) else 0
         if small == 2:
             break
-    return np.array(coefficients)
+    return np.array(coefficients), scale
 
 
 def _series_at(unique, largest, outgoing, restitution):
     """For each v of ``unique`` (with the largest x it serves, ``largest``): P(0, v) times the
-    coefficients c_n of the series and of its check interpolant (zeros where P(0, .)
-    underflows on the window, P(0, v) below ~1e-280)."""
+    coefficients a_n of the series in x / X, of its check interpolant and of its response to
+    rounding, and X (zeros where P(0, .) underflows on the window, P(0, v) below ~1e-280)."""
     radius = _window(unique, restitution)
     density = np.asarray(outgoing((unique[:, None] + radius[:, None] * _NODES).ravel()))
     density = density.reshape(unique.size, _NODES.size)
     out = []
     for k, speed in enumerate(unique):
-        if not np.all(density[k] > 0.0) or not np.all(np.isfinite(density[k])):
-            out.append((np.zeros(1), np.zeros(1), np.zeros(1)))
+        if not np.all(np.isfinite(density[k])):
+            raise ValueError(
+                f"v = {speed}: P(0, v) exceeds the largest double on the near-wall series' "
+                f"window [{speed - radius[k]:.3g}, {speed + radius[k]:.3g}] (P(x, v) with it)"
+            )
+        if not np.all(density[k] > 0.0):
+            out.append((np.zeros(1), np.zeros(1), np.zeros(1), 1.0))
             continue
         log_density = np.log(density[k])
         at = density[k, _NODES.size // 2]
-        main = _coefficients(largest[k], speed, radius[k], log_density, _NODES, _MATRIX)
-        check = _coefficients(
+        main, scale = _coefficients(largest[k], speed, radius[k], log_density, _NODES, _MATRIX)
+        check, _ = _coefficients(
             largest[k], speed, radius[k], log_density[::2], _CHECK_NODES, _CHECK_MATRIX
         )
         # the spectral derivatives' response to a rounding of ln P(0, .) at the nodes: the
         # highest Chebyshev mode, (-1)^j (the worst case), of size 1e-8 (linear response)
-        shaken = _coefficients(
+        shaken, _ = _coefficients(
             largest[k], speed, radius[k], log_density + 1e-8 * _ALTERNATING, _NODES, _MATRIX
         )
         size = min(main.size, shaken.size)
         response = np.abs(shaken[:size] - main[:size]) / 1e-8
-        out.append((at * main, at * check, at * FLOOR_NOISE * response))
+        out.append((at * main, at * check, at * FLOOR_NOISE * response, scale))
     return out
 
 
@@ -231,8 +239,9 @@ def distribution_near_wall(x, speeds, outgoing, restitution):
     Raises
     ------
     ValueError
-        If a v is not > 0, an x is outside [0, NEAR_WALL_REACH v^3], or the error estimate of
-        a point exceeds ``NEAR_WALL_TOLERANCE`` of its value.
+        If a v is not > 0, an x is outside [0, NEAR_WALL_REACH v^3], P(0, .) exceeds the
+        largest double on v's window, or the error estimate of a point exceeds
+        ``NEAR_WALL_TOLERANCE`` of its value.
 
     Examples
     --------
@@ -257,11 +266,12 @@ def distribution_near_wall(x, speeds, outgoing, restitution):
     largest = np.zeros(unique.size)
     np.maximum.at(largest, which.ravel(), x.ravel())
     series = _series_at(unique, largest, outgoing, restitution)
-    for k, (main, check, response) in enumerate(series):
+    for k, (main, check, response, scale) in enumerate(series):
         at = which == k
-        value = np.polynomial.polynomial.polyval(x[at], main)
-        error = np.abs(value - np.polynomial.polynomial.polyval(x[at], check))
-        error += np.polynomial.polynomial.polyval(x[at], response) + 4e-16 * np.abs(value)
+        t = x[at] / scale
+        value = np.polynomial.polynomial.polyval(t, main)
+        error = np.abs(value - np.polynomial.polynomial.polyval(t, check))
+        error += np.polynomial.polynomial.polyval(t, response) + 4e-16 * np.abs(value)
         _checked(value, error, x[at], unique[k])
         values[at], errors[at] = value, error
     return values, errors
@@ -313,9 +323,11 @@ def distribution_near_wall_cell_average(x_lo, x_hi, v_lo, v_hi, outgoing, restit
     # the x average of x^n over [x_lo, x_hi]
     total, error = 0.0, 0.0
     series = _series_at(speeds, np.full(speeds.size, x_hi), outgoing, restitution)
-    for speed, weight, (main, check, response) in zip(speeds, weights, series):
+    for speed, weight, (main, check, response, scale) in zip(speeds, weights, series):
         n = np.arange(max(main.size, check.size, response.size))
-        average = (x_hi ** (n + 1) - x_lo ** (n + 1)) / ((n + 1) * (x_hi - x_lo))
+        # the average of (x / X)^n over [x_lo, x_hi], X = x_hi
+        lo = x_lo / scale
+        average = (1.0 - lo ** (n + 1)) / ((n + 1) * (1.0 - lo))
         value = float(main @ average[: main.size])
         difference = abs(value - float(check @ average[: check.size])) + 4e-16 * abs(value)
         difference += float(response @ average[: response.size])

@@ -136,3 +136,13 @@ def test_the_series_refuses_outside_its_reach_and_on_a_noisy_floor_density():
         distribution_near_wall(0.9 * NEAR_WALL_REACH * 20.0**3, 20.0, noisy, 0.5)
     with pytest.raises(ValueError, match="x_hi <= 60 x_lo"):
         ExactEquilibrium("1/2").pxv_cell_average(1e-4, 1e-2, 20.0, 25.0)
+
+
+def test_the_series_holds_at_the_smallest_heights_and_speeds():
+    """At x = 1e-300, v = 1e-90 (and 1e-50) the series' terms are of relative order
+    x / v^3 (2 x / v^3 = 2e-30 at r = 1/2, where L P(0, .) / P(0, .) = (2 / v^2 + 1 / v) / v):
+    P(x, v) is P(0, v) = e^(-v) / (3 v) to rounding, with no overflow in the coefficients."""
+    for v in (1e-90, 1e-50):
+        assert near_wall_points(1e-300, v)
+        value = ExactEquilibrium("1/2").pxv(1e-300, v)
+        assert value == pytest.approx(exact.outgoing_speed_density(v, "1/2"), rel=1e-14)
