@@ -33,6 +33,9 @@ Measured here (``--scaling`` adds the stage on 1 and 2 cores, outside the defaul
     that pays numba's compile or cache load), nodes, and accuracy against the
     exact r = 1/2 and 1/3 solutions over v in [1e-3, 20]; target: 50 ms or
     less per r at relative error 1e-8;
+  * the first P(x) curve of 1000 points at a new r (0.6, 0.95, 0.99) after its solve, in a
+    fresh process with numba's on-disk cache cold and warm, and the second curve (target: the
+    first, warm, within 1 s);
   * the workflow's overhead (from a repository checkout): the dry run of a
     grid of 20 r values x 16 shards (target < 5 s), and a no-op rerun of the
     default workflow (target < 3 s; only where its results are complete);
@@ -56,7 +59,13 @@ from pathlib import Path
 
 from .breakdown import breakdown
 from .efficiency import efficiency_benchmark
-from .report import REFERENCE_TARGET, SOLVER_TARGET_MS, machine_info, markdown_report
+from .report import (
+    FIRST_CURVE_TARGET_SECONDS,
+    REFERENCE_TARGET,
+    SOLVER_TARGET_MS,
+    machine_info,
+    markdown_report,
+)
 from .shards import PAPER_CRITERION_C, SHARD_SETTINGS, run_shard
 
 SINGLE_THREAD = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
@@ -388,6 +397,75 @@ def distribution_benchmark():
     return {"rows": rows}
 
 
+FIRST_CURVE_RESTITUTIONS = (0.6, 0.95, 0.99)
+
+
+FIRST_CURVE_POINTS = 1000
+
+
+# a fresh process: solve (untimed), then time (CPU) the first P(x) curve over the span of P(x)
+# (1e-6 / q^2 to (22 / b)^2, b the large-x rate: docs/distribution.md) and a second one
+_FIRST_CURVE = """
+import json, sys, time
+import numpy as np
+from bouncing_ball import Equilibrium
+from bouncing_ball.asymptotics import large_speed_decay_rate
+r, points = float(sys.argv[1]), int(sys.argv[2])
+q = large_speed_decay_rate(r)
+b = q * np.sqrt(2.0 * (3.0 - 2.0 * q) / 3.0) if r > 0.5 else np.sqrt(2.0 / 3.0)
+x = np.geomspace(1e-6 / q**2, (22.0 / b) ** 2, points)
+eq = Equilibrium(r)
+eq.p0v(1.0)
+started = time.process_time()
+eq.px(x)
+first = time.process_time() - started
+started = time.process_time()
+eq.px(x)
+print(json.dumps({"first": first, "second": time.process_time() - started}))
+"""
+
+
+def _first_curve(r, environment):
+    output = subprocess.run(
+        [sys.executable, "-c", _FIRST_CURVE, repr(r), str(FIRST_CURVE_POINTS)],
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=REPOSITORY,
+        env=environment,
+    ).stdout
+    return json.loads(output.strip().splitlines()[-1])
+
+
+def first_curve_benchmark():
+    """The first P(x) curve of FIRST_CURVE_POINTS points at a new r after its solve (building
+    w(F) of eq. (weightfunc) and P(x) of eq. (P(x)1)), in CPU seconds of one core (BLAS pinned
+    to one thread, so a shared machine's load does not count), each in a fresh process: with numba's
+    on-disk cache cold (an empty NUMBA_CACHE_DIR: the compile is in the time) and warm (a
+    second process on the same cache), and the second curve in the same process."""
+    rows = []
+    for r in FIRST_CURVE_RESTITUTIONS:
+        with tempfile.TemporaryDirectory() as cache:
+            environment = {**os.environ, "NUMBA_CACHE_DIR": cache}
+            cold = _first_curve(r, environment)
+            warm = _first_curve(r, environment)
+        rows.append(
+            {
+                "r": r,
+                "points": FIRST_CURVE_POINTS,
+                "first_cold_seconds": cold["first"],
+                "first_warm_seconds": warm["first"],
+                "second_seconds": warm["second"],
+            }
+        )
+    worst = max(row["first_warm_seconds"] for row in rows)
+    return {
+        "rows": rows,
+        "worst_first_warm_seconds": worst,
+        "target_met": worst <= FIRST_CURVE_TARGET_SECONDS,
+    }
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(
         prog="python -m benchmarks",
@@ -452,6 +530,7 @@ def _full_benchmark(results, scaling):
             "efficiency": efficiency_benchmark(),
             "compile": compile_benchmark(),
             "distribution": distribution_benchmark(),
+            "first_curve": first_curve_benchmark(),
             "workflow": workflow_benchmark(),
         }
     )

@@ -19,6 +19,7 @@ import pandas as pd
 from scipy import integrate, special
 
 from .airy import check_force_integral_point, oscillating_airy_ai, scaled_airy_ai
+from .near_wall import distribution_near_wall, near_wall_points
 from .restitution import EXACT_RESTITUTIONS, parse_restitution
 
 __all__ = [
@@ -31,6 +32,7 @@ __all__ = [
     "position_moments",
     "weight_function",
     "distribution_by_force_integral",
+    "distribution_on_ray",
     "distribution_with_error",
     "distribution",
     "mean_speed_squared_given_position",
@@ -636,6 +638,116 @@ def distribution_by_force_integral(x, v, restitution):
     return value, error
 
 
+#: The angle of the ray of F of ``distribution_on_ray``, its step in ln |F| and its lower end.
+RAY_FORCE_ANGLE = 1.3
+
+
+RAY_FORCE_STEP = 0.05
+
+
+RAY_FORCE_LOWEST = -80.0
+
+
+def _log_weight_rest(force, restitution):
+    """ln w(F) + 1/(12 F) of eq. (weightfunc2) at complex F, Re F > 0."""
+    a = normalization_constant(restitution)
+    if _which(restitution) == Fraction(1, 2):
+        return np.log(0.5 * a) - 0.5 * np.log(force)
+    z = (1.0 / 12.0) / force
+    far = np.abs(z) > 1e4  # scipy's kve fails far out; its asymptotic series (DLMF 10.40.2)
+    near = np.where(far, 1.0, z)
+    mu, y = 4.0 / 36.0, 1.0 / (8.0 * np.where(far, z, 1.0))
+    series = 1.0 + (mu - 1.0) * y * (1.0 + (mu - 9.0) * y / 2.0 * (1.0 + (mu - 25.0) * y / 3.0))
+    bessel = np.where(
+        far,
+        0.5 * np.log(np.pi / (2.0 * np.where(far, z, 1.0))) + np.log(series),
+        np.log(special.kve(1.0 / 6.0, near)),
+    )
+    return np.log(np.sqrt(2.0 / (27.0 * np.pi)) * a) - 0.5 * np.log(force) + bessel
+
+
+def distribution_on_ray(x, v, restitution):
+    """P(x, v) of eqs. (fpsol), (psi), (weightfunc2), v > 0, by the F integral on a complex ray.
+
+    Any x >= 0, however fast the Airy factor oscillates on the real axis.
+    On the real axis Ai(z) = 2 Re[-omega Ai(omega z)], omega = e^(2 pi i / 3); for
+    z = -F^(1/3) v + F^(-2/3) / 4 the half -omega Ai(omega z) ~ e^(i (2/3) F^(1/2) v^(3/2)) decays
+    in the upper half F plane, and w(F) of eq. (weightfunc2) is analytic for Re F > 0, so its
+    integral is taken along F = t e^(i RAY_FORCE_ANGLE), t > 0 (with e^(-F x) the arc at
+    infinity vanishes for the angle below pi / 2; at F -> 0 the half grows like e^(1/(12 F)),
+    w falls like e^(-1/(12 F)), and their product, summed in one exponent, is bounded).  On
+    the ray the integrand does not oscillate and is no larger than the result, so nothing
+    cancels: the trapezoidal rule in ln t, step RAY_FORCE_STEP from ln t = RAY_FORCE_LOWEST to
+    where e^(-F x) or the half's decay reaches e^-80, is exact to the rounding of its terms: ~3e-13 relative at r = 1/2, and at r = 1/3 up to
+    4e-12 at v = 20 (against P(0, v) of eq. (P(0,v)) at x = 0, v = 1e-3 to 300 and 20, and
+    the real-axis integral where that works).
+
+    Parameters
+    ----------
+    x : array_like
+        Heights, x >= 0.
+    v : array_like
+        Outgoing velocities, 1e-3 <= v <= 300 at r = 1/2, <= 20 at r = 1/3; they broadcast
+        against ``x``.  (At r = 1/3 the ray's integrand near F = 0, ~e^(-v), cancels down to
+        P ~ e^(-3 v / 2): the rounding grows like e^(v / 2), 4e-7 at v = 40.)
+    restitution : float or str
+        r = 1/2 or 1/3, a float or a fraction string ("1/2", "1/3").
+
+    Returns
+    -------
+    numpy.ndarray
+        P(x, v), the broadcast shape; P(0, v) of eq. (P(0,v)) at x = 0.
+
+    Raises
+    ------
+    ValueError
+        If an x is negative or not finite, a v outside its range, or r not 1/2 or 1/3.
+
+    Examples
+    --------
+    At x = 0 it is eq. (P(0,v)), e^(-v) / (3 v) at r = 1/2; at x = 1e-5, v = 20 the real-axis
+    integral (``distribution_by_force_integral``) is out of reach:
+
+    >>> from bouncing_ball.exact import distribution_on_ray, outgoing_speed_density
+    >>> values = distribution_on_ray([0.0, 1e-5], 20.0, "1/2")
+    >>> print(values, outgoing_speed_density(20.0, "1/2"))
+    [3.43525604e-11 3.43525613e-11] 3.435256037397596e-11
+    """
+    _which(restitution)
+    x, v = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(v, dtype=float))
+    if np.any(~(x >= 0.0) | ~np.isfinite(x)):
+        raise ValueError("x: P(x, v) on the F ray needs finite heights x >= 0")
+    top_speed = 300.0 if _which(restitution) == Fraction(1, 2) else 20.0
+    if np.any(~(v >= 1e-3) | ~(v <= top_speed)):
+        raise ValueError(
+            f"v: P(x, v) on the F ray needs outgoing velocities 1e-3 <= v <= {top_speed:g} "
+            f"at r = {restitution}"
+        )
+    theta = RAY_FORCE_ANGLE
+    turn = np.exp(1j * theta)
+    omega = np.exp(2j * np.pi / 3.0)
+    out = np.empty(x.shape)
+    for index in np.ndindex(x.shape):
+        xi, vi = float(x[index]), float(v[index])
+        top = 2.0 * math.log(80.0 / ((2.0 / 3.0) * vi**1.5 * math.sin(0.5 * theta)))
+        if xi > 0.0:
+            top = min(top, math.log(80.0 / (xi * math.cos(theta))))
+        t = np.arange(RAY_FORCE_LOWEST, max(top, 0.0) + RAY_FORCE_STEP, RAY_FORCE_STEP)
+        force = np.exp(t) * turn
+        u = 4.0 * force * vi
+        power = (1.0 - u) * np.sqrt(1.0 - u)
+        # -(2/3) (omega z)^(3/2) - 1/(12 F) = ((1 - u)^(3/2) - 1) / (12 F), without the
+        # cancellation at small u (numpy's complex log1p loses it)
+        small = np.abs(u) < 0.5
+        exponent = np.where(small, (-3.0 * u + 3.0 * u * u - u**3) / (power + 1.0), power - 1.0)
+        exponent = exponent / (12.0 * force)
+        zeta = omega * 0.25 * force ** (-2.0 / 3.0) * (1.0 - u)
+        log_rest = _log_weight_rest(force, restitution) + exponent - force * xi - 0.5 * vi
+        terms = -omega * scaled_airy_ai(zeta) * np.exp(log_rest + (5.0 / 6.0) * np.log(force))
+        out[index] = 2.0 * RAY_FORCE_STEP * float(np.sum(terms.real))
+    return out
+
+
 def _force_integrals(x, v, restitution):
     """P(x, v) at the points x > 0 (1-d arrays x, v), eqs. (fpsol), (psi), (weightfunc2): the
     integrand of ``distribution_by_force_integral`` on the same range of ln F, all points at
@@ -683,7 +795,10 @@ def distribution_with_error(x, v, restitution):
     F integral of eqs. (fpsol), (psi), (weightfunc2) over the same range of ln F as
     ``distribution_by_force_integral``, to 1e-10 relative, every point at once by an adaptive
     21-point Gauss-Kronrod rule, each point's intervals bisected on its own
-    (``_force_integrals``).
+    (``_force_integrals``); next to the floor at large v > 0, where that integral oscillates
+    too fast (x < 1.7e-8 v^3, ``near_wall.near_wall_points``), the Taylor series in x of
+    eq. (fp) from eq. (P(0,v)) (``near_wall.distribution_near_wall``, to ~1e-13 of
+    ``distribution_on_ray``).
 
     Parameters
     ----------
@@ -715,17 +830,22 @@ def distribution_with_error(x, v, restitution):
     [0.12262648 0.03065662 0.0471541 ] True
     """
     x, v = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(v, dtype=float))
+    near = near_wall_points(x, v)
     for index in np.ndindex(x.shape):
-        if x[index] != 0.0:
+        if x[index] != 0.0 and not near[index]:
             check_force_integral_point(float(x[index]), float(v[index]))
     values, errors = np.empty(x.shape), np.zeros(x.shape)
     r = float(_which(restitution))
+    if near.any():
+        values[near], errors[near] = distribution_near_wall(
+            x[near], v[near], lambda speeds: outgoing_speed_density(speeds, restitution), r
+        )
     wall = x == 0.0
     outgoing, incoming = wall & (v > 0.0), wall & (v < 0.0)
     values[outgoing] = outgoing_speed_density(v[outgoing], restitution)
     values[incoming] = r * r * outgoing_speed_density(-r * v[incoming], restitution)
     values[wall & (v == 0.0)] = np.nan
-    inside = ~wall
+    inside = ~wall & ~near
     values[inside], errors[inside] = _force_integrals(x[inside], v[inside], restitution)
     return values, errors
 

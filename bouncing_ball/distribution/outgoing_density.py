@@ -170,7 +170,7 @@ class _OutgoingDensity:
     largest: float  # P(0, v) is trusted up to here
     panel_edges: np.ndarray  # in s = ln v + v^(1/2)
     coefficients: np.ndarray  # Chebyshev coefficients of ln P + beta ln v + q v, per panel
-    nodes: np.ndarray  # u grid of the complex Nystrom sum
+    nodes: np.ndarray  # u grid of the complex Nystrom sum (empty where r > RAY_RESTITUTION)
     log_weights: np.ndarray  # ln(weight u P(0, u))
     remainder: float  # closed-form part of the lower tail, times P(0, u_0)
     # P(0, v) on the ray arg v = RAY_ANGLE where r > RAY_RESTITUTION (``_RayDensity``), else None
@@ -303,6 +303,11 @@ class _OutgoingDensity:
         magnitudes of its terms (rounding errors are ~1e-16 of it: at complex v the terms
         cancel, increasingly so as Im(v)^2 / Re(v) grows).  ``slack``: per v, the e-folds by
         which its result may be less accurate (``_complex_kernel_sums``; none if None)."""
+        if self.ray is not None:
+            raise ValueError(
+                f"r = {self.restitution}: above RAY_RESTITUTION, A(F) is taken on the ray "
+                "and P(0, v) has no wedge grid (use ray.log_density)"
+            )
         v = np.ascontiguousarray(np.asarray(v, dtype=complex).ravel())
         slack = np.zeros(v.size) if slack is None else np.ascontiguousarray(slack, dtype=float)
         r = self.restitution
@@ -361,6 +366,12 @@ def _evaluate_wedge_cell(cell, key, origin, sigma, theta, v, beta, with_noise=Tr
     return value, np.abs(value) * spread
 
 
+#: Above this s = ln v + v^(1/2), the real-axis Chebyshev panels of ``_outgoing_density`` are
+#: twice ``panel_width`` wide: there they hold ln P(0, v) to 1.1e-13 of the Nystrom formula
+#: at r = 0.25 and 0.99 (as panels 1 wide do; 2 wide below s = 0 they reach only 2e-11).
+REAL_PANEL_GRADE = 5.0
+
+
 def _outgoing_density(solution, panel_width=1.0, panel_order=20) -> _OutgoingDensity:
     r = solution.restitution
     beta = solution.small_speed_exponent
@@ -370,8 +381,14 @@ def _outgoing_density(solution, panel_width=1.0, panel_order=20) -> _OutgoingDen
     log_amplitude = float(np.log(solution.outgoing_speed_density(u0)) + beta * np.log(u0))
     # Chebyshev panels in s for ln P + beta ln v + q v (smooth, O(1))
     s_lo, s_hi = coordinate_of_speed(u0), coordinate_of_speed(largest)
-    count = max(1, int(np.ceil((s_hi - s_lo) / panel_width)))
-    edges = np.linspace(s_lo, s_hi, count + 1)
+    # twice as wide above s = REAL_PANEL_GRADE (v ~ 7), where ln P + beta ln v + q v is smoother
+    s_mid = min(max(REAL_PANEL_GRADE, s_lo), s_hi)
+    low = max(1, int(np.ceil((s_mid - s_lo) / panel_width))) if s_mid > s_lo else 0
+    high = int(np.ceil((s_hi - s_mid) / (2.0 * panel_width))) if s_hi > s_mid else 0
+    edges = np.unique(
+        np.concatenate([np.linspace(s_lo, s_mid, low + 1), np.linspace(s_mid, s_hi, high + 1)])
+    )
+    count = edges.size - 1
     cheb = np.cos(np.pi * (np.arange(panel_order) + 0.5) / panel_order)
     s = 0.5 * (edges[:-1, None] + edges[1:, None]) + 0.5 * np.diff(edges)[:, None] * cheb[None, :]
     v = speed_of_coordinate(s.ravel())
@@ -382,6 +399,22 @@ def _outgoing_density(solution, panel_width=1.0, panel_order=20) -> _OutgoingDen
             for row in smooth.reshape(count, panel_order)
         ]
     )
+    if r > RAY_RESTITUTION:
+        # A(F) is taken on the ray (``_ray_density``): no wedge, no complex Nystrom sum
+        return _OutgoingDensity(
+            r,
+            beta,
+            q,
+            log_amplitude,
+            u0,
+            largest,
+            edges,
+            coefficients,
+            np.empty(0),
+            np.empty(0),
+            np.nan,
+            _ray_density(solution),
+        )
     # the u grid of the complex Nystrom sum: the solver's rule, REFINE times finer
     step = solution.step / REFINE
     s0 = coordinate_of_speed(u0)
@@ -403,7 +436,6 @@ def _outgoing_density(solution, panel_width=1.0, panel_order=20) -> _OutgoingDen
         / -np.expm1(-alpha * step)
         * main_density[0]
     )
-    ray = _ray_density(solution) if r > RAY_RESTITUTION else None
     return _OutgoingDensity(
         r,
         beta,
@@ -416,7 +448,7 @@ def _outgoing_density(solution, panel_width=1.0, panel_order=20) -> _OutgoingDen
         nodes,
         log_weights,
         remainder,
-        ray,
+        None,
     )
 
 

@@ -15,9 +15,13 @@ from scipy import integrate, special
 from ..airy import (
     LARGEST_AIRY_PHASE,
     check_force_integral_point,
-    force_integral_phase,
     oscillating_airy_ai,
     scaled_airy_ai,
+)
+from ..near_wall import (
+    distribution_near_wall,
+    distribution_near_wall_cell_average,
+    near_wall_points,
 )
 from .position import _total_decay
 
@@ -270,7 +274,9 @@ def distribution_by_force_rule(x, speeds, weight):
 CELL_SPEED_NODES = 8
 
 
-def distribution_cell_average(x_lo, x_hi, v_lo, v_hi, weight, speed_nodes=CELL_SPEED_NODES):
+def distribution_cell_average(
+    x_lo, x_hi, v_lo, v_hi, weight, speed_nodes=CELL_SPEED_NODES, outgoing=None
+):
     """The average of P(x, v) of eq. (fpsol) over a cell, as a simulation's histogram measures it.
 
     (1 / area) int_{x_lo}^{x_hi} dx int_{v_lo}^{v_hi} dv P(x, v), for broadcast arrays of cells
@@ -294,6 +300,12 @@ def distribution_cell_average(x_lo, x_hi, v_lo, v_hi, weight, speed_nodes=CELL_S
         ``closed_form_weight_function``).
     speed_nodes : int, optional
         Gauss-Legendre nodes per panel in v (``CELL_SPEED_NODES``).
+    outgoing : callable, optional
+        P(0, v) at an array of v > 0 (``solver.OutgoingSpeedSolution.outgoing_speed_density``,
+        or an exact P(0, v)).  Given, the part of a cell at speeds above those the F integral
+        reaches at x_lo, v > v_c(x_lo) = (x_lo / 1.7e-8)^(1/3) (``airy.LARGEST_AIRY_PHASE``),
+        is averaged from the near-wall series (``near_wall.distribution_near_wall_cell_average``),
+        which needs x_hi <= 60 x_lo there; without it such a cell is refused.
 
     Returns
     -------
@@ -303,8 +315,9 @@ def distribution_cell_average(x_lo, x_hi, v_lo, v_hi, weight, speed_nodes=CELL_S
     Raises
     ------
     ValueError
-        If a cell is not 0 < x_lo < x_hi < inf with finite v_lo < v_hi, or reaches an x and
-        v > 0 at which the F integral oscillates too fast (``LARGEST_AIRY_PHASE``).
+        If a cell is not 0 < x_lo < x_hi < inf with finite v_lo < v_hi; or reaches an x and
+        v > 0 at which the F integral oscillates too fast (``LARGEST_AIRY_PHASE``) without
+        ``outgoing``, or with it at x_hi > 60 x_lo or where the near-wall series refuses.
 
     Examples
     --------
@@ -321,41 +334,72 @@ def distribution_cell_average(x_lo, x_hi, v_lo, v_hi, weight, speed_nodes=CELL_S
     )
     if np.any(~(x_lo > 0.0) | ~(x_hi > x_lo) | ~(v_hi > v_lo) | ~np.isfinite(x_hi + v_lo + v_hi)):
         raise ValueError("cells need 0 < x_lo < x_hi < inf and finite v_lo < v_hi")
-    if np.any(force_integral_phase(x_lo, v_hi) > LARGEST_AIRY_PHASE):
+    # the speed up to which the F integral reaches at x_lo: phase (2/3) (60 / x)^(1/2) v^(3/2)
+    reach = (LARGEST_AIRY_PHASE / ((2.0 / 3.0) * np.sqrt(60.0 / x_lo))) ** (2.0 / 3.0)
+    beyond = v_hi > reach
+    if np.any(beyond) and outgoing is None:
         raise ValueError(
             "x_lo: a cell reaches an x and v > 0 at which the F integral of eq. (fpsol) "
-            "oscillates too fast to evaluate (check_force_integral_point)"
+            "oscillates too fast to evaluate (check_force_integral_point); give outgoing, "
+            "P(0, v), for the near-wall series there"
         )
-    nodes, node_weights = np.polynomial.legendre.leggauss(speed_nodes)
+    if np.any(beyond & (x_hi > 60.0 * x_lo)):
+        raise ValueError(
+            "x_hi: a cell reaching speeds beyond the F integral's at x_lo needs "
+            "x_hi <= 60 x_lo (the near-wall series holds for x <= 1e-6 v^3)"
+        )
     result = np.empty(x_lo.shape)
     for index in np.ndindex(x_lo.shape):
-        lo, width = float(x_lo[index]), float(x_hi[index] - x_lo[index])
-        lower, upper = _force_range(weight, lo)
-        panels = int(np.ceil((v_hi[index] - v_lo[index]) / lo ** (1.0 / 3.0)))
-        edges = np.linspace(v_lo[index], v_hi[index], panels + 1)
+        lo, hi = float(x_lo[index]), float(x_hi[index])
+        a, b, c = float(v_lo[index]), float(v_hi[index]), float(reach[index])
         total = 0.0
-        for a, b in zip(edges[:-1], edges[1:]):
-            for node, node_weight in zip(nodes, node_weights):
-                value, *_ = integrate.quad(
-                    _distribution_integrand,
-                    lower,
-                    upper,
-                    args=(lo, float(0.5 * (a + b) + 0.5 * (b - a) * node), weight, width),
-                    limit=2000,
-                    epsabs=0.0,
-                    epsrel=1e-10,
-                    full_output=1,
-                )
-                total += 0.5 * (b - a) * node_weight * value
-        result[index] = total / (v_hi[index] - v_lo[index])
+        if a < c:
+            total += (min(b, c) - a) * _force_cell_average(
+                lo, hi, a, min(b, c), weight, speed_nodes
+            )
+        if b > c:
+            start = max(a, c)
+            near, _ = distribution_near_wall_cell_average(
+                lo, hi, start, b, outgoing, weight.restitution
+            )
+            total += (b - start) * near
+        result[index] = total / (b - a)
     return result
+
+
+def _force_cell_average(x_lo, x_hi, v_lo, v_hi, weight, speed_nodes):
+    """The cell average of P(x, v) by the F integral of eq. (fpsol)
+    (``distribution_cell_average``), one cell whose speeds the F integral reaches."""
+    nodes, node_weights = np.polynomial.legendre.leggauss(speed_nodes)
+    lo, width = x_lo, x_hi - x_lo
+    lower, upper = _force_range(weight, lo)
+    panels = int(np.ceil((v_hi - v_lo) / lo ** (1.0 / 3.0)))
+    edges = np.linspace(v_lo, v_hi, panels + 1)
+    total = 0.0
+    for a, b in zip(edges[:-1], edges[1:]):
+        for node, node_weight in zip(nodes, node_weights):
+            value, *_ = integrate.quad(
+                _distribution_integrand,
+                lower,
+                upper,
+                args=(lo, float(0.5 * (a + b) + 0.5 * (b - a) * node), weight, width),
+                limit=2000,
+                epsabs=0.0,
+                epsrel=1e-10,
+                full_output=1,
+            )
+            total += 0.5 * (b - a) * node_weight * value
+    return total / (v_hi - v_lo)
 
 
 def distribution_with_error(x, v, weight, solution):
     """P(x, v) and an estimate of its absolute error, for broadcast arrays x >= 0 and v.
 
     x > 0: eq. (fpsol) by the F integral, every v at one x by one fixed rule
-    (``distribution_by_force_rule``).  x = 0: the outgoing side is the
+    (``distribution_by_force_rule``), except next to the floor at large v > 0, where its Airy
+    factor oscillates too fast (x < 1.7e-8 v^3, ``near_wall.near_wall_points``): there the
+    Taylor series in x of eq. (fp) from the solver's P(0, v)
+    (``near_wall.distribution_near_wall``).  x = 0: the outgoing side is the
     solver's P(0, v), the incoming side the boundary condition eq. (bc),
     P(0, -v) = r^2 P(0, r v); P(0, 0) diverges and is NaN.
 
@@ -367,20 +411,22 @@ def distribution_with_error(x, v, weight, solution):
         w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
         ``closed_form_weight_function``).
     solution : solver.OutgoingSpeedSolution
-        P(0, v) of eq. (inteq), used at x = 0 only (evaluating it there compiles the kernel on
-        its first call).
+        P(0, v) of eq. (inteq), used at x = 0 and by the near-wall series (evaluating it
+        compiles the kernel on its first call).
 
     Returns
     -------
     values : numpy.ndarray
         P(x, v), the broadcast shape.
     errors : numpy.ndarray
-        Estimates of their absolute errors (``distribution_by_force_rule``; 0 at x = 0).
+        Estimates of their absolute errors (``distribution_by_force_rule``, or
+        ``near_wall.distribution_near_wall``; 0 at x = 0).
 
     Raises
     ------
     ValueError
-        Before any integral, as ``check_force_integral_point`` for each (x, v) with x != 0.
+        Before any integral, for an x < 0 or NaN (``check_force_integral_point``); as
+        ``near_wall.distribution_near_wall`` for a point next to the floor.
 
     Examples
     --------
@@ -402,11 +448,16 @@ def distribution_with_error(x, v, weight, solution):
     [0.07568971 0.04549126] True
     """
     x, v = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(v, dtype=float))
+    near = near_wall_points(x, v)
     for index in np.ndindex(x.shape):
-        if x[index] != 0.0:
+        if x[index] != 0.0 and not near[index]:
             check_force_integral_point(float(x[index]), float(v[index]))
     values, errors = np.empty(x.shape), np.zeros(x.shape)
     r = solution.restitution
+    if near.any():
+        values[near], errors[near] = distribution_near_wall(
+            x[near], v[near], solution.outgoing_speed_density, r
+        )
     for index in np.ndindex(x.shape):
         xi, vi = float(x[index]), float(v[index])
         if xi == 0.0:
@@ -417,8 +468,8 @@ def distribution_with_error(x, v, weight, solution):
             else:
                 values[index] = np.nan
     # x > 0: every v at one x by one fixed rule in ln F (w(F) evaluated once for them all)
-    for xi in np.unique(x[x > 0.0]):
-        at = x == xi
+    for xi in np.unique(x[(x > 0.0) & ~near]):
+        at = (x == xi) & ~near
         values[at], errors[at] = distribution_by_force_rule(xi, v[at], weight)
     return values, errors
 
@@ -434,7 +485,8 @@ def distribution(x, v, weight, solution):
         w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
         ``closed_form_weight_function``).
     solution : solver.OutgoingSpeedSolution
-        P(0, v) of eq. (inteq), used at x = 0 only (``distribution_with_error``).
+        P(0, v) of eq. (inteq), used at x = 0 and next to the floor at large v
+        (``distribution_with_error``).
 
     Returns
     -------
@@ -444,7 +496,7 @@ def distribution(x, v, weight, solution):
     Raises
     ------
     ValueError
-        As ``check_force_integral_point`` for each (x, v) with x != 0.
+        As ``distribution_with_error``.
 
     Examples
     --------

@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from ..asymptotics import small_speed_exponent
-from .outgoing_density import _panels
+from .outgoing_density import _GL_W, _GL_X
 from .weight_function import _log_sum, small_force_decay
 
 __all__ = [
@@ -75,17 +75,10 @@ SMALLEST_WEIGHT_FORCE = 2e-4
 LARGEST_LOG_FORCE = 690.0
 
 
-def _force_nodes(weight, power, x):
-    """Gauss-Legendre nodes ln F and ln of their weights for int dF F^(-1/2 - power) w(F)
-    e^(-1/(12F) - F x) at one x >= 0, the factor F^(1/2 - power) w e^(-1/(12F)) dF/dlnF folded
-    into the weights.  The nodes depend on x alone, so a result never depends on the other
-    points of an array.  At x > 0 they span the FORCE_EFOLDS e-folds of e^(-(S + 1/12)/F - F x)
-    about its saddle F_s = ((S + 1/12) / x)^(1/2) (out to F = FORCE_EFOLDS / x at small x, where
-    w is its power law, so P(x) follows its small-x law, docs/distribution.md); at x = 0 (the
-    moments, power >= 1; P(0) where beta < 1) out to where the power law
-    F^((beta - 1)/3 - power) has fallen by e^-FORCE_EFOLDS beyond F = 1e24, but no further
-    than F = e^LARGEST_LOG_FORCE (where F stays a double), the power law's tail beyond summed in
-    closed form as one more node (its F is never multiplied by an x > 0)."""
+def _force_plan(weight, power, x):
+    """The panels of ``_force_nodes`` at one x: (width, first, last, tail), the panels
+    [k width, (k + 1) width] for first <= k < last and the power-law tail's decay (None at
+    x > 0)."""
     total = _total_decay(weight)
     tail = None
     if x > 0.0:
@@ -105,24 +98,69 @@ def _force_nodes(weight, power, x):
     first, last = math.floor(lo / width), math.ceil(hi / width)
     if tail is not None:
         last = math.floor(hi / width)
-    y, wy = _panels(first * width, last * width, width)
-    log_wy = np.log(wy)
-    if tail is not None:  # int_end^inf dy e^(f(end) - decay (y - end)) = e^f(end) / decay
-        y, log_wy = np.append(y, last * width), np.append(log_wy, -math.log(tail))
+    return width, first, last, tail
+
+
+def _panel_nodes(weight, power, width, first, last):
+    """ln F of the Gauss-Legendre nodes on the panels [k width, (k + 1) width],
+    first <= k < last (each node a function of k and width alone), F, and ln of the weights
+    with F^(1/2 - power) w e^(-1/(12F)) dF/dlnF folded in."""
+    k = np.arange(first, last, dtype=float)[:, None]
+    y = ((k + 0.5) * width + (0.5 * width) * _GL_X[None, :]).ravel()
+    log_wy = np.log(0.5 * width * np.broadcast_to(_GL_W, (last - first, _GL_W.size)).ravel())
     force = np.exp(y)
-    log_weights = log_wy + (0.5 - power) * y + weight.log(force) - 1.0 / (12.0 * force)
+    return y, force, log_wy + (0.5 - power) * y + weight.log(force) - 1.0 / (12.0 * force)
+
+
+def _with_tail(weight, power, width, last, tail, y, force, log_weights):
+    # int_end^inf dy e^(f(end) - decay (y - end)) = e^f(end) / decay, one more node at the end
+    end = last * width
+    f_end = math.exp(end)
+    log_end = (0.5 - power) * end + float(weight.log(np.array([f_end]))[0]) - 1.0 / (12.0 * f_end)
+    return np.append(force, f_end), np.append(log_weights, log_end - math.log(tail))
+
+
+def _force_nodes(weight, power, x):
+    """Gauss-Legendre nodes ln F and ln of their weights for int dF F^(-1/2 - power) w(F)
+    e^(-1/(12F) - F x) at one x >= 0, the factor F^(1/2 - power) w e^(-1/(12F)) dF/dlnF folded
+    into the weights.  The nodes depend on x alone (each panel's on its place on a grid fixed
+    by x: ``_force_plan``), so a result never depends on the other points of an array.  At
+    x > 0 they span the FORCE_EFOLDS e-folds of e^(-(S + 1/12)/F - F x) about its saddle
+    F_s = ((S + 1/12) / x)^(1/2) (out to F = FORCE_EFOLDS / x at small x, where w is its power
+    law, so P(x) follows its small-x law, docs/distribution.md); at x = 0 (the moments,
+    power >= 1; P(0) where beta < 1) out to where the power law F^((beta - 1)/3 - power) has
+    fallen by e^-FORCE_EFOLDS beyond F = 1e24, but no further than F = e^LARGEST_LOG_FORCE
+    (where F stays a double), the power law's tail beyond summed in closed form as one more
+    node (its F is never multiplied by an x > 0)."""
+    width, first, last, tail = _force_plan(weight, power, x)
+    _, force, log_weights = _panel_nodes(weight, power, width, first, last)
+    if tail is not None:
+        force, log_weights = _with_tail(weight, power, width, last, tail, None, force, log_weights)
     return force, log_weights
 
 
 def _log_laplace(weight, power, x):
     """ln int dF F^(-1/2 - power) w(F) exp(-1/(12F) - F x), for an array x >= 0, each x on its
-    own nodes (``_force_nodes``): finite where the integral itself under- or overflows."""
+    own nodes (``_force_nodes``): finite where the integral itself under- or overflows.  The
+    points with the same panel width share one evaluation of w at the union of their panels
+    (a node's value depends on its panel alone, so each result is that of ``_force_nodes``)."""
     x = np.asarray(x, dtype=float)
     flat = x.ravel()
     out = np.empty(flat.size)
-    for index, point in enumerate(flat):
-        force, log_weights = _force_nodes(weight, power, float(point))
-        out[index] = _log_sum(log_weights - point * force)[0]
+    plans = [_force_plan(weight, power, float(point)) for point in flat]
+    count = _GL_X.size
+    for width in {plan[0] for plan in plans}:
+        members = [i for i, plan in enumerate(plans) if plan[0] == width]
+        lowest = min(plans[i][1] for i in members)
+        highest = max(plans[i][2] for i in members)
+        _, force, log_weights = _panel_nodes(weight, power, width, lowest, highest)
+        for i in members:
+            _, first, last, tail = plans[i]
+            chosen = slice((first - lowest) * count, (last - lowest) * count)
+            f, lw = force[chosen], log_weights[chosen]
+            if tail is not None:
+                f, lw = _with_tail(weight, power, width, last, tail, None, f, lw)
+            out[i] = _log_sum(lw - flat[i] * f)[0]
     return out.reshape(x.shape)
 
 

@@ -402,7 +402,11 @@ class EquilibriumBase(abc.ABC):
 
         At x > 0 each value is good to ``distribution.DISTRIBUTION_NOISE`` (1e-10) of the
         largest P(x, v) at that x (the F integral's Airy factor cancels); at x = 0 it is
-        ``p0v``'s.
+        ``p0v``'s.  Next to the floor at large v > 0, where the F integral oscillates too fast
+        (x < 1.7e-8 v^3, ``near_wall.near_wall_points``), P(x, v) is the Taylor series in x
+        of eq. (fp) from P(0, v) (``near_wall.distribution_near_wall``): good to 1e-11 of
+        itself besides P(0, v)'s own error (to ~1e-13 against the exact r = 1/2 and 1/3
+        solutions).
 
         Parameters
         ----------
@@ -410,24 +414,24 @@ class EquilibriumBase(abc.ABC):
             Heights: x = 0 or ``distribution.SMALLEST_POSITION`` (1e-300) <= x <=
             ``distribution.LARGEST_POSITION`` (1e12).
         v : array_like
-            Velocities (either sign), finite, broadcast against ``x``.  At x > 0 and v > 0 the
-            F integral's Airy factor oscillates, and P(x, v) is computed only where its phase
-            stays below ``airy.LARGEST_AIRY_PHASE`` (x >= 60 (v^(3/2) / 6e4)^2: x >= 1e-4 up to
-            v = 18).  Beyond ``distribution.LARGEST_VELOCITY`` (1e6) in |v|, P(x, v) is 0 to
+            Velocities (either sign), finite, broadcast against ``x``: every (x, v) of the
+            domain (the F integral where its Airy phase stays below
+            ``airy.LARGEST_AIRY_PHASE``, x >= 1.7e-8 v^3 at v > 0, the near-wall series
+            below).  Beyond ``distribution.LARGEST_VELOCITY`` (1e6) in |v|, P(x, v) is 0 to
             every double and 0 is returned.
 
         Returns
         -------
         numpy.ndarray or numpy.float64
-            P(x, v), the broadcast shape; inf at x = v = 0, where P(0, v) diverges; 0 where it
-            underflows.
+            P(x, v), the broadcast shape; inf at x = v = 0, the true value where beta > 0
+            (P(0, v) ~ v^-beta diverges as v -> 0, eq. (asym1)); 0 where it underflows.
 
         Raises
         ------
         ValueError
-            Naming x or v and the bound: x outside its domain, NaN or inf in either, or an
-            (x, v > 0) at which the Airy phase is too large
-            (``airy.check_force_integral_point``).
+            Naming x or v and the bound: x outside its domain, NaN or inf in either, or a
+            point next to the floor whose near-wall series misses its tolerance
+            (``near_wall.NEAR_WALL_TOLERANCE``; not met with the solver's P(0, v)).
 
         Examples
         --------
@@ -812,14 +816,16 @@ class EquilibriumBase(abc.ABC):
 
         ``distribution.distribution_cell_average`` of ``weight_function``: the x average in
         closed form under the F integral, the v average by Gauss-Legendre on panels no wider
-        than x_lo^(1/3); good to 1e-9 for x_lo >= 0.01.
+        than x_lo^(1/3); good to 1e-9 for x_lo >= 0.01.  The part of a cell at speeds the F
+        integral does not reach at x_lo (v > (x_lo / 1.7e-8)^(1/3)) is averaged from the
+        near-wall series of eq. (fp) (``near_wall.distribution_near_wall_cell_average``).
 
         Parameters
         ----------
         x_lo, x_hi, v_lo, v_hi : array_like
             The cells' edges, 0 < x_lo < x_hi <= ``distribution.LARGEST_POSITION`` and finite
-            v_lo < v_hi; they broadcast.  A cell must not reach an x and v > 0 at which the F
-            integral's Airy factor oscillates too fast (as ``pxv``).
+            v_lo < v_hi; they broadcast.  A cell reaching speeds beyond the F integral's at
+            x_lo needs x_hi <= 60 x_lo (the near-wall series holds up to x = 1e-6 v^3).
 
         Returns
         -------
@@ -857,7 +863,7 @@ class EquilibriumBase(abc.ABC):
         x_lo, x_hi, v_lo, v_hi = np.broadcast_arrays(x_lo, x_hi, v_lo, v_hi)
         with self._paper_bounds():
             average = distribution.distribution_cell_average(
-                x_lo, x_hi, v_lo, v_hi, self.weight_function
+                x_lo, x_hi, v_lo, v_hi, self.weight_function, outgoing=self._outgoing
             )
         return _out(self._physical(average, "phase_space_density"))
 

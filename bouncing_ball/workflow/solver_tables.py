@@ -571,11 +571,12 @@ def distribution_frame(weight, solution, positions, speeds):
         w(F) of eq. (weightfunc) (``interpolated_weight_function``, or
         ``closed_form_weight_function``).
     solution : solver.OutgoingSpeedSolution
-        P(0, v) of eq. (inteq), used at x = 0 only (``distribution_with_error``).
+        P(0, v) of eq. (inteq), used at x = 0 and next to the floor at large v, where the F
+        integral oscillates too fast (``distribution_with_error``).
     positions : array_like
         Heights x >= 0.
     speeds : array_like
-        Velocities v.
+        Velocities v: any, at every x (the near-wall series of eq. (fp) where x < 1.7e-8 v^3).
 
     Returns
     -------
@@ -583,12 +584,12 @@ def distribution_frame(weight, solution, positions, speeds):
         Long format: columns x, v and pxv, x varying slowest.
     worst : float
         The largest estimated relative error of a positive P(x, v) of the table
-        (``distribution_by_force_rule``).
+        (``distribution_by_force_rule``, ``near_wall.distribution_near_wall``).
 
     Raises
     ------
     ValueError
-        As ``check_force_integral_point`` for each (x, v) with x != 0.
+        As ``distribution_with_error``.
 
     Examples
     --------

@@ -142,6 +142,26 @@ def fake_results(hand_tuned=True, scaling=False):
                 }
             ]
         },
+        "first_curve": {
+            "rows": [
+                {
+                    "r": 0.6,
+                    "points": 1000,
+                    "first_cold_seconds": 1.5,
+                    "first_warm_seconds": 0.5,
+                    "second_seconds": 0.02,
+                },
+                {
+                    "r": 0.99,
+                    "points": 1000,
+                    "first_cold_seconds": 3.0,
+                    "first_warm_seconds": 1.5,
+                    "second_seconds": 0.02,
+                },
+            ],
+            "worst_first_warm_seconds": 1.5,
+            "target_met": False,
+        },
         "workflow": {
             "grid_shard_jobs": 320,
             "grid_dry_run_seconds": 4.0,
@@ -218,6 +238,9 @@ def test_the_report_has_a_table_per_measurement_with_its_values():
         "40.0 +- 14.1",
         ">= 4: met",
     ]
+    first = next(table for table in tables if "first, warm cache CPU s" in table[0])
+    assert first[1] == ["0.6", "1000", "1.50", "0.50", "0.020", "<= 1 s: met"]
+    assert first[2] == ["0.99", "1000", "3.00", "1.50", "0.020", "<= 1 s: MISSED"]
     workflow = next(table for table in tables if table[0][1:] == ["seconds", "target"])
     assert workflow[1] == ["dry run of 20 r x 16 shards (320 shard jobs)", "4.0", "< 5 s: met"]
     assert workflow[2][2] == "not measured: its results are not complete"

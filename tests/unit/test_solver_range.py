@@ -103,19 +103,20 @@ def test_negative_speeds_are_refused():
 
 
 @pytest.mark.parametrize(("x", "v"), [(1e-8, 2.0), (1e-9, 2.0), (1e-6, 6.0)])
-def test_heights_below_the_reach_of_the_force_integral_are_refused(x, v):
+def test_heights_below_the_reach_of_the_force_integral_take_the_near_wall_series(x, v):
     """exact.distribution(1e-8, 2, 1/2) gave -0.418 and distribution.distribution(1e-9, 2, ...)
     0.0509 (the true value is near P(0, 2) = 0.02256): there the F integral of eq. (fpsol)
-    oscillates too fast on the outgoing side.  Refused, naming x; at v <= 0 it converges and
-    is computed, and at (1e-7, 1) it is still P(0, v) to 1e-6."""
+    oscillates too fast on the outgoing side.  The F integral itself refuses, naming x; P(x, v)
+    there is the near-wall series of eq. (fp), the exact P(x, v) on the rotated F ray to 1e-12;
+    at v <= 0 the F integral converges and is computed."""
     with pytest.raises(ValueError, match=f"x = {x}: at v = {v}"):
-        exact.distribution(x, v, 0.5)
+        exact.distribution_by_force_integral(x, v, 0.5)
     with pytest.raises(ValueError, match=f"x = {x}: at v = {v}"):
-        distribution.distribution(x, v, None, None)
+        distribution.distribution_by_force_rule(x, [v], None)
+    near_floor = exact.distribution(x, v, 0.5) / exact.distribution_on_ray(x, v, 0.5)
+    assert abs(near_floor - 1.0) < 1e-12
     at_rest = exact.distribution(x, -0.5, 0.5)
     assert np.isfinite(at_rest) and at_rest > 0.0
-    near_floor = exact.distribution(1e-7, 1.0, 0.5) / exact.outgoing_speed_density(1.0, 0.5)
-    assert abs(near_floor - 1.0) < 1e-6
 
 
 def test_the_kernel_constants_have_one_home():
