@@ -87,7 +87,7 @@ with job_log(snakemake.log[0], exit_when_done=True):
     logging.info(
         "r=%s: w(F), P(x), P(x, v) in %.1f s; from P(x): int P dx - 1 = %.1e, <x> = %.10g, "
         "Delta x = %.10g (Ito: %.10g, %.10g); w(F) interpolation error estimate %.1e; "
-        "P(x, v) quadrature error estimate %.1e; "
+        "P(x, v) quadrature error estimate %.1e of the peak at its x; "
         "large-x decay rate %.6g (predicted %.6g), power %.4g (predicted %.4g)",
         label,
         time.perf_counter() - started_distribution,

@@ -525,7 +525,8 @@ def joint_distribution_figure(panels):
     """Fig. 8 (past the paper, the paper's Fig. 3 for any r): P(x, v) against v at several x
     from the solver, eqs. (fpsol), (weightfunc), (P(x)1); the simulation's time-weighted
     cells of the x bin holding each x (points, one-sigma errors); the exact curve where r is
-    1/2 or 1/3 (eq. (weightfunc2)).
+    1/2 or 1/3 (eq. (weightfunc2)); over the velocities where some curve is above 1e-3 of the
+    tallest.
 
     ``panels``: dicts with ``restitution``, ``solver`` (x, v, pxv), ``simulated``
     (x_lo, x_hi, v_lo, v_hi, pxv, pxv_err) and ``exact`` (x, v, pxv, or None).
@@ -565,7 +566,13 @@ def joint_distribution_figure(panels):
         if panel.get("exact") is not None:
             axis.plot([], [], color="k", linestyle=":", linewidth=0.9, label="exact")
         axis.set_ylim(0.0, 1.15 * top if top > 0 else None)
-        axis.set_xlim(solver.v.min(), solver.v.max())
+        # the velocities where some curve is above 1e-3 of the tallest: the body of P(x, v)
+        # on a linear axis (the table spans the scales of r, its tails far below)
+        body = solver[(solver.x > 0) & (solver.pxv >= 1e-3 * top)].v
+        shown = (
+            (body.min(), body.max()) if len(body) and top > 0 else (solver.v.min(), solver.v.max())
+        )
+        axis.set_xlim(*shown)
         axis.set_xlabel(r"$v$")
         axis.set_ylabel(r"$P(x, v)$")
         panel_title(axis, restitution_text(panel["restitution"]))

@@ -583,8 +583,11 @@ def distribution_frame(weight, solution, positions, speeds):
     table : pandas.DataFrame
         Long format: columns x, v and pxv, x varying slowest.
     worst : float
-        The largest estimated relative error of a positive P(x, v) of the table
-        (``distribution_by_force_rule``, ``near_wall.distribution_near_wall``).
+        The largest estimated error of the table's P(x, v) (``distribution_by_force_rule``,
+        ``near_wall.distribution_near_wall``) relative to the largest finite P(x, v) at its x:
+        the measure of the stated accuracy, ``distribution.DISTRIBUTION_NOISE`` (the table
+        spans r's scales, and a far-tail value far below the peak has a large relative error
+        of no consequence).
 
     Raises
     ------
@@ -621,7 +624,9 @@ def distribution_frame(weight, solution, positions, speeds):
     x, v = np.meshgrid(np.asarray(positions, dtype=float), speeds, indexing="ij")
     pxv, error = distribution_with_error(x, v, weight, solution)
     finite = np.isfinite(pxv) & (pxv > 0.0)
-    worst = float(np.max(error[finite] / pxv[finite])) if finite.any() else 0.0
+    peak = np.max(np.where(finite, pxv, 0.0), axis=1, keepdims=True)  # at each x
+    relative = np.where(finite, error / np.where(peak > 0.0, peak, 1.0), 0.0)
+    worst = float(np.max(relative)) if finite.any() else 0.0
     return pd.DataFrame({"x": x.ravel(), "v": v.ravel(), "pxv": pxv.ravel()}), worst
 
 
