@@ -45,8 +45,7 @@ __all__ = [
     "auto_log_bins",
     "auto_linear_bins",
     "resolve_bins",
-    "is_auto",
-    "is_grid_auto",
+    "has_auto",
     "resolve_grid",
     "SOLVER_TABLE_POINTS",
     "solver_table_ranges",
@@ -60,6 +59,17 @@ __all__ = [
 #: The fraction of a distribution outside an explicit bin set or grid above which the config
 #: check warns, naming r, the key and the fraction.
 OUTSIDE_WARNING = 1.0e-4
+
+#: The parts of a config's log bins, linear bins and grids.
+LOG_BIN_KEYS, LINEAR_BIN_KEYS, GRID_KEYS = (
+    ("lo", "hi", "per_decade"),
+    ("lo", "hi", "width"),
+    (
+        "min",
+        "max",
+        "points",
+    ),
+)
 
 #: The fraction of a distribution each end of an automatic range aims to leave out.
 TAIL_FRACTION = 1.0e-6
@@ -308,6 +318,42 @@ def estimated_outside_fractions(settings: dict, restitution) -> dict:
     return {name: min(1.0, fraction) for name, fraction in fractions.items()}
 
 
+def has_auto(spec, keys) -> bool:
+    """Whether a bin set or grid (config-shaped) asks for any part from r's scales.
+
+    Parameters
+    ----------
+    spec : object
+        ``"auto"``, a dict, or anything else (a ``bins.LogBins``: explicit).
+    keys : tuple of str
+        Its parts: ("lo", "hi", "per_decade") of log bins, ("lo", "hi", "width") of linear
+        bins, ("min", "max", "points") of a grid.
+
+    Returns
+    -------
+    bool
+        True for ``"auto"``, or a dict with a part ``"auto"`` or missing.
+
+    Examples
+    --------
+    >>> from bouncing_ball.scales import has_auto
+    >>> has_auto({"lo": 1e-4, "hi": 100}, ("lo", "hi", "per_decade"))
+    True
+    """
+    if isinstance(spec, str):
+        return spec == AUTO
+    return isinstance(spec, dict) and any(spec.get(key, AUTO) == AUTO for key in keys)
+
+
+def _filled(spec, defaults: dict) -> dict:
+    """The parts of ``spec`` ("auto" or a dict), each one that is "auto" or missing taken from
+    ``defaults``."""
+    spec = {} if spec == AUTO else spec
+    return {
+        key: value if spec.get(key, AUTO) == AUTO else spec[key] for key, value in defaults.items()
+    }
+
+
 def _decade_aligned(lo, hi, per_decade):
     """lo rounded down and hi up to the grid 10^(k / per_decade)."""
     k_lo = math.floor(math.log10(lo) * per_decade + 1e-9)
@@ -333,16 +379,10 @@ def auto_log_bins(spec, default_range, per_decade):
         {lo, hi, per_decade}: the automatic ends on the grid 10^(k / per_decade), so that the
         bins of two r share edges where they overlap.
     """
-    spec = {} if spec == AUTO else dict(spec)
-    density = spec.get("per_decade", AUTO)
-    density = per_decade if density == AUTO else int(density)
+    density = int(_filled(spec, {"per_decade": per_decade})["per_decade"])
     lo, hi = _decade_aligned(*default_range, density)
-    given_lo, given_hi = spec.get("lo", AUTO), spec.get("hi", AUTO)
-    return {
-        "lo": lo if given_lo == AUTO else float(given_lo),
-        "hi": hi if given_hi == AUTO else float(given_hi),
-        "per_decade": density,
-    }
+    filled = _filled(spec, {"lo": lo, "hi": hi})
+    return {"lo": float(filled["lo"]), "hi": float(filled["hi"]), "per_decade": density}
 
 
 def auto_linear_bins(spec, largest, bins=VELOCITY_BINS):
@@ -362,10 +402,8 @@ def auto_linear_bins(spec, largest, bins=VELOCITY_BINS):
     dict
         {lo, hi, width}; an automatic width is a 1, 2 or 5 times a power of 10.
     """
-    spec = {} if spec == AUTO else dict(spec)
-    lo = -largest if spec.get("lo", AUTO) == AUTO else float(spec["lo"])
-    hi = largest if spec.get("hi", AUTO) == AUTO else float(spec["hi"])
-    width = spec.get("width", AUTO)
+    filled = _filled(spec, {"lo": -largest, "hi": largest, "width": AUTO})
+    lo, hi, width = float(filled["lo"]), float(filled["hi"]), filled["width"]
     if width == AUTO:
         raw = (hi - lo) / bins
         decade = 10.0 ** math.floor(math.log10(raw))
@@ -418,30 +456,10 @@ def resolve_bins(settings: dict, restitution) -> dict:
     resolved = dict(settings)
     for name, fill in automatic.items():
         spec = settings.get(name, AUTO)
-        if is_auto(spec):
+        keys = LINEAR_BIN_KEYS if name == "velocity_bins" else LOG_BIN_KEYS
+        if has_auto(spec, keys):
             resolved[name] = fill(spec)
     return resolved
-
-
-def is_auto(spec) -> bool:
-    """Whether a bin set (config-shaped) asks for any part from r's scales.
-
-    Parameters
-    ----------
-    spec : object
-        A bin set: ``"auto"``, a dict, or a ``bins.LogBins`` / ``bins.LinearBins``.
-
-    Returns
-    -------
-    bool
-        True for ``"auto"``, or a dict with a part ``"auto"`` or an end (lo, hi) missing.
-    """
-    if isinstance(spec, str):
-        return spec == AUTO
-    if isinstance(spec, dict):
-        ends = ("lo", "hi") if ("lo" in spec or "hi" in spec or "per_decade" in spec) else ()
-        return AUTO in spec.values() or any(end not in spec for end in ends)
-    return False
 
 
 def resolve_grid(spec, default_range, points):
@@ -461,12 +479,11 @@ def resolve_grid(spec, default_range, points):
     dict
         {min, max, points}.
     """
-    spec = {} if spec == AUTO else dict(spec)
-    given = {key: spec.get(key, AUTO) for key in ("min", "max", "points")}
+    filled = _filled(spec, {"min": default_range[0], "max": default_range[1], "points": points})
     return {
-        "min": default_range[0] if given["min"] == AUTO else float(given["min"]),
-        "max": default_range[1] if given["max"] == AUTO else float(given["max"]),
-        "points": points if given["points"] == AUTO else int(given["points"]),
+        "min": float(filled["min"]),
+        "max": float(filled["max"]),
+        "points": int(filled["points"]),
     }
 
 
@@ -550,30 +567,10 @@ def resolve_solver_grids(settings: dict, restitution) -> dict:
     ranges = None
     for name, points in SOLVER_TABLE_POINTS.items():
         spec = settings.get(name, AUTO)
-        if is_grid_auto(spec):
+        if has_auto(spec, GRID_KEYS):
             ranges = solver_table_ranges(restitution) if ranges is None else ranges
             resolved[name] = resolve_grid(spec, ranges[name], points)
     return resolved
-
-
-def is_grid_auto(spec) -> bool:
-    """Whether a grid (config-shaped) asks for any part from r's scales.
-
-    Parameters
-    ----------
-    spec : object
-        A grid: ``"auto"`` or a dict of min, max and points.
-
-    Returns
-    -------
-    bool
-        True for ``"auto"``, or a dict with a part ``"auto"`` or missing.
-    """
-    if isinstance(spec, str):
-        return spec == AUTO
-    return isinstance(spec, dict) and (
-        AUTO in spec.values() or any(key not in spec for key in ("min", "max", "points"))
-    )
 
 
 def tail_fractions(edges, mass_density):
