@@ -61,15 +61,9 @@ __all__ = [
 OUTSIDE_WARNING = 1.0e-4
 
 #: The parts of a config's log bins, linear bins and grids.
-LOG_BIN_KEYS, LINEAR_BIN_KEYS, GRID_KEYS = (
-    ("lo", "hi", "per_decade"),
-    ("lo", "hi", "width"),
-    (
-        "min",
-        "max",
-        "points",
-    ),
-)
+LOG_BIN_KEYS = ("lo", "hi", "per_decade")
+LINEAR_BIN_KEYS = ("lo", "hi", "width")
+GRID_KEYS = ("min", "max", "points")
 
 #: The fraction of a distribution each end of an automatic range aims to leave out.
 TAIL_FRACTION = 1.0e-6
