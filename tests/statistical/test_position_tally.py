@@ -16,7 +16,6 @@ import math
 
 import numpy as np
 import pytest
-from default_settings import DEFAULT_SETTINGS
 from numba import njit
 from scipy import integrate, optimize, special
 
@@ -30,6 +29,7 @@ from bouncing_ball.free_flight import (
     quintic_antiderivative_value,
     speed_squared_coefficients,
 )
+from bouncing_ball.settings import DEFAULT_POSITION_BINS
 from bouncing_ball.simulation.step_tallies import (
     _bin_index,
     _bridge_correction,
@@ -38,7 +38,7 @@ from bouncing_ball.simulation.step_tallies import (
     floor_stratum_end,
 )
 
-BINS = DEFAULT_SETTINGS.position_bins
+BINS = DEFAULT_POSITION_BINS  # 1e-3 to 1e3: the narrow bins near the floor this step crosses
 EDGES = BINS.edges
 LOWER = np.concatenate(([-np.inf], EDGES))
 UPPER = np.concatenate((EDGES, [np.inf]))
