@@ -97,6 +97,7 @@ TIME_RELAXATION_COLUMNS = (
     "relaxation_rate",
     "relaxation_rate_accuracy",
     "large_speed_edge",
+    "relaxation_time",
 )
 
 #: The fractions of gamma_e at which the root is bracketed: below ~0.98 gamma_e the matrix's
