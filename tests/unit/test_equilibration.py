@@ -123,17 +123,17 @@ def _default_config():
 
 def test_the_equilibration_time_can_be_set_per_r():
     config = _default_config()
-    config["simulation"]["per_restitution"] = {"0.75": {"equilibration_time": 1.0e5}}
+    config["simulation"]["per_restitution"]["0.75"] = {"equilibration_time": 1.0e5}
     schema = read_yaml(REPOSITORY / "workflow/schemas/config.schema.yaml")
     check_config(config, schema)
     assert shard_settings(config, "0.75").equilibration_time == 1.0e5
     assert shard_settings(config, "0.5").equilibration_time == 1.0e3
-    config["simulation"]["per_restitution"] = {"0.75": {"equilibration_time": -1.0}}
+    config["simulation"]["per_restitution"]["0.75"] = {"equilibration_time": -1.0}
     with pytest.raises(ValueError, match="equilibration_time"):
         check_config(config, schema)
 
 
-# 8 relaxation times at r = 0.99 and a little more: the transient of a 1e3 equilibration is a
+# 3.4 slowest relaxation times at r = 0.99 (9 of the bounce chain's n_c <T>): the transient of a 1e3 equilibration is a
 # large part of such a shard's recording; in the default run's far longer shards it leaves a
 # bias below the check's power (docs/validation.md, "What the equilibration check can see")
 SHORT_SHARD_TIME = 2.4e5
