@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from test_solver_range import _passing_tables
 
-from bouncing_ball.time_relaxation import TIME_RELAXATION_COLUMNS
 from bouncing_ball import Equilibrium, ExactEquilibrium, relaxation, solver
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION, small_speed_exponent
 from bouncing_ball.flight_time import mean_flight_time_given_speed
+from bouncing_ball.time_relaxation import TIME_RELAXATION_COLUMNS
 from bouncing_ball.workflow import solver_tables
 from bouncing_ball.workflow.solver_tables import _relaxation_columns
 
