@@ -367,7 +367,7 @@ def relaxation_record(restitution, shard_time: float, equilibration_time: float)
     >>> from bouncing_ball.simulation.equilibration import relaxation_record
     >>> record = relaxation_record("1/2", 2e3, 1e3)
     >>> round(record["shard_relaxation_times"], 1), record["problems"]
-    (136.9, [])
+    (103.4, [])
     """
     relaxation = equilibration_relaxation_time(restitution)
     ratio = (lambda time: None) if relaxation is None else (lambda time: time / relaxation)
