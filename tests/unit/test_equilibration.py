@@ -190,9 +190,10 @@ def test_the_default_equilibration_is_twenty_relaxation_times_and_at_least_1e3(r
 
 def test_shards_too_short_for_the_relaxation_time_are_named():
     """The equilibration time and the shard time against the relaxation time at r = 0.95
-    (about 1e3 time units): each problem names r, the relaxation time and the setting."""
+    (2.7e3 time units): each problem names r, the relaxation time and the setting."""
     relaxation = Equilibrium(0.95).relaxation_time
-    assert equilibration_problems(0.95, SHARD_RELAXATION_TIMES * relaxation * 1.01, 2.1e4) == []
+    enough = EQUILIBRATION_RELAXATION_TIMES * relaxation * 1.01
+    assert equilibration_problems(0.95, SHARD_RELAXATION_TIMES * relaxation * 1.01, enough) == []
     short = equilibration_problems(0.95, 2e3, 50.0, "simulation.")
     assert len(short) == 2
     assert all(f"{relaxation:.6g}" in problem and "r = 0.95" in problem for problem in short)
