@@ -62,3 +62,35 @@ def test_scaled_speed_curves_approach_the_limit_with_the_first_correction():
     for bad in ([0.0, 1.0], [np.inf], [[1.0]], []):
         with pytest.raises(ValueError, match="scaled_speeds"):
             qe.scaled_speed_curves([0.999], bad)
+
+
+@pytest.fixture(scope="module", params=[0.01, 0.005])
+def process_relaxation(request):
+    """The tilted bounce operator's rate at r = 1 - epsilon and its error estimate."""
+    from bouncing_ball.time_relaxation import time_relaxation, time_relaxation_accuracy
+
+    relaxation = time_relaxation(1.0 - request.param)
+    return request.param, relaxation, time_relaxation_accuracy(relaxation)
+
+
+def test_the_relaxation_time_approaches_64_over_9_eps2_with_the_first_correction(
+    process_relaxation,
+):
+    """1 / gamma = (64/9) epsilon^-2 (1 + c1 epsilon + c2 epsilon^2 + ...) with c1 = -1: the
+    measured c1 = (epsilon^2 / (gamma 64/9) - 1) / epsilon within 2 |c2| epsilon (the fitted
+    c2 of SCALINGS, the factor 2 room for the next order) plus 3 times the solver's error
+    estimate over epsilon (``time_relaxation_accuracy``, relative, in gamma and 1 / gamma
+    alike).  The leading order alone is held within |c1| epsilon + 2 |c2| epsilon^2 of 1: a
+    constant 8/3 (the bounce chain's) fails that; a first correction of the other sign, or
+    -epsilon/2, fails the second (by 2 and 0.5, against tolerances below 0.02)."""
+    epsilon, relaxation, accuracy = process_relaxation
+    scaling = qe.SCALINGS["relaxation_time"]
+    assert relaxation.isolated
+    assert qe.relaxation_time(1.0 - epsilon) == pytest.approx(scaling.limit * epsilon**-2)
+    ratio = relaxation.time / qe.relaxation_time(1.0 - epsilon)
+    numerical = 3.0 * accuracy
+    next_order = 2.0 * abs(scaling.second) * epsilon
+    assert ratio == pytest.approx(1.0, abs=(1.0 + next_order) * epsilon + numerical)
+    measured = (ratio - 1.0) / epsilon
+    print(f"epsilon = {epsilon}: c1 = {measured:.5f}, accuracy {accuracy:.2g}")
+    assert measured == pytest.approx(scaling.first, abs=next_order + numerical / epsilon)
