@@ -5,7 +5,7 @@ loop driven by the library's step functions), gives the series int x dt and int 
 per window.  Their principal correlation mu_k (the largest lag-k correlation of a combination of
 the two, ``time_windows.principal_correlation``) decays as e^(-gamma k W): the slowest mode's
 eigenfunction changes sign once, and x and x^(1/2) project on it (the
-second takes out much of the faster modes' share in x).  A least-squares line through
+second takes out part of the faster modes' share in x, below).  A least-squares line through
 ln mu_k over the lags of 1 to 4 relaxation times (k = 4 .. 16) gives the simulated rate, with a
 delete-one jackknife error over the independent shards.  The z-score
 (gamma_sim - gamma) / error is held to |z| < Z_LIMIT at each r: with 32 shards z follows
