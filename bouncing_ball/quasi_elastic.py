@@ -96,14 +96,18 @@ class QuasiElasticScaling:
 
 #: The expansions of docs/quasi_elastic.md: the collision rate I (eq. (collrate)), <x> and
 #: Delta x (eq. (xandDeltax)), the correlation length of the bounce chain in bounces and that
-#: length times the mean time between collisions 1/I.  I's second coefficient is 1/4 from the
-#: moment recursion plus 1 from the flights that start at u = O(1).
+#: length times the mean time between collisions 1/I, and the slowest relaxation time of the
+#: process in time, 1 / gamma (``time_relaxation``).  I's second coefficient is 1/4 from the
+#: moment recursion plus 1 from the flights that start at u = O(1); those of the bounce chain
+#: follow from its second eigenvalue r + 2 epsilon^3 + ...; that of 1 / gamma is the solver's
+#: (0.709 over 0.9 <= r <= 0.99), not derived.
 SCALINGS = {
     "collision_rate": QuasiElasticScaling(1, 3 / 8, 1 / 2, 5 / 4),
     "mean_x": QuasiElasticScaling(-2, 16 / 9, -1.0, 4 / 3),
     "delta_x": QuasiElasticScaling(-2, 16 * np.sqrt(2.0) / 9, -1.0, 229 / 120),
-    "correlation_bounces": QuasiElasticScaling(-1, 1.0, -1 / 2, -1 / 12),
-    "bounce_chain_time": QuasiElasticScaling(-2, 8 / 3, -1.0, -5 / 6),
+    "correlation_bounces": QuasiElasticScaling(-1, 1.0, -1 / 2, 23 / 12),
+    "bounce_chain_time": QuasiElasticScaling(-2, 8 / 3, -1.0, 7 / 6),
+    "relaxation_time": QuasiElasticScaling(-2, 64 / 9, -1.0, 0.71),
 }
 
 #: The r of the quasi-elastic table (``quasi_elastic_table``).
@@ -305,8 +309,10 @@ def correlation_bounces(restitution) -> float:
 
     The chain of outgoing speeds u_n maps polynomials of degree k in u to polynomials of degree
     k (eq. (returnlaw) of the module's docstring), with eigenvalue r^k: its second eigenvalue is
-    r up to O(epsilon^3) (the flights that start at u = O(1)), so correlations decay as r^n and
-    the length is -1 / ln r = 1/epsilon - 1/2 - epsilon/12 + ..., to a relative O(epsilon^2).
+    r up to O(epsilon^3) (the flights that start at u = O(1) add 2 epsilon^3), so correlations
+    decay as r^n and the length is -1 / ln r = 1/epsilon - 1/2 + O(epsilon), to a relative
+    O(epsilon^2) (the chain's own length is 1/epsilon - 1/2 + (23/12) epsilon + ...,
+    ``SCALINGS["correlation_bounces"]``).
 
     Parameters
     ----------
@@ -340,7 +346,8 @@ def relaxation_time(restitution) -> float:
     hydrogen-like problem with levels (3/8) (1 - 1/n^2), n = 1, 2, ...  The slowest decay is
     n = 2: the rate 9 epsilon^2 / 64 in t.  It is not the bounce count times the mean flight
     time (``SCALINGS["bounce_chain_time"]``, 8 / (3 epsilon^2)): long flights carry the slow
-    mode.  Relative error O(epsilon) (the first correction is not derived).
+    mode.  Relative error O(epsilon): the first correction, -epsilon, is the tilted bounce
+    operator's (``time_relaxation``; ``SCALINGS["relaxation_time"]``, docs/quasi_elastic.md).
 
     Parameters
     ----------

@@ -41,7 +41,8 @@ k, as the largest modulus of the rest of the spectrum to the power k.  Two parts
 
 The relaxation eigenvalue is the larger of the two: the matrix's second eigenvalue where it
 lies above lambda_c (an isolated eigenvalue: r above a crossover near 0.6), else lambda_c.  The
-correlation length in bounces is n_c = -1 / ln lambda and the relaxation time n_c <T>.
+correlation length in bounces is n_c = -1 / ln lambda, and n_c <T> the time of n_c bounces (the
+relaxation of the process in time is ``time_relaxation``'s).
 
 Below r_c (beta >= 2, eq. (rc)) Phi < 1 between 2 and beta means ln u_n drifts to -infinity:
 the chain has no stationary law (f = u P(0, u) is not integrable, I = infinity), the speeds
@@ -86,7 +87,7 @@ RELAXATION_COLUMNS = (
     "relaxation_eigenvalue_accuracy",
     "continuum_edge",
     "correlation_bounces",
-    "relaxation_time",
+    "bounce_chain_time",
 )
 
 

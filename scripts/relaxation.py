@@ -1,13 +1,17 @@
 """Rule relaxation: the relaxation eigenvalue lambda of the bounce chain and its correlation
-length n_c = -1 / ln lambda (``relaxation.bounce_chain_relaxation``) at r = 1 - eps on the log
+length n_c = -1 / ln lambda (``relaxation.bounce_chain_relaxation``), that length in time
+n_c <T> (``Equilibrium.bounce_chain_time``) and the slowest time of the process 1 / gamma
+(``time_relaxation.time_relaxation``, ``Equilibrium.relaxation_time``) at r = 1 - eps on the log
 grid of eps figures.fig12_inelasticity, and at each simulated r -> results/theory/relaxation.parquet
-(r, relaxation_eigenvalue, correlation_bounces, isolated, simulated)."""
+(r, relaxation_eigenvalue, correlation_bounces, isolated, bounce_chain_time, relaxation_time,
+relaxation_time_isolated, simulated)."""
 
 import logging
 
 import pandas as pd
 
 from bouncing_ball.bins import log_grid
+from bouncing_ball.equilibrium import Equilibrium
 from bouncing_ball.relaxation import bounce_chain_relaxation
 from bouncing_ball.workflow.io import write_table
 from bouncing_ball.workflow.jobs import job_log
@@ -17,12 +21,16 @@ with job_log(snakemake.log[0], exit_when_done=True):
     rows = []
     for r, simulated in [*grid, *((value, True) for value in snakemake.params.simulated)]:
         relaxation = bounce_chain_relaxation(r)
+        equilibrium = Equilibrium(r)
         rows.append(
             {
                 "r": relaxation.restitution,
                 "relaxation_eigenvalue": relaxation.eigenvalue,
                 "correlation_bounces": relaxation.correlation_bounces,
                 "isolated": relaxation.isolated,
+                "bounce_chain_time": equilibrium.bounce_chain_time,
+                "relaxation_time": equilibrium.relaxation_time,
+                "relaxation_time_isolated": equilibrium._time_relaxation.isolated,
                 "simulated": simulated,
             }
         )
@@ -34,4 +42,9 @@ with job_log(snakemake.log[0], exit_when_done=True):
         "code": snakemake.params.code,
     }
     write_table(table, snakemake.output[0], provenance)
-    logging.info("lambda_2 at %d values of r in [%g, %g]", len(table), table.r.min(), table.r.max())
+    logging.info(
+        "lambda_2 and 1 / gamma at %d values of r in [%g, %g]",
+        len(table),
+        table.r.min(),
+        table.r.max(),
+    )

@@ -64,8 +64,10 @@ class EquilibriumBase(abc.ABC):
         Whether P(x), <v^2>_x, P(x, v) and w(F) are computed at this r.
     smallest_speed, smallest_force : float
         The lower bounds of ``p0v`` and ``weight``.
-    relaxation_eigenvalue, correlation_bounces, relaxation_time, relaxation_accuracy : float
+    relaxation_eigenvalue, correlation_bounces, bounce_chain_time, relaxation_accuracy : float
         The relaxation of the bounce-speed chain (``relaxation``).
+    relaxation_rate, relaxation_time, relaxation_rate_accuracy : float
+        The slowest relaxation of the process in time (``time_relaxation``).
 
     Examples
     --------
@@ -916,27 +918,84 @@ class EquilibriumBase(abc.ABC):
         return self._relaxation.correlation_bounces
 
     @property
-    def relaxation_time(self) -> float:
+    def bounce_chain_time(self) -> float:
         """n_c <T>: the time the ball takes for ``correlation_bounces`` bounces, in ``units``;
-        of order (1 - r)^-2 time units T = Lambda / g^2 as r -> 1.
+        (8/3) (1 - r)^-2 time units T = Lambda / g^2 as r -> 1.
 
-        The time scale on which the state at the floor forgets its past (docs/methods.md,
-        "Relaxation of the bounce chain"): n bounces take n <T> (``mean_flight_time``) up to
-        relative fluctuations n^(-1/2).  It sets the scale, not the exact exponential rate of
-        time correlations, which differs by a factor of order 1.  Where lambda is the continuum
-        edge (r below ~0.6) the slow correlations are carried by cascades of short low-speed
-        flights, so the forgetting in time is faster than n_c <T>.
+        The bounce chain's correlation length turned into time by the mean flight time
+        (``mean_flight_time``).  Not the decay time of correlations in time
+        (``relaxation_time``): the flight times are correlated over n_c bounces, which makes
+        the slowest time 8/3 times longer near r = 1, and where lambda is the continuum edge
+        (r below ~0.6) its slow correlations live in cascades of short low-speed flights that
+        take little time.
 
         Defined for r_c < r <= 0.9999; ValueError below r_c (there <T> = 0).
 
         Examples
         --------
         >>> from bouncing_ball import Equilibrium
-        >>> print(round(Equilibrium("1/2").relaxation_time, 4))
+        >>> print(round(Equilibrium("1/2").bounce_chain_time, 4))
         14.6093
         """
         bounces = self._relaxation.correlation_bounces
         return self._physical(bounces * self._paper_scalar("mean_flight_time"), "time")
+
+    @property
+    def _time_relaxation(self):
+        return _process_relaxation(self.restitution, self._relaxation_step)
+
+    @property
+    def relaxation_rate(self) -> float:
+        """gamma: the slowest decay rate of correlations in time of the process, in ``units``
+        (per time unit T = Lambda / g^2 in the paper's).
+
+        The smallest gamma > 0 with E[e^(gamma T) h(r V) | u] = h(u) solvable, from the bounce
+        operator of eq. (inteq) tilted by the flight time of eq. (joint)
+        (``time_relaxation.time_relaxation``): an isolated root below the large-speed
+        continuum at every r above r_c; (9/64) (1 - r)^2 as r -> 1.  Built on first use, then
+        kept for the process.  Defined for r_c < r <= 0.9999; ValueError below r_c.  Its
+        relative error estimate is ``relaxation_rate_accuracy``.
+
+        Examples
+        --------
+        >>> from bouncing_ball import Equilibrium
+        >>> print(round(1.0 / Equilibrium("1/2").relaxation_rate, 4))
+        19.3446
+        """
+        return self._physical(self._time_relaxation.rate, "rate")
+
+    @property
+    def relaxation_time(self) -> float:
+        """1 / gamma: the slowest relaxation time of the process, in ``units``; (64/9) (1 -
+        r)^-2 (1 - (1 - r)) time units T = Lambda / g^2 as r -> 1.
+
+        Correlations in time of the state (x(t), v(t), the collisions binned in time) decay as
+        exp(-t / relaxation_time) at long times (``relaxation_rate``).  Longer than the bounce
+        chain's ``bounce_chain_time`` above r ~ 0.45, 8/3 times it as r -> 1.
+
+        Defined for r_c < r <= 0.9999; ValueError below r_c.
+
+        Examples
+        --------
+        >>> from bouncing_ball import Equilibrium
+        >>> print(round(Equilibrium("1/2").relaxation_time, 4))
+        19.3446
+        """
+        return self._physical(self._time_relaxation.time, "time")
+
+    @property
+    def relaxation_rate_accuracy(self) -> float:
+        """The relative error estimate of ``relaxation_rate`` (and ``relaxation_time``): its
+        change against a finer matrix (``time_relaxation.time_relaxation_accuracy``).  Built on
+        first use, then kept for the process.  ValueError below r_c.
+
+        Examples
+        --------
+        >>> from bouncing_ball import Equilibrium
+        >>> Equilibrium("1/2").relaxation_rate_accuracy < 1e-8
+        True
+        """
+        return _process_relaxation_accuracy(self.restitution, self._relaxation_step)
 
     @property
     def relaxation_accuracy(self) -> float:
@@ -1014,3 +1073,23 @@ def _chain_relaxation_accuracy(exact: Fraction, step) -> float:
     from .. import relaxation
 
     return relaxation.relaxation_accuracy(_chain_relaxation(exact, step))
+
+
+@functools.lru_cache(maxsize=16)
+def _process_relaxation(exact: Fraction, step):
+    """``time_relaxation.time_relaxation`` at (r, step), once per process (step None: the
+    solver's default)."""
+    from .. import solver, time_relaxation
+
+    return time_relaxation.time_relaxation(
+        exact, step=solver.DEFAULT_STEP if step is None else step
+    )
+
+
+@functools.lru_cache(maxsize=16)
+def _process_relaxation_accuracy(exact: Fraction, step) -> float:
+    """``time_relaxation.time_relaxation_accuracy`` of ``_process_relaxation(exact, step)``,
+    once per process."""
+    from .. import time_relaxation
+
+    return time_relaxation.time_relaxation_accuracy(_process_relaxation(exact, step))

@@ -165,9 +165,12 @@ class Equilibrium(EquilibriumBase):
     position_accuracy : float
         The largest of ``|int P dx - 1|`` and the relative differences of <x>, Delta x from P(x)
         (eq. (P(x)1)) and from the Ito identities (builds w(F) on first use).
-    relaxation_eigenvalue, correlation_bounces, relaxation_time, relaxation_accuracy : float
+    relaxation_eigenvalue, correlation_bounces, bounce_chain_time, relaxation_accuracy : float
         The relaxation of the bounce-speed chain (``relaxation``): lambda, n_c = -1 / ln lambda,
         n_c <T> and the error estimate of lambda (built on first use; ValueError below r_c).
+    relaxation_rate, relaxation_time, relaxation_rate_accuracy : float
+        The slowest relaxation of the process in time (``time_relaxation``): gamma, 1 / gamma
+        and the relative error estimate of gamma (built on first use; ValueError below r_c).
     distribution_available : bool
         Whether r lies in ``restitution.DISTRIBUTION_RESTITUTION_RANGE``, where P(x), <v^2>_x,
         P(x, v) and w(F) are computed.

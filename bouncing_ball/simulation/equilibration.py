@@ -34,14 +34,12 @@ time, ``default_equilibration_time``; the check catches gross shortfalls of it, 
 ``equilibration_time`` set far below the relaxation time.
 
 How long to discard, and how long a shard must be, follow from the relaxation time of the
-process (``equilibration_relaxation_time``: ``Equilibrium(r).relaxation_time``, the bounce
-chain's correlation length in bounces times the mean flight time, docs/methods.md):
+process (``equilibration_relaxation_time``: ``Equilibrium(r).relaxation_time``, the slowest
+decay time 1 / gamma of correlations in time, ``time_relaxation``, docs/methods.md):
 
 * ``default_equilibration_time``: ``EQUILIBRATION_RELAXATION_TIMES`` relaxation times, never
-  less than ``MIN_EQUILIBRATION_TIME``.  Near r -> 1 the slowest decay in continuous time is
-  8/3 times slower than the bounce chain's (docs/quasi_elastic.md), so the default discards
-  20 / (8/3) = 7.5 of those decay times: what is left of the start, e^-7.5 = 6e-4 of it,
-  decays within the first of the recorded ones.
+  less than ``MIN_EQUILIBRATION_TIME``: what is left of the start, at most e^-20 = 2e-9 of it
+  in the slowest mode, is far below any statistical error.
 * ``SHARD_RELAXATION_TIMES``: the shortest shard whose errors are trusted, so that the early
   part of its recording (``EARLY_FRACTION``) spans at least one relaxation time: a transient
   shorter than the shard but longer than its early part would straddle the two and escape
@@ -92,7 +90,7 @@ QUANTITIES = ("mean_x", "mean_x2", "collision_rate")
 _SUMS = ("time", "collisions", "int_x", "int_x2")
 
 #: The least ratio of ``relaxation_time_bound`` to the relaxation time over r_c < r < 1.
-RELAXATION_BOUND_MARGIN = 1.04
+RELAXATION_BOUND_MARGIN = 1.05
 #: The default ``equilibration_time`` in relaxation times (``default_equilibration_time``).
 EQUILIBRATION_RELAXATION_TIMES = 20
 #: The least default ``equilibration_time``, where the relaxation time is short or undefined.
@@ -113,11 +111,11 @@ class EquilibrationWarning(RuntimeWarning):
 def equilibration_relaxation_time(restitution) -> float | None:
     """The relaxation time that sets the equilibration of the simulation at r.
 
-    ``Equilibrium(r).relaxation_time`` (the bounce chain's correlation length times the mean
-    flight time, ``relaxation.bounce_chain_relaxation``) where the solver answers it,
-    r_c < r <= 0.9999; above 0.9999 its quasi-elastic form, (8/3) (1 - r)^-2 to first order
-    (``quasi_elastic.quasi_elastic_form("bounce_chain_time", r)``).  None at or below r_c
-    (eq. (rc)), where the outgoing speeds collapse and the chain has no relaxation eigenvalue.
+    ``Equilibrium(r).relaxation_time``, the slowest relaxation time of the process in time
+    (1 / gamma, ``time_relaxation.time_relaxation``) where the solver answers it,
+    r_c < r <= 0.9999; above 0.9999 its quasi-elastic form, (64/9) (1 - r)^-2 (1 - (1 - r))
+    (``quasi_elastic.quasi_elastic_form("relaxation_time", r)``).  None at or below r_c
+    (eq. (rc)), where the outgoing speeds collapse and there is no stationary state.
 
     Parameters
     ----------
@@ -133,11 +131,11 @@ def equilibration_relaxation_time(restitution) -> float | None:
     --------
     >>> from bouncing_ball.simulation.equilibration import equilibration_relaxation_time
     >>> print(round(equilibration_relaxation_time("1/2"), 4))
-    14.6093
+    19.3446
     >>> print(equilibration_relaxation_time(0.1))
     None
     >>> print(f"{equilibration_relaxation_time(0.99999):.4g}")
-    2.667e+10
+    7.111e+10
     """
     from ..asymptotics import CRITICAL_RESTITUTION
     from ..restitution import SOLVER_RESTITUTION_RANGE, parse_restitution
@@ -148,21 +146,21 @@ def equilibration_relaxation_time(restitution) -> float | None:
     if exact > SOLVER_RESTITUTION_RANGE[1]:
         from ..quasi_elastic import quasi_elastic_form
 
-        return quasi_elastic_form("bounce_chain_time", exact)
+        return quasi_elastic_form("relaxation_time", exact)
     from ..equilibrium import Equilibrium
 
     return float(Equilibrium(exact).relaxation_time)
 
 
 def relaxation_time_bound(restitution) -> float:
-    """An upper bound of the relaxation time at r that needs no solve: 2.4 / (r - r_c) + 2.8 / (1 - r)^2.
+    """An upper bound of the relaxation time at r that needs no solve: 7.5 / (1 - r)^2.
 
-    The relaxation time (``equilibration_relaxation_time``) diverges as 1.93 / (r - r_c) at
-    r_c (eq. (rc)) and as (8/3) (1 - r)^-2 (1 - (1 - r)) at r -> 1 (docs/quasi_elastic.md);
-    this sum of the two, with margins, lies above it by a factor of at least
-    ``RELAXATION_BOUND_MARGIN`` at every r_c < r < 1 (``tests/unit/test_equilibration.py``
+    The relaxation time (``equilibration_relaxation_time``, 1 / gamma) stays finite at r_c
+    (6.9 there) and grows as (64/9) (1 - r)^-2 (1 - (1 - r)) at r -> 1 (docs/quasi_elastic.md);
+    (1 - r)^2 / gamma lies between 4.6 and 64/9 = 7.11 over r_c < r < 1, so the bound lies above
+    it by a factor of at least ``RELAXATION_BOUND_MARGIN`` (``tests/numerical/test_whole_range.py``
     holds it against the solver on a grid from r_c + 1e-5 to 0.9999, and the quasi-elastic
-    form beyond), and keeps 20 of it below 1e3 up to r = 0.75.  ``default_equilibration_time``
+    form beyond), and keeps 20 of it below 1e3 up to r = 0.6.  ``default_equilibration_time``
     and ``equilibration_problems`` solve eq. (inteq) only where the bound leaves the answer
     open.
 
@@ -185,7 +183,7 @@ def relaxation_time_bound(restitution) -> float:
     --------
     >>> from bouncing_ball.simulation.equilibration import relaxation_time_bound
     >>> print(round(relaxation_time_bound("1/2"), 3))
-    18.322
+    30.0
     """
     from ..asymptotics import CRITICAL_RESTITUTION
     from ..restitution import parse_restitution
@@ -193,7 +191,7 @@ def relaxation_time_bound(restitution) -> float:
     r = float(parse_restitution(restitution, "r"))
     if not r > CRITICAL_RESTITUTION:
         raise ValueError(f"r = {restitution}: at or below r_c there is no relaxation time")
-    return 2.4 / (r - CRITICAL_RESTITUTION) + 2.8 / (1.0 - r) ** 2
+    return 7.5 / (1.0 - r) ** 2
 
 
 def _above_critical(restitution) -> bool:
@@ -225,7 +223,7 @@ def default_equilibration_time(restitution) -> float:
     >>> default_equilibration_time("1/2"), default_equilibration_time(0.1)
     (1000.0, 1000.0)
     >>> default_equilibration_time(0.95), default_equilibration_time(0.99)
-    (21000.0, 530000.0)
+    (55000.0, 1500000.0)
     """
     if not _above_critical(restitution):
         return MIN_EQUILIBRATION_TIME
@@ -279,8 +277,8 @@ def equilibration_problems(
     []
     >>> for problem in equilibration_problems(0.95, 2e3, 50.0):
     ...     print(problem)  # doctest: +ELLIPSIS
-    r = 0.95: equilibration_time = 50 is shorter than 20 relaxation times (1016.13 each): ...
-    r = 0.95: shard_time = 2000 is shorter than 8 relaxation times (1016.13 each): ...
+    r = 0.95: equilibration_time = 50 is shorter than 20 relaxation times (2707.26 each): ...
+    r = 0.95: shard_time = 2000 is shorter than 8 relaxation times (2707.26 each): ...
 
     The same in seconds, for a ball under g = 9.81 and a noise strength Lambda = 0.05, whose
     unit of time is Lambda / g^2 = 5.2e-4 s:
@@ -288,7 +286,7 @@ def equilibration_problems(
     >>> from bouncing_ball.units import PhysicalUnits
     >>> units = PhysicalUnits(gravity=9.81, noise=0.05)
     >>> print(equilibration_problems(0.95, 2e3, 50.0, units=units)[0])  # doctest: +ELLIPSIS
-    r = 0.95: equilibration_time = 0.0259778 is shorter than 20 relaxation times (0.527935 each): ...
+    r = 0.95: equilibration_time = 0.0259778 is shorter than 20 relaxation times (1.40657 each): ...
     """
     from ..restitution import parse_restitution, restitution_label
 
@@ -369,7 +367,7 @@ def relaxation_record(restitution, shard_time: float, equilibration_time: float)
     >>> from bouncing_ball.simulation.equilibration import relaxation_record
     >>> record = relaxation_record("1/2", 2e3, 1e3)
     >>> round(record["shard_relaxation_times"], 1), record["problems"]
-    (136.9, [])
+    (103.4, [])
     """
     relaxation = equilibration_relaxation_time(restitution)
     ratio = (lambda time: None) if relaxation is None else (lambda time: time / relaxation)

@@ -101,7 +101,14 @@ SIMULATED_BOUNCE_CHAIN = TableKind(
 RELAXATION = TableKind(
     "relaxation of the bounce chain",
     "relaxation",
-    ("r", "relaxation_eigenvalue", "correlation_bounces", "simulated"),
+    (
+        "r",
+        "relaxation_eigenvalue",
+        "correlation_bounces",
+        "bounce_chain_time",
+        "relaxation_time",
+        "simulated",
+    ),
 )
 QUASI_ELASTIC_CURVES = TableKind(
     "P(0,v) in the quasi-elastic scaling",

@@ -775,15 +775,37 @@ def relaxation_figure(theory, panels):
     asymptote -1 / ln r, and the simulated decay rates (points, one-sigma errors).  Right:
     the simulated principal correlation mu_k of (ln u_n, u_n) over lags k (filled) and the
     autocorrelation rho_k of ln u_n (open) at each simulated r, against lambda_2^k (lines).
+    Third: the slowest time of the process 1 / gamma (``theory``: relaxation_time, from the
+    tilted bounce operator) and the bounce chain's n_c <T> (bounce_chain_time) against 1 - r,
+    with their asymptotes (64/9) (1 - r)^-2 and (8/3) (1 - r)^-2.
 
     ``panels``: dicts with ``restitution``, ``eigenvalue`` (the theory's lambda_2) and
     ``simulated`` (the merged bounce_chain table: lag, autocorrelation,
     principal_correlation with their _err, correlation_bounces from decay_rate).
     """
-    figure, axes = new_figure(1, 2, width=9.0, height=3.8)
-    left, right = axes[0, 0], axes[0, 1]
+    figure, axes = new_figure(1, 3, width=13.0, height=3.8)
+    left, right, times = axes[0, 0], axes[0, 1], axes[0, 2]
     curve = theory[~theory.simulated].sort_values("r")
     eps = 1.0 - curve.r.to_numpy()
+    times.plot(eps, curve.relaxation_time, color="k", label=r"$1/\gamma$, tilted operator")
+    times.plot(
+        eps, curve.bounce_chain_time, color="C3", label=r"$n_c \langle T\rangle$, bounce chain"
+    )
+    times.plot(
+        eps,
+        (64.0 / 9.0) / eps**2,
+        color="0.5",
+        linestyle="--",
+        label=r"$(64/9)(1-r)^{-2}$",
+    )
+    times.plot(
+        eps, (8.0 / 3.0) / eps**2, color="C3", alpha=0.5, linestyle=":", label=r"$(8/3)(1-r)^{-2}$"
+    )
+    times.set_xscale("log")
+    times.set_yscale("log")
+    times.set_xlabel(r"$1 - r$")
+    times.set_ylabel(r"time ($\Lambda/g^2$)")
+    times.legend(loc="upper right")
     left.plot(eps, curve.correlation_bounces, color="k", label=r"$-1/\ln\lambda_2$, solver")
     left.plot(eps, -1.0 / np.log(curve.r), color="0.5", linestyle="--", label=r"$-1/\ln r$")
     for index, panel in enumerate(panels):

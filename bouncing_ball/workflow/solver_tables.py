@@ -80,17 +80,23 @@ def _solve(equilibrium, what: str):
 
 
 def _relaxation_columns(equilibrium) -> dict:
-    """The summary's ``relaxation.RELAXATION_COLUMNS``: NaN at r <= r_c."""
+    """The summary's ``relaxation.RELAXATION_COLUMNS`` (the bounce chain) and
+    ``time_relaxation.TIME_RELAXATION_COLUMNS`` (the process in time): NaN at r <= r_c."""
     from ..asymptotics import CRITICAL_RESTITUTION
     from ..relaxation import RELAXATION_COLUMNS
+    from ..time_relaxation import TIME_RELAXATION_COLUMNS
 
     if equilibrium.r <= CRITICAL_RESTITUTION:
-        return dict.fromkeys(RELAXATION_COLUMNS, math.nan)
+        return dict.fromkeys(RELAXATION_COLUMNS + TIME_RELAXATION_COLUMNS, math.nan)
     return {
         "relaxation_eigenvalue": equilibrium.relaxation_eigenvalue,
         "relaxation_eigenvalue_accuracy": equilibrium.relaxation_accuracy,
         "continuum_edge": equilibrium._relaxation.continuum_edge,
         "correlation_bounces": equilibrium.correlation_bounces,
+        "bounce_chain_time": equilibrium.bounce_chain_time,
+        "relaxation_rate": equilibrium.relaxation_rate,
+        "relaxation_rate_accuracy": equilibrium.relaxation_rate_accuracy,
+        "large_speed_edge": equilibrium._time_relaxation.large_speed_edge,
         "relaxation_time": equilibrium.relaxation_time,
     }
 
@@ -103,7 +109,8 @@ def summary(equilibrium) -> dict:
     (eqs. (P(x)1), (xandDeltax)), the interpolation error of w(F)
     (``WeightFunction.interpolation_error``), the measured and predicted exponents of P(x)
     with the large-x fit window (``distribution.measured_exponents``), and the relaxation of
-    the bounce-speed chain (``relaxation.RELAXATION_COLUMNS``; NaN below r_c).
+    the bounce-speed chain and of the process in time (``relaxation.RELAXATION_COLUMNS``,
+    ``time_relaxation.TIME_RELAXATION_COLUMNS``; NaN below r_c).
 
     Parameters
     ----------
@@ -717,10 +724,11 @@ def solve_table_defects(summary, tables, target=1e-8) -> list:
     from ..asymptotics import large_speed_decay_rate
     from ..distribution import DISTRIBUTION_NOISE
     from ..relaxation import RELAXATION_COLUMNS
+    from ..time_relaxation import TIME_RELAXATION_COLUMNS
 
     infinite_rate = not np.isfinite(summary["collision_rate"])
-    # the relaxation of the bounce chain is not defined below r_c (relaxation.RELAXATION_COLUMNS)
-    undefined = RELAXATION_COLUMNS if infinite_rate else ()
+    # the relaxations of the bounce chain and of the process in time are not defined below r_c
+    undefined = RELAXATION_COLUMNS + TIME_RELAXATION_COLUMNS if infinite_rate else ()
     defects = [
         f"summary: {key} is NaN"
         for key, value in summary.items()

@@ -55,6 +55,7 @@ SOLVER = (
     "relaxation",
     "restitution",
     "solver",
+    "time_relaxation",
     "workflow.solver_tables",
 )
 EXACT = ("airy", "bins", "exact")

@@ -120,7 +120,10 @@ def test_solver_settings_are_held_to_the_library_bounds(key, value):
 
 def test_per_r_overrides_apply_by_label():
     config = _default_config()
-    config["simulation"]["per_restitution"] = {"3/4": {"shard_time": 1234.0}}
+    # the other overrides stay: r = 0.99 needs its longer shards (8 relaxation times 1/gamma)
+    overrides = config["simulation"]["per_restitution"]
+    del overrides["0.75"]
+    overrides["3/4"] = {"shard_time": 1234.0}
     check_config(config)
     assert simulation_settings(config, "0.75")["shard_time"] == 1234.0
     assert simulation_settings(config, "0.5")["shard_time"] == config["simulation"]["shard_time"]
@@ -234,9 +237,13 @@ def test_a_key_written_twice_in_a_yaml_file_is_refused_with_its_line(tmp_path):
 def test_an_overlay_clears_the_per_r_overrides(tmp_path, cleared):
     base = REPOSITORY / "config" / "config.yaml"
     overlay = tmp_path / "overlay.yaml"
-    overlay.write_text(f"simulation:\n  shards: 2\n  per_restitution: {cleared}\n")
+    # without its override r = 0.99 needs shards of 8 relaxation times 1/gamma (7.0e4 each)
+    overlay.write_text(
+        f"simulation:\n  shards: 2\n  shard_time: 6.0e+5\n  per_restitution: {cleared}\n"
+    )
     config = _default_config()  # as Snakemake merges the two files: {} adds nothing
     config["simulation"]["shards"] = 2
+    config["simulation"]["shard_time"] = 6.0e5
     if cleared == "null":
         config["simulation"]["per_restitution"] = None
     overlay_per_restitution(config, [base, overlay])

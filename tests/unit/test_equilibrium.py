@@ -431,11 +431,13 @@ MEMBER_VALUES = {
     "relaxation_eigenvalue": lambda eq: eq.relaxation_eigenvalue,
     "correlation_bounces": lambda eq: eq.correlation_bounces,
     "relaxation_time": lambda eq: eq.relaxation_time,
+    "relaxation_rate": lambda eq: eq.relaxation_rate,
+    "bounce_chain_time": lambda eq: eq.bounce_chain_time,
     "observables": lambda eq: [v for k, v in eq.observables().items() if k != "accuracy"],
     "units": lambda eq: [eq.units.gravity, eq.units.noise],
 }
 # each class's own error bound: not a value to agree on, each held to the 1e-8 target
-ERROR_BOUNDS = {"accuracy", "position_accuracy", "relaxation_accuracy"}
+ERROR_BOUNDS = {"accuracy", "position_accuracy", "relaxation_accuracy", "relaxation_rate_accuracy"}
 
 
 def test_both_classes_agree_on_every_public_member(pair):

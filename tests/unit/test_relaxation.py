@@ -11,6 +11,7 @@ from test_solver_range import _passing_tables
 from bouncing_ball import Equilibrium, ExactEquilibrium, relaxation, solver
 from bouncing_ball.asymptotics import CRITICAL_RESTITUTION, small_speed_exponent
 from bouncing_ball.flight_time import mean_flight_time_given_speed
+from bouncing_ball.time_relaxation import TIME_RELAXATION_COLUMNS
 from bouncing_ball.workflow import solver_tables
 from bouncing_ball.workflow.solver_tables import _relaxation_columns
 
@@ -127,31 +128,35 @@ def test_equilibrium_gives_the_relaxation_and_exact_equilibrium_the_same():
     for eq in (numerical, exact):
         assert eq.relaxation_eigenvalue == relaxation.continuum_edge(0.5)
         assert eq.correlation_bounces == pytest.approx(-1.0 / math.log(eq.relaxation_eigenvalue))
-        assert eq.relaxation_time == pytest.approx(eq.correlation_bounces / eq.collision_rate)
+        assert eq.bounce_chain_time == pytest.approx(eq.correlation_bounces / eq.collision_rate)
+    assert numerical.bounce_chain_time == pytest.approx(exact.bounce_chain_time, rel=TARGET)
     assert numerical.relaxation_time == pytest.approx(exact.relaxation_time, rel=TARGET)
 
 
 def test_equilibrium_refuses_the_relaxation_below_r_c():
     eq = Equilibrium(0.1)
-    for name in ("relaxation_eigenvalue", "correlation_bounces", "relaxation_time"):
+    names = ("relaxation_eigenvalue", "correlation_bounces", "bounce_chain_time")
+    for name in (*names, "relaxation_rate", "relaxation_time"):
         with pytest.raises(ValueError, match="at or below r_c"):
             getattr(eq, name)
 
 
 def test_the_summary_relaxation_columns_may_be_nan_only_below_r_c():
     summary, tables = _passing_tables()
-    summary.update(dict.fromkeys(relaxation.RELAXATION_COLUMNS, math.nan))
+    columns = relaxation.RELAXATION_COLUMNS + TIME_RELAXATION_COLUMNS
+    summary.update(dict.fromkeys(columns, math.nan))
     defects = solver_tables.solve_table_defects(summary, tables)
-    assert defects == [f"summary: {key} is NaN" for key in relaxation.RELAXATION_COLUMNS]
+    assert defects == [f"summary: {key} is NaN" for key in columns]
     summary["collision_rate"] = math.inf
     assert solver_tables.solve_table_defects(summary, tables) == []
 
 
 def test_the_summary_has_the_relaxation_columns_and_nan_below_r_c():
     columns = _relaxation_columns(Equilibrium("1/2"))
-    assert tuple(columns) == relaxation.RELAXATION_COLUMNS
+    assert tuple(columns) == relaxation.RELAXATION_COLUMNS + TIME_RELAXATION_COLUMNS
     assert columns["relaxation_eigenvalue"] == columns["continuum_edge"]
     assert columns["relaxation_time"] == Equilibrium("1/2").relaxation_time
+    assert columns["bounce_chain_time"] == Equilibrium("1/2").bounce_chain_time
     below = _relaxation_columns(Equilibrium(0.1))
-    assert tuple(below) == relaxation.RELAXATION_COLUMNS
+    assert tuple(below) == relaxation.RELAXATION_COLUMNS + TIME_RELAXATION_COLUMNS
     assert all(math.isnan(value) for value in below.values())

@@ -109,6 +109,9 @@ MEMBERS = {
     "relaxation_eigenvalue": (lambda eq: eq.relaxation_eigenvalue, "dimensionless"),
     "correlation_bounces": (lambda eq: eq.correlation_bounces, "dimensionless"),
     "relaxation_time": (lambda eq: eq.relaxation_time, "time"),
+    "relaxation_rate": (lambda eq: eq.relaxation_rate, "rate"),
+    "bounce_chain_time": (lambda eq: eq.bounce_chain_time, "time"),
+    "relaxation_rate_accuracy": (lambda eq: eq.relaxation_rate_accuracy, "dimensionless"),
     "relaxation_accuracy": (lambda eq: eq.relaxation_accuracy, "dimensionless"),
 }
 # the observables() dict, by key

@@ -49,8 +49,8 @@ rule fit:
 
 
 # The relaxation of the bounce chain, lambda_2 and n_c = -1 / ln lambda_2, from the solver's
-# matrix over r = 1 - eps on the log grid figures.fig12_inelasticity and at every simulated r
-# (Fig. 12).
+# matrix, n_c <T>, and the slowest time of the process 1 / gamma from the tilted matrix, over
+# r = 1 - eps on the log grid figures.fig12_inelasticity and at every simulated r (Fig. 12).
 rule relaxation:
     output:
         "results/theory/relaxation.parquet",
@@ -60,7 +60,7 @@ rule relaxation:
     conda:
         "../envs/bouncing-ball.yaml"
     resources:
-        runtime=10,
+        runtime=60,
         mem_mb=1000,
         cpus_per_task=1,
     params:
