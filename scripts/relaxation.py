@@ -1,8 +1,10 @@
 """Rule relaxation: the relaxation eigenvalue lambda of the bounce chain and its correlation
 length n_c = -1 / ln lambda (``relaxation.bounce_chain_relaxation``), that length in time
-n_c <T> (``Equilibrium.bounce_chain_time``) and the slowest time of the process 1 / gamma
-(``time_relaxation.time_relaxation``, ``Equilibrium.relaxation_time``) at r = 1 - eps on the log
-grid of eps figures.fig12_inelasticity, and at each simulated r -> results/theory/relaxation.parquet
+n_c <T> (``Equilibrium.bounce_chain_time``) at r = 1 - eps on the log grid of eps
+figures.fig12_inelasticity, and the slowest time of the process 1 / gamma
+(``time_relaxation.time_relaxation``, ``Equilibrium.relaxation_time``) on the grid
+figures.fig12_time_inelasticity (NaN at the other points: each is an eigenvalue search), both at
+each simulated r -> results/theory/relaxation.parquet
 (r, relaxation_eigenvalue, correlation_bounces, isolated, bounce_chain_time, relaxation_time,
 relaxation_time_isolated, simulated)."""
 
@@ -17,11 +19,14 @@ from bouncing_ball.workflow.io import write_table
 from bouncing_ball.workflow.jobs import job_log
 
 with job_log(snakemake.log[0], exit_when_done=True):
-    grid = [(1.0 - float(eps), False) for eps in log_grid(snakemake.params.inelasticity)]
+    chain = {1.0 - float(eps) for eps in log_grid(snakemake.params.inelasticity)}
+    times = {1.0 - float(eps) for eps in log_grid(snakemake.params.time_inelasticity)}
+    grid = [(r, False) for r in sorted(chain | times)]
     rows = []
     for r, simulated in [*grid, *((value, True) for value in snakemake.params.simulated)]:
         relaxation = bounce_chain_relaxation(r)
         equilibrium = Equilibrium(r)
+        timed = simulated or r in times
         rows.append(
             {
                 "r": relaxation.restitution,
@@ -29,8 +34,10 @@ with job_log(snakemake.log[0], exit_when_done=True):
                 "correlation_bounces": relaxation.correlation_bounces,
                 "isolated": relaxation.isolated,
                 "bounce_chain_time": equilibrium.bounce_chain_time,
-                "relaxation_time": equilibrium.relaxation_time,
-                "relaxation_time_isolated": equilibrium._time_relaxation.isolated,
+                "relaxation_time": equilibrium.relaxation_time if timed else float("nan"),
+                "relaxation_time_isolated": (
+                    equilibrium._time_relaxation.isolated if timed else False
+                ),
                 "simulated": simulated,
             }
         )
@@ -38,6 +45,7 @@ with job_log(snakemake.log[0], exit_when_done=True):
     provenance = {
         "rule": "relaxation",
         "inelasticity_grid": snakemake.params.inelasticity,
+        "time_inelasticity_grid": snakemake.params.time_inelasticity,
         "simulated": list(snakemake.params.simulated),
         "code": snakemake.params.code,
     }

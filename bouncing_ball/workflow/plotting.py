@@ -787,7 +787,16 @@ def relaxation_figure(theory, panels):
     left, right, times = axes[0, 0], axes[0, 1], axes[0, 2]
     curve = theory[~theory.simulated].sort_values("r")
     eps = 1.0 - curve.r.to_numpy()
-    times.plot(eps, curve.relaxation_time, color="k", label=r"$1/\gamma$, tilted operator")
+    timed = np.isfinite(
+        curve.relaxation_time.to_numpy(dtype=float)
+    )  # figures.fig12_time_inelasticity
+    times.plot(
+        eps[timed],
+        curve.relaxation_time[timed],
+        color="k",
+        marker=".",
+        label=r"$1/\gamma$, tilted operator",
+    )
     times.plot(
         eps, curve.bounce_chain_time, color="C3", label=r"$n_c \langle T\rangle$, bounce chain"
     )

@@ -65,6 +65,7 @@ rule relaxation:
         cpus_per_task=1,
     params:
         inelasticity=config["figures"]["fig12_inelasticity"],
+        time_inelasticity=config["figures"]["fig12_time_inelasticity"],
         simulated=[exact_string(value) for value in RESTITUTION.values()],
         code=code(stages.SOLVER, "relaxation.py"),
     script:
