@@ -17,6 +17,7 @@ import pytest
 import yaml
 from workflow_support import SMALL, copy_repository, planned_jobs, snakemake, two_at_a_time
 
+from bouncing_ball.workflow.config import shard_settings
 from bouncing_ball.workflow.io import read_table
 
 # three shards of r = 1/2, each long enough that a job can be killed mid-run
@@ -181,7 +182,11 @@ def test_extreme_r_runs_end_to_end_within_its_budget(tmp_path):
     """r = 0.05 (below r_c, with a floor on delta) and r = 0.85 (slow relaxation): every stage
     finishes; the solver's tables pass their checks; I is infinite below r_c."""
     config = yaml.safe_load(yaml.safe_dump(SMALL)) | {"restitution": [0.05, 0.85]}
-    config["simulation"]["per_restitution"] = {"0.05": {"min_step_floor": 1.0e-12}}
+    config["simulation"]["per_restitution"] = {
+        "0.05": {"min_step_floor": 1.0e-12},
+        # the shortest shards the config check accepts there, in relaxation times of r
+        "0.85": {"shard_time": {"relaxation_times": 8}},
+    }
     directory = copy_repository(tmp_path, config)
     targets = [
         f"results/{kind}/r{label}/summary.parquet"
@@ -199,7 +204,8 @@ def test_extreme_r_runs_end_to_end_within_its_budget(tmp_path):
     for label in ("0.05", "0.85"):
         simulated, _ = read_table(directory / f"results/simulation/r{label}/summary.parquet")
         assert simulated.shards_out_of_budget.iloc[0] == 0
-        assert simulated.total_time.iloc[0] == pytest.approx(3 * 2.0e3)
+        shard_time = shard_settings(config, label).shard_time  # 2e3; 8 relaxation times at 0.85
+        assert simulated.total_time.iloc[0] == pytest.approx(3 * shard_time)
         solved, _ = read_table(directory / f"results/solver/r{label}/summary.parquet")
         assert solved.accuracy_estimate.iloc[0] < 1e-8
         # int P dx, within the interpolation error of w(F) at the test config's few nodes
