@@ -56,6 +56,9 @@ rule relaxation:
         "results/theory/relaxation.parquet",
     log:
         "logs/theory/relaxation.log",
+    # a minute of eigenvalue searches that only Fig. 12 waits for: beside the simulation, not
+    # after it (with the solves, common.smk's solve_priority)
+    priority: 9
     localrule: True
     conda:
         "../envs/bouncing-ball.yaml"
