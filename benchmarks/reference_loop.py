@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bouncing_ball.settings import RETURN_LAW_SPEED_BINS, ShardSettings
+from bouncing_ball.settings import ShardSettings, return_law_speed_bins
 from bouncing_ball.tallies import (
     BINS,
     EARLY_FRACTION,
@@ -212,8 +212,8 @@ def reference_shard(
         settings.velocity_bins.n,
         edges["flight_time_bins"],
         settings.flight_time_bins.n,
-        np.ascontiguousarray(RETURN_LAW_SPEED_BINS.edges, dtype=np.float64),
-        RETURN_LAW_SPEED_BINS.n,
+        np.ascontiguousarray(return_law_speed_bins(settings.speed_bins).edges, dtype=np.float64),
+        return_law_speed_bins(settings.speed_bins).n,
         arrays["speed_counts"],
         arrays["position_time"],
         arrays["position_v2_time"],

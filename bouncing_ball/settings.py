@@ -26,7 +26,8 @@ __all__ = [
     "DEFAULT_POSITION_BINS",
     "DEFAULT_VELOCITY_BINS",
     "DEFAULT_FLIGHT_TIME_BINS",
-    "RETURN_LAW_SPEED_BINS",
+    "RETURN_LAW_BINS_PER_DECADE",
+    "return_law_speed_bins",
 ]
 
 #: The largest step budget: far beyond any shard (10^15 steps are years of CPU), far inside
@@ -57,10 +58,35 @@ DEFAULT_POSITION_BINS = LogBins(1.0e-3, 1.0e3, 5)
 DEFAULT_VELOCITY_BINS = LinearBins(-24.0, 20.0, 0.25)
 #: Times between collisions: 1e-12 to 1000, 5 bins per decade.
 DEFAULT_FLIGHT_TIME_BINS = LogBins(1.0e-12, 1.0e3, 5)
-#: Outgoing speeds again, 1e-10 to 1000 at 100 bins per decade: fine enough that the
-#: return-speed law of eq. (kernel3) hardly varies within a bin, for the return-law control
-#: of P(0, v) (``estimators.return_law_prediction``).  Not a setting: every shard records it.
-RETURN_LAW_SPEED_BINS = LogBins(1.0e-10, 1.0e3, 100)
+#: Bins per decade of the fine outgoing speeds (``return_law_speed_bins``).
+RETURN_LAW_BINS_PER_DECADE = 100
+
+
+def return_law_speed_bins(speed_bins: LogBins) -> LogBins:
+    """The fine bins of outgoing speeds every shard records beside ``speed_bins``.
+
+    The same range at ``RETURN_LAW_BINS_PER_DECADE`` bins per decade: fine enough that the
+    return-speed law of eq. (kernel3) hardly varies within a bin, for the return-law control of
+    P(0, v) (``estimators.return_law_prediction``); the range is the speed bins', which follow
+    r's scales (``scales``).  Not a setting of its own.
+
+    Parameters
+    ----------
+    speed_bins : LogBins
+        The shard's bins of outgoing speeds.
+
+    Returns
+    -------
+    LogBins
+
+    Examples
+    --------
+    >>> from bouncing_ball.bins import LogBins
+    >>> from bouncing_ball.settings import return_law_speed_bins
+    >>> return_law_speed_bins(LogBins(1e-4, 100.0, 10)).n
+    600
+    """
+    return LogBins(speed_bins.lo, speed_bins.hi, RETURN_LAW_BINS_PER_DECADE)
 
 
 @dataclass(frozen=True)

@@ -4,7 +4,7 @@ A shard is stored as one long table, a row per tally entry::
 
     tally                   lo     hi     lo2    hi2    value
     outgoing_speed          v_lo   v_hi   NaN    NaN    collisions with v_out in [v_lo, v_hi)
-    outgoing_speed_fine     v_lo   v_hi   NaN    NaN    the same on RETURN_LAW_SPEED_BINS
+    outgoing_speed_fine     v_lo   v_hi   NaN    NaN    the same on the fine bins (settings.return_law_speed_bins)
     position_time           x_lo   x_hi   NaN    NaN    time spent with x in [x_lo, x_hi)
     position_v2_time        x_lo   x_hi   NaN    NaN    int v^2 dt over that time
     flight_time             t_lo   t_hi   NaN    NaN    flights with duration in [t_lo, t_hi)
@@ -63,7 +63,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .bins import LinearBins, LogBins
-from .settings import RETURN_LAW_SPEED_BINS
+from .settings import return_law_speed_bins
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -100,7 +100,7 @@ __all__ = [
 ]
 
 #: The 1-D histograms, name in the table: (the bins' attribute, the values' attribute,
-#: integer counts?).  ``return_law_speed_bins`` is ``settings.RETURN_LAW_SPEED_BINS``, the same
+#: integer counts?).  ``return_law_speed_bins`` is ``settings.return_law_speed_bins`` of the speed bins, the same
 #: for every shard.
 HISTOGRAMS = {
     "outgoing_speed": ("speed_bins", "speed_counts", True),
@@ -222,7 +222,7 @@ def bounce_lag_pair_sums(sums):
 def _bins(holder, attribute):
     """The bins ``attribute`` of a shard's settings or tallies (``HISTOGRAMS``)."""
     if attribute == "return_law_speed_bins":
-        return RETURN_LAW_SPEED_BINS
+        return return_law_speed_bins(holder.speed_bins)
     return getattr(holder, attribute)
 
 
@@ -277,7 +277,7 @@ class ShardTallies:
         Collisions by outgoing speed (P(0, v)), flights by duration; each with its under- and
         overflow bins.
     return_law_speed_counts : numpy.ndarray of int64
-        Collisions by outgoing speed on the fine ``settings.RETURN_LAW_SPEED_BINS``, for the
+        Collisions by outgoing speed on the fine ``settings.return_law_speed_bins``, for the
         return-law control of P(0, v) (``estimators.return_law_prediction``).
     bounce_lag_sums : numpy.ndarray
         Shape (len(BOUNCE_LAG_SUMS), BOUNCE_LAGS + 1): for each sum of ``BOUNCE_LAG_SUMS``
@@ -324,7 +324,7 @@ class ShardTallies:
     flight_time_counts: np.ndarray  # durations of the recorded flights
     position_velocity_time: np.ndarray  # (x bins, v bins): time per cell (sampled on the bridge)
     return_speed_counts: np.ndarray  # (u bins, v bins): outgoing speed u, return speed v
-    return_law_speed_counts: np.ndarray  # outgoing speeds again, on RETURN_LAW_SPEED_BINS
+    return_law_speed_counts: np.ndarray  # outgoing speeds again, on the fine return_law_speed_bins
     bounce_lag_sums: np.ndarray  # (BOUNCE_LAG_SUMS, lags 0 .. BOUNCE_LAGS): bounce-chain sums
     time: float
     collisions: int

@@ -5,7 +5,7 @@ import numbers
 
 import numpy as np
 
-from ..settings import RETURN_LAW_SPEED_BINS
+from ..settings import return_law_speed_bins
 from ..tallies import (
     MOMENT_CONTROLS,
     RATE_CONTROLS,
@@ -134,7 +134,7 @@ def _restitution_float(restitution) -> float:
 def _occupied_fine_bins(shards):
     """The shards' ``return_law_speed_counts`` in the fine bins any shard reached, and those
     bins' edges (the fine under- and overflow bins as the decade beyond each end)."""
-    fine = RETURN_LAW_SPEED_BINS
+    fine = return_law_speed_bins(shards[0].speed_bins)
     counts = np.stack([s.return_law_speed_counts for s in shards]).astype(float)
     occupied = np.flatnonzero(counts.sum(axis=0))
     lower = np.maximum(fine.lower[occupied], 0.1 * fine.lo)
@@ -149,7 +149,7 @@ _RETURN_LAW_SHARDS = max(SHARDS_PER_CONTROL, 4)
 _FLIGHT_LAW_SHARDS = SHARDS_PER_CONTROL * (len(RATE_CONTROLS) + 2)
 
 
-#: Gauss-Legendre points in ln u per fine bin of ``settings.RETURN_LAW_SPEED_BINS`` (2.3 %
+#: Gauss-Legendre points in ln u per fine bin of ``settings.return_law_speed_bins`` (2.3 %
 #: wide) in ``return_law_prediction``.
 RETURN_LAW_POINTS = 4
 
@@ -166,7 +166,7 @@ def return_law_prediction(shards: list[ShardTallies], restitution: float, outgoi
 
     over the collisions of a shard, up to one collision at the ends of its recording.  This
     is the shard's ``return_law_speed_counts`` (outgoing speeds on the fine
-    ``settings.RETURN_LAW_SPEED_BINS``) times M_j averaged over each fine bin with weight
+    ``settings.return_law_speed_bins``) times M_j averaged over each fine bin with weight
     u P(0, u) (``flight_time.return_speed_bin_probabilities``; the solver's P(0, u) only
     weighs u inside a 2.3 % wide bin).  Counts minus prediction is the return-law control
     variate of ``outgoing_speed_histogram``: mean 0 for the process of eq. (kernel3); in a
@@ -196,7 +196,7 @@ def return_law_prediction(shards: list[ShardTallies], restitution: float, outgoi
     >>> import numpy as np
     >>> from bouncing_ball.bins import LinearBins, LogBins
     >>> from bouncing_ball.exact import outgoing_speed_density
-    >>> from bouncing_ball.settings import RETURN_LAW_SPEED_BINS, ShardSettings
+    >>> from bouncing_ball.settings import ShardSettings
     >>> from bouncing_ball.tallies import ShardTallies
     >>> from bouncing_ball.estimators import return_law_prediction
     >>> settings = ShardSettings(
@@ -204,7 +204,7 @@ def return_law_prediction(shards: list[ShardTallies], restitution: float, outgoi
     ...     max_steps=100, speed_bins=LogBins(0.1, 10.0, 1),
     ... )
     >>> arrays = ShardTallies.loop_arrays(settings)
-    >>> arrays["return_law_speed_counts"][1 + 1000] = 100  # u in [1, 1.023)
+    >>> arrays["return_law_speed_counts"][1 + 100] = 100  # u in [1, 1.023): 0.1 to 10, 100 a decade
     >>> shard = ShardTallies.from_loop(settings, arrays)
     >>> density = lambda u: outgoing_speed_density(u, "1/2")
     >>> prediction = return_law_prediction([shard], 0.5, density)
@@ -268,7 +268,7 @@ def flight_law_prediction(shards: list[ShardTallies], outgoing_density) -> np.nd
     ...     max_steps=100,
     ... )
     >>> arrays = ShardTallies.loop_arrays(settings)
-    >>> arrays["return_law_speed_counts"][1 + 1000] = 100  # u in [1, 1.023)
+    >>> arrays["return_law_speed_counts"][1 + 400] = 100  # u in [1, 1.023): from 1e-4, 100 a decade
     >>> shard = ShardTallies.from_loop(settings, arrays)
     >>> density = lambda u: outgoing_speed_density(u, "1/2")
     >>> print(np.round(flight_law_prediction([shard], density), 1))

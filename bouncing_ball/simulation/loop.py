@@ -143,7 +143,7 @@ from ..free_flight import (
 )
 from ..jit import flag_is_set, fma, njit
 from ..pcg64 import next_double, standard_normal, stream_words
-from ..settings import RETURN_LAW_SPEED_BINS, ShardSettings
+from ..settings import ShardSettings, return_law_speed_bins
 from ..tallies import EARLY_FRACTION, SCALAR_INDEX, ShardTallies, tally_seed_sequence
 from .step_tallies import (
     CONTROL_VARIATES,
@@ -354,7 +354,7 @@ def _run(
 ):
     # stop: the stop flag (ShardStop.flag); returns True when it stopped the shard
     # v_edges: speeds (log); x_edges: heights (log); u_edges: velocities of P(x, v) (linear);
-    # f_edges: flight times (log); w_edges: outgoing speeds, fine (log, RETURN_LAW_SPEED_BINS);
+    # f_edges: flight times (log); w_edges: outgoing speeds, fine (log, settings.return_law_speed_bins);
     # stream, tally_stream: the PCG64 states (pcg64.stream_words)
     high, low, inc_high, inc_low = stream
     tally_high, tally_low, tally_inc_high, tally_inc_low = tally_stream
@@ -797,7 +797,7 @@ def simulate_shard(
         settings.position_bins.edges,
         settings.velocity_bins.edges,
         settings.flight_time_bins.edges,
-        RETURN_LAW_SPEED_BINS.edges,
+        return_law_speed_bins(settings.speed_bins).edges,
         arrays["speed_counts"],
         arrays["position_time"],
         arrays["position_v2_time"],

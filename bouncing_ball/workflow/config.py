@@ -40,7 +40,7 @@ from ..scales import (
     resolve_bins,
     resolve_solver_grids,
 )
-from ..settings import RETURN_LAW_SPEED_BINS, ShardSettings
+from ..settings import ShardSettings, return_law_speed_bins
 from ..tallies import HISTOGRAMS, HISTOGRAMS_2D
 
 # the config's schema, in the repository that holds this package
@@ -387,7 +387,7 @@ def tally_cells(simulation: dict) -> dict[str, int]:
         "position_bins": log_bins(simulation["position_bins"]),
         "velocity_bins": linear_bins(simulation["velocity_bins"]),
         "flight_time_bins": log_bins(simulation["flight_time_bins"]),
-        "return_law_speed_bins": RETURN_LAW_SPEED_BINS,
+        "return_law_speed_bins": return_law_speed_bins(log_bins(simulation["speed_bins"])),
     }
     cells = {name: bins[spec].n + 2 for name, (spec, _, _) in HISTOGRAMS.items()}
     for name, ((first, second), _, _) in HISTOGRAMS_2D.items():
@@ -398,7 +398,7 @@ def tally_cells(simulation: dict) -> dict[str, int]:
 # the settings behind each tally's cells, as the config names them
 TALLY_KEYS = {
     "outgoing_speed": "simulation.speed_bins",
-    "outgoing_speed_fine": "the fixed settings.RETURN_LAW_SPEED_BINS",
+    "outgoing_speed_fine": "simulation.speed_bins (at 100 bins per decade)",
     "position_time": "simulation.position_bins",
     "position_v2_time": "simulation.position_bins",
     "flight_time": "simulation.flight_time_bins",

@@ -10,12 +10,20 @@ import pytest
 from scipy import integrate
 
 from bouncing_ball import exact
+from bouncing_ball.bins import LogBins
 from bouncing_ball.estimators import return_law_prediction
-from bouncing_ball.settings import RETURN_LAW_SPEED_BINS, ShardSettings
+from bouncing_ball.settings import ShardSettings, return_law_speed_bins
 from bouncing_ball.tallies import ShardTallies
 
+# speed bins (and so the fine bins of the return-law control) that hold the collisions of
+# both exact r to rounding, as the bins that follow r do (scales)
 SETTINGS = ShardSettings(
-    shard_time=1.0, equilibration_time=0.0, criterion_c=3, min_step_divisor=10, max_steps=100
+    shard_time=1.0,
+    equilibration_time=0.0,
+    criterion_c=3,
+    min_step_divisor=10,
+    max_steps=100,
+    speed_bins=LogBins(1e-10, 1e3, 10),
 )
 # the rate of collisions is int u P(0, u) du, eq. (collrate); scaled up to counts
 SCALE = 1e12
@@ -32,7 +40,7 @@ def _collision_rate(density, lower, upper):
 
 def _equilibrium_shard(density):
     """A shard whose fine outgoing-speed counts are the equilibrium's expectation."""
-    fine = RETURN_LAW_SPEED_BINS
+    fine = return_law_speed_bins(SETTINGS.speed_bins)
     counts = SCALE * _collision_rate(density, fine.lower, fine.upper)
     empty = ShardTallies.from_loop(SETTINGS, ShardTallies.loop_arrays(SETTINGS))
     return dataclasses.replace(empty, return_law_speed_counts=counts)
@@ -107,7 +115,7 @@ def _shards_with_speeds(density, scales):
     expected counts times ``scales`` (one shard each), rounded."""
     from bouncing_ball.tallies import SCALAR_INDEX
 
-    fine, coarse = RETURN_LAW_SPEED_BINS, SETTINGS.speed_bins
+    fine, coarse = return_law_speed_bins(SETTINGS.speed_bins), SETTINGS.speed_bins
     shards = []
     for scale in scales:
         arrays = ShardTallies.loop_arrays(SETTINGS)
