@@ -79,7 +79,7 @@ DECAY_LENGTHS = 22.0
 LONGEST_NOISE_FLIGHT = 150.0
 
 #: Velocity bins of P(x, v) an automatic range is cut into.
-VELOCITY_BINS = 160
+VELOCITY_BINS = 320
 
 
 def _exponents(restitution):
@@ -394,14 +394,14 @@ def auto_linear_bins(spec, largest, bins=VELOCITY_BINS):
     Returns
     -------
     dict
-        {lo, hi, width}; an automatic width is a 1, 2 or 5 times a power of 10.
+        {lo, hi, width}; an automatic width is 1, 2, 2.5 or 5 times a power of 10.
     """
     filled = _filled(spec, {"lo": -largest, "hi": largest, "width": AUTO})
     lo, hi, width = float(filled["lo"]), float(filled["hi"]), filled["width"]
     if width == AUTO:
         raw = (hi - lo) / bins
         decade = 10.0 ** math.floor(math.log10(raw))
-        width = next(step * decade for step in (1.0, 2.0, 5.0, 10.0) if step * decade >= raw)
+        width = next(step * decade for step in (1.0, 2.0, 2.5, 5.0, 10.0) if step * decade >= raw)
         lo, hi = math.floor(lo / width) * width, math.ceil(hi / width) * width
     return {"lo": float(lo), "hi": float(hi), "width": float(width)}
 
@@ -487,7 +487,7 @@ SOLVER_TABLE_POINTS = {
     "output_speeds": 401,
     "flight_times": 151,
     "position_grid": 141,
-    "speeds": 201,
+    "speeds": 801,
     "forces": 121,
 }
 
