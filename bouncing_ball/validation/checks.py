@@ -12,6 +12,7 @@ from .moments import _number, value_with_error
 from .sign_flip import SIGN_FLIPS, order_free_mean, ratio_deviations, sign_flip_test
 
 __all__ = [
+    "MINIMUM_BIN_COUNT",
     "outgoing_speed_residuals",
     "exact_outgoing_speed_residuals",
     "outgoing_speed_checks",
@@ -29,6 +30,13 @@ __all__ = [
 
 # exact, fits and histograms (scipy, numba) are imported by the functions that use them: the
 # moments and position tables need none of them
+
+
+#: The fewest collisions a bin of P(0, v) needs to enter a z-score: below, its counts come from
+#: a few excursions of a few shards, so its shard-scatter error is no standard error and most
+#: shards' deviations share a sign (the sign-flip null fails).  The bins that follow r reach
+#: about 1e-6 of the collisions at each end: their outermost bins hold a handful in any run.
+MINIMUM_BIN_COUNT = 50
 
 
 def outgoing_speed_residuals(simulated: pd.DataFrame, solver_curve: pd.DataFrame) -> pd.DataFrame:
@@ -59,6 +67,7 @@ def outgoing_speed_residuals(simulated: pd.DataFrame, solver_curve: pd.DataFrame
         & (simulated.v_hi <= speeds[-1])
         & np.isfinite(simulated.p0v_err)
         & (simulated.p0v_err > 0)
+        & (simulated["count"] >= MINIMUM_BIN_COUNT)
     )
     bins = simulated[inside]
     reference = bin_averages_of_curve(speeds, density, bins.v_lo.to_numpy(), bins.v_hi.to_numpy())
@@ -84,7 +93,8 @@ def exact_outgoing_speed_residuals(simulated: pd.DataFrame, restitution) -> pd.D
     Parameters
     ----------
     simulated : pandas.DataFrame
-        A merged p0v table; its finite bins with an error are compared.
+        A merged p0v table; its finite bins with an error and at least ``MINIMUM_BIN_COUNT``
+        collisions are compared.
     restitution : float or fractions.Fraction
         1/2 or 1/3.
 
@@ -101,6 +111,7 @@ def exact_outgoing_speed_residuals(simulated: pd.DataFrame, restitution) -> pd.D
         & np.isfinite(simulated.v_hi)
         & np.isfinite(simulated.p0v_err)
         & (simulated.p0v_err > 0.0)
+        & (simulated["count"] >= MINIMUM_BIN_COUNT)
     )
     bins = simulated[usable]
     truth = exact.outgoing_speed_bin_average(

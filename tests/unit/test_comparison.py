@@ -31,6 +31,7 @@ from bouncing_ball.validation import (
     validation_table,
     value_with_error,
 )
+from bouncing_ball.validation.checks import MINIMUM_BIN_COUNT
 
 
 @pytest.mark.parametrize("restitution", exact.EXACT_RESTITUTIONS)
@@ -253,7 +254,7 @@ def test_a_curve_that_underflows_is_used_up_to_its_last_positive_value():
             "v": np.sqrt(edges[:-1] * edges[1:]),
             "p0v": 1.0,
             "p0v_err": 0.1,
-            "count": 10,
+            "count": 100,
         }
     )
     table = outgoing_speed_residuals(simulated, pd.DataFrame({"v": speeds, "p0v": density}))
@@ -812,7 +813,12 @@ def test_validation_chi2_rows_get_a_sign_flip_p_value_from_the_shards(restitutio
         assert "sign flips of the 16 shards" in rows.loc[check, "detail"]
     assert rows.drop(index=chi2_rows).p_sign_flip.isna().all()
     table = outgoing_speed_histogram(shards)
-    usable = np.flatnonzero(np.isfinite(table.p0v_err) & (table.v_lo > 0) & np.isfinite(table.v_hi))
+    usable = np.flatnonzero(
+        np.isfinite(table.p0v_err)
+        & (table.v_lo > 0)
+        & np.isfinite(table.v_hi)
+        & (table["count"] >= MINIMUM_BIN_COUNT)
+    )
     numerators, denominators = shard_ratios(shards)["p0v"]
     reference = exact.outgoing_speed_bin_average(
         table.v_lo.to_numpy()[usable], table.v_hi.to_numpy()[usable], restitution
