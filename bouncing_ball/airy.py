@@ -56,7 +56,7 @@ BESSEL_AIRY_PHASE = 2.0
 #: ``scaled_airy_ai`` sums the Maclaurin series of Ai (DLMF 9.4.1) where ``|z| <= SERIES_AIRY``
 #: (MACLAURIN_TERMS terms of each of its two series: the next is below 1e-20 of the first), and
 #: the asymptotic series (DLMF 9.7.5) where ``|z| >= ASYMPTOTIC_AIRY`` and
-#: ``|arg z| <= 2 pi / 3`` (ASYMPTOTIC_TERMS terms: at zeta = (2/3) |z|^(3/2) >= 27.7 the next,
+#: ``|arg z| <= 2 pi / 3`` (ASYMPTOTIC_TERMS terms: at zeta = (2/3) abs(z)^(3/2) >= 27.7 the next,
 #: ~ k! / (2 zeta)^k, is below 1e-16); both within 1e-15 of mpmath's Ai at 30 digits (scipy's
 #: airye within 4e-15 there: tests/unit/test_airy.py holds them to 5e-15 of it), several
 #: times faster than the Bessel function.

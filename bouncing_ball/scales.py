@@ -17,7 +17,7 @@ paper and of ``distribution.exponents``:
   a speed below T^(1/2) round, so T_hi = 2.5 ``DECAY_LENGTHS`` / q (and at least
   ``LONGEST_NOISE_FLIGHT``, the flights the noise keeps up where q is large) and
   T_lo = eps^(2 / (2 - beta)) / q^2;
-- velocities of P(x, v): |v| <= (``DECAY_LENGTHS`` + 4) / q, and at least 40.
+- velocities of P(x, v): abs(v) <= (``DECAY_LENGTHS`` + 4) / q, and at least 40.
 
 Where 2 - beta is small (r just above r_c) or negative (below r_c, where the collapse is cut
 off by the simulation's floor), the low ends stop at the smallest speed and time the
@@ -227,7 +227,7 @@ def flight_time_range(restitution, smallest=1e-300, tail=TAIL_FRACTION):
 
 
 def velocity_range(restitution):
-    """The largest |v| of the velocities P(x, v) is tabulated on.
+    """The largest abs(v) of the velocities P(x, v) is tabulated on.
 
     Parameters
     ----------
@@ -237,10 +237,10 @@ def velocity_range(restitution):
     Returns
     -------
     float
-        max(26 / q, 40): a flight's |v| stays below its incoming speed, up to the noise, and
+        max(26 / q, 40): a flight's abs(v) stays below its incoming speed, up to the noise, and
         the time at speeds above 26 / q is about e^-26 (q v)^2 of the whole; where q is large
         the noise keeps flights up longer (at r = 1/4 and 1/2 about 1e-6 of the time has
-        |v| > 22, and in some runs at r = 1/4 3e-5 has v < -30).
+        abs(v) > 22, and in some runs at r = 1/4 3e-5 has v < -30).
 
     Examples
     --------
@@ -387,7 +387,7 @@ def auto_linear_bins(spec, largest, bins=VELOCITY_BINS):
     spec : str or dict
         ``"auto"``, or a dict whose lo, hi and width may each be ``"auto"`` or missing.
     largest : float
-        The largest |v| of r's scales (``velocity_range``).
+        The largest abs(v) of r's scales (``velocity_range``).
     bins : int, optional
         The bins an automatic width cuts [lo, hi] into.
 
