@@ -36,7 +36,7 @@ def test_the_relaxation_time_bound_lies_above_the_relaxation_time_at_every_r():
     )
 
     near_critical = CRITICAL_RESTITUTION + np.array([1e-5, 1e-3])
-    # each r is an eigenvalue search (3 CPU s at 0.99, 20 s at 0.999); above 0.995 the ratio is
+    # each r is an eigenvalue search on a matrix that grows like 1/(1 - r); above 0.995 the ratio is
     # the quasi-elastic one, 7.5 / ((64/9) (1 - eps)) > 1.054 (tests/numerical holds 1/gamma to
     # (64/9) eps^-2 (1 - eps) at eps = 0.01 and 0.005), and 0.99999 takes the quasi-elastic form
     grid = [*near_critical, *np.linspace(0.17, 0.99, 15)]

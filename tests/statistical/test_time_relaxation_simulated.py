@@ -46,7 +46,7 @@ WINDOWS_PER_TIME = 4  # windows per relaxation time
 LAGS = np.arange(4, 17)  # 1 to 4 relaxation times
 EQUILIBRATION_WINDOWS = 80
 EDGE_POWER_RESTITUTION = 0.75  # 20 relaxation times
-# the recorded time per shard, in relaxation times (the three r: about 25 s of one core)
+# the recorded time per shard, in relaxation times
 SHARD_RELAXATION_TIMES = {0.5: 3.2e4, 0.75: 3.5e4, 0.9: 2.0e4}
 
 
