@@ -67,7 +67,13 @@ from scipy import linalg, optimize
 
 from .asymptotics import CRITICAL_RESTITUTION, small_speed_exponent
 from .restitution import SOLVER_RESTITUTION_RANGE, check_solver_range
-from .solver import DEFAULT_STEP, _jacobian, _scaled_operator
+from .solver import (
+    DEFAULT_STEP,
+    FINER_LOWEST_SPEED,
+    FINER_STEP,
+    _jacobian,
+    _scaled_operator,
+)
 
 __all__ = [
     "RELAXATION_COLUMNS",
@@ -336,8 +342,8 @@ def relaxation_accuracy(relaxation) -> float:
     """
     finer = bounce_chain_relaxation(
         relaxation.restitution,
-        step=0.8 * relaxation.step,
-        lowest_speed=1e-4 * relaxation.lowest_speed,
+        step=FINER_STEP * relaxation.step,
+        lowest_speed=FINER_LOWEST_SPEED * relaxation.lowest_speed,
     )
     return float(abs(relaxation.eigenvalue - finer.eigenvalue))
 

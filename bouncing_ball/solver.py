@@ -96,6 +96,9 @@ __all__ = [
     "LARGEST_STEP",
     "ACCURACY_TARGET",
     "CHECKED_SPEEDS",
+    "FINER_STEP",
+    "FINER_LOWEST_SPEED",
+    "FINER_HIGHEST_SPEED",
     "SMALLEST_OUTPUT_SPEED",
     "speed_of_coordinate",
     "coordinate_of_speed",
@@ -709,6 +712,11 @@ SMALLEST_OUTPUT_SPEED = 1e-100
 #: The accuracy the solver is held to: relative error of P(0, v) over CHECKED_SPEEDS
 #: (independent of the output grid), and of the energy balance (M_3 above).
 ACCURACY_TARGET = 1e-8
+#: The finer discretisation every accuracy estimate compares with (``accuracy_estimate``,
+#: ``relaxation.relaxation_accuracy``, ``time_relaxation.time_relaxation_accuracy``): the
+#: step, the lowest node and the highest node times these.
+FINER_STEP, FINER_LOWEST_SPEED, FINER_HIGHEST_SPEED = 0.8, 1e-4, 1.2
+
 #: The speeds at which ``accuracy_estimate`` compares P(0, v) with a finer solve.
 CHECKED_SPEEDS = np.geomspace(1e-3, 20.0, 400)
 
@@ -744,9 +752,9 @@ def accuracy_estimate(solution) -> float:
     cap = 0.99 * UNDERFLOW_EFOLDS / large_speed_decay_rate(r)
     finer = solve_outgoing_speed_density(
         r,
-        step=0.8 * solution.step,
-        lowest_speed=1e-4 * solution.speeds[0],
-        highest_speed=min(1.2 * solution.speeds[-1], cap),
+        step=FINER_STEP * solution.step,
+        lowest_speed=FINER_LOWEST_SPEED * solution.speeds[0],
+        highest_speed=min(FINER_HIGHEST_SPEED * solution.speeds[-1], cap),
     )
     reference = finer.outgoing_speed_density(CHECKED_SPEEDS)
     usable = reference > 0.0  # below r ~ 0.015, P(0, 20) underflows

@@ -75,6 +75,9 @@ from .kernel import kernel_small_u_limit, return_speed_kernel_matrix
 from .relaxation import _chain_restitution, _checked_step
 from .solver import (
     DEFAULT_STEP,
+    FINER_HIGHEST_SPEED,
+    FINER_LOWEST_SPEED,
+    FINER_STEP,
     OutgoingSpeedSolution,
     coordinate_of_speed,
     default_highest_speed,
@@ -372,8 +375,8 @@ def time_relaxation_accuracy(relaxation) -> float:
     """
     finer = time_relaxation(
         relaxation.restitution,
-        step=0.8 * relaxation.step,
-        lowest_speed=1e-4 * relaxation.lowest_speed,
-        highest_speed=1.2 * relaxation.highest_speed,
+        step=FINER_STEP * relaxation.step,
+        lowest_speed=FINER_LOWEST_SPEED * relaxation.lowest_speed,
+        highest_speed=FINER_HIGHEST_SPEED * relaxation.highest_speed,
     )
     return float(abs(relaxation.rate / finer.rate - 1.0))
